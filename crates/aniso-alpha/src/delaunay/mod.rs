@@ -1,1 +1,225 @@
-//! tmp
+//! Exact 3D Delaunay tetrahedralization.
+//!
+//! [`Triangulation::new`] builds the Delaunay tetrahedralization of a point
+//! set with exact predicates and CGAL's symbolic perturbation, so that on
+//! degenerate input (grids, cospherical points) the result is the same
+//! unique triangulation that CGAL's `Delaunay_triangulation_3` produces,
+//! tetrahedron for tetrahedron.
+//!
+//! # Storage
+//!
+//! Tetrahedra live in flat arrays indexed by `u32`:
+//!
+//! * `tets[t]`: the four vertex ids, positively oriented for finite tets;
+//! * `adj[t][i]`: the tetrahedron across the face opposite vertex `i`,
+//!   packed as `4 * neighbour + j` where `j` is the index of that face in the
+//!   neighbour (the *mirror* index), so crossing a face costs nothing.
+//!
+//! The convex hull is closed by an *infinite vertex* ([`INFINITE`]): each
+//! hull facet is the finite face of one infinite tetrahedron, and hull
+//! facets are ordinary adjacency. An infinite tet is oriented so that
+//! replacing the infinite vertex by a point outside the hull (beyond its
+//! facet) gives a positively oriented tetrahedron. After construction the
+//! finite tetrahedra are numbered `0 .. num_finite_tets()`, the infinite ones
+//! after them.
+//!
+//! Vertex ids are assigned in insertion order (a spatially coherent order);
+//! [`Triangulation::input_index`] and [`Triangulation::vertex_of_input`]
+//! translate to and from indices into the caller's slice.
+
+mod build;
+mod order;
+mod queries;
+mod validate;
+
+pub use queries::{Edge, Triangle};
+pub use validate::ValidationError;
+
+use crate::geometry::Point3;
+
+/// The id of the infinite vertex.
+pub const INFINITE: u32 = u32::MAX;
+
+/// Error building a triangulation.
+#[derive(Debug, Clone, PartialEq)]
+pub enum DelaunayError {
+    /// The input holds no point.
+    Empty,
+    /// A coordinate is NaN or infinite.
+    NonFinite {
+        /// Index of the offending point in the input.
+        index: usize,
+        /// Which coordinate (0 = x, 1 = y, 2 = z).
+        coord: usize,
+        /// The value found.
+        value: f64,
+    },
+    /// More points than the `u32` indices can address.
+    TooManyPoints(usize),
+}
+
+impl std::fmt::Display for DelaunayError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            DelaunayError::Empty => write!(f, "no points to triangulate"),
+            DelaunayError::NonFinite { index, coord, value } => write!(
+                f,
+                "point {index} has a non-finite {} coordinate ({value})",
+                ["x", "y", "z"][*coord]
+            ),
+            DelaunayError::TooManyPoints(n) => {
+                write!(f, "{n} points is more than this library can index (2^32 - 2)")
+            }
+        }
+    }
+}
+
+impl std::error::Error for DelaunayError {}
+
+/// A Delaunay tetrahedralization of a finite point set in R³.
+///
+/// ```
+/// use aniso_alpha::delaunay::Triangulation;
+/// // The 8 corners of a cube: 5 points cospherical everywhere, settled by
+/// // the symbolic perturbation.
+/// let pts: Vec<[f64; 3]> = (0..8)
+///     .map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64])
+///     .collect();
+/// let tri = Triangulation::new(&pts)?;
+/// assert_eq!(tri.dimension(), 3);
+/// assert_eq!(tri.num_finite_tets(), 6);
+/// tri.validate()?;
+/// // Every tet, with indices into `pts`, positively oriented.
+/// for [a, b, c, d] in tri.finite_tets_input() {
+///     assert!(a != b && c != d);
+/// }
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Clone, Debug)]
+pub struct Triangulation {
+    /// Vertex id -> coordinates (insertion order).
+    pts: Vec<Point3>,
+    /// Vertex id -> smallest input index holding that point.
+    vert_input: Vec<u32>,
+    /// Input index -> vertex id.
+    input_vert: Vec<u32>,
+    /// Tetrahedron -> vertex ids.
+    tets: Vec<[u32; 4]>,
+    /// Tetrahedron -> packed neighbours (`4 * tet + mirror`).
+    adj: Vec<[u32; 4]>,
+    /// Number of finite tetrahedra (they come first).
+    num_finite: usize,
+    /// Vertex id -> one incident tetrahedron.
+    vert_tet: Vec<u32>,
+    /// Affine dimension of the point set.
+    dim: usize,
+}
+
+impl Triangulation {
+    /// Builds the Delaunay tetrahedralization of `points`.
+    ///
+    /// Exact duplicates are merged (every input index maps to a vertex, see
+    /// [`Self::vertex_of_input`]). If the points span fewer than 3 dimensions
+    /// the result has no tetrahedra and [`Self::dimension`] says 0, 1 or 2.
+    ///
+    /// # Errors
+    /// [`DelaunayError::Empty`] for no points, [`DelaunayError::NonFinite`]
+    /// for a NaN or infinite coordinate.
+    pub fn new(points: &[[f64; 3]]) -> Result<Self, DelaunayError> {
+        build::build(points)
+    }
+
+    /// Affine dimension of the input: 0 (one distinct point), 1 (collinear),
+    /// 2 (coplanar) or 3. Below 3 there are no tetrahedra.
+    pub fn dimension(&self) -> usize {
+        self.dim
+    }
+
+    /// Number of input points (including duplicates).
+    pub fn num_input_points(&self) -> usize {
+        self.input_vert.len()
+    }
+
+    /// Number of distinct points, i.e. of vertices.
+    pub fn num_vertices(&self) -> usize {
+        self.pts.len()
+    }
+
+    /// Number of input points that were exact duplicates of an earlier one.
+    pub fn num_duplicates(&self) -> usize {
+        self.input_vert.len() - self.pts.len()
+    }
+
+    /// Coordinates of vertex `v`.
+    #[inline]
+    pub fn point(&self, v: u32) -> &Point3 {
+        &self.pts[v as usize]
+    }
+
+    /// All vertex coordinates, indexed by vertex id.
+    pub fn points(&self) -> &[Point3] {
+        &self.pts
+    }
+
+    /// The smallest input index whose point is vertex `v`.
+    #[inline]
+    pub fn input_index(&self, v: u32) -> u32 {
+        self.vert_input[v as usize]
+    }
+
+    /// The vertex holding input point `i`.
+    #[inline]
+    pub fn vertex_of_input(&self, i: usize) -> u32 {
+        self.input_vert[i]
+    }
+
+    /// Number of finite tetrahedra.
+    pub fn num_finite_tets(&self) -> usize {
+        self.num_finite
+    }
+
+    /// Number of tetrahedra including the infinite ones (those incident to
+    /// the infinite vertex, one per hull facet).
+    pub fn num_tets(&self) -> usize {
+        self.tets.len()
+    }
+
+    /// The finite tetrahedra as vertex ids, each positively oriented.
+    pub fn finite_tets(&self) -> &[[u32; 4]] {
+        &self.tets[..self.num_finite]
+    }
+
+    /// The finite tetrahedra with indices into the input (the smallest
+    /// index of a duplicated point), each positively oriented.
+    pub fn finite_tets_input(&self) -> impl ExactSizeIterator<Item = [u32; 4]> + '_ {
+        self.finite_tets()
+            .iter()
+            .map(move |t| t.map(|v| self.vert_input[v as usize]))
+    }
+
+    /// The four vertices of tetrahedron `t` (one may be [`INFINITE`]).
+    #[inline]
+    pub fn tet(&self, t: u32) -> [u32; 4] {
+        self.tets[t as usize]
+    }
+
+    /// Whether tetrahedron `t` is incident to the infinite vertex.
+    #[inline]
+    pub fn is_infinite(&self, t: u32) -> bool {
+        t as usize >= self.num_finite
+    }
+
+    /// The neighbour of `t` across the face opposite its vertex `i`, and the
+    /// index of that shared face in the neighbour (the mirror index).
+    #[inline]
+    pub fn neighbor(&self, t: u32, i: usize) -> (u32, usize) {
+        let p = self.adj[t as usize][i];
+        (p >> 2, (p & 3) as usize)
+    }
+
+    /// One tetrahedron incident to vertex `v` (possibly infinite).
+    #[inline]
+    pub fn incident_tet(&self, v: u32) -> u32 {
+        self.vert_tet[v as usize]
+    }
+}

@@ -1,0 +1,563 @@
+//! Bulk construction: BRIO order, remembering walk, Bowyer–Watson cavity.
+
+use super::order::{brio_order, SplitMix64};
+use super::{DelaunayError, Triangulation, INFINITE};
+use crate::geometry::predicates::{
+    collinear, coplanar_incircle_perturbed, insphere_perturbed, orient3d,
+};
+use crate::geometry::Point3;
+
+/// Marks a dead (freed) tetrahedron in `tets[t][0]`.
+const DEAD: u32 = u32::MAX - 1;
+/// An adjacency slot not yet linked.
+const UNSET: u32 = u32::MAX;
+
+/// Faces: for vertex index `i`, the other three indices in an order that
+/// makes `(face[i][0], face[i][1], face[i][2], i)` an even permutation of
+/// `(0, 1, 2, 3)`, so face `i` seen from vertex `i` is counter-clockwise.
+pub(crate) const FACE: [[usize; 3]; 4] = [[1, 3, 2], [0, 2, 3], [0, 3, 1], [0, 1, 2]];
+
+#[inline(always)]
+fn pack(t: u32, i: usize) -> u32 {
+    (t << 2) | i as u32
+}
+
+/// Whether inserting `q` destroys the tetrahedron with vertices `v`, under
+/// CGAL's symbolic perturbation: for a finite tet, `q` is inside its
+/// circumsphere; for an infinite tet, `q` is strictly beyond its hull facet,
+/// or in the facet's plane and inside its circumcircle.
+pub(crate) fn tet_in_conflict(pts: &[Point3], v: &[u32; 4], q: &Point3) -> bool {
+    let p = |w: u32| &pts[w as usize];
+    if let Some(k) = v.iter().position(|&x| x == INFINITE) {
+        let mut r: [&Point3; 4] = [q; 4];
+        for i in 0..4 {
+            if i != k {
+                r[i] = p(v[i]);
+            }
+        }
+        let o = orient3d(r[0], r[1], r[2], r[3]);
+        if o != 0 {
+            return o > 0;
+        }
+        let f = FACE[k];
+        coplanar_incircle_perturbed(p(v[f[0]]), p(v[f[1]]), p(v[f[2]]), q) > 0
+    } else {
+        insphere_perturbed(p(v[0]), p(v[1]), p(v[2]), p(v[3]), q) > 0
+    }
+}
+
+/// Working state of the incremental construction.
+struct Builder {
+    pts: Vec<Point3>,
+    tets: Vec<[u32; 4]>,
+    adj: Vec<[u32; 4]>,
+    mark: Vec<u32>,
+    free: Vec<u32>,
+    stamp: u32,
+    rng: SplitMix64,
+    // Scratch, reused across insertions.
+    stack: Vec<u32>,
+    conflicts: Vec<u32>,
+    boundary: Vec<(u32, u8)>,
+    new_tets: Vec<u32>,
+    last: u32,
+}
+
+impl Builder {
+    #[inline(always)]
+    fn p(&self, v: u32) -> &Point3 {
+        &self.pts[v as usize]
+    }
+
+    #[inline]
+    fn alloc(&mut self) -> u32 {
+        if let Some(t) = self.free.pop() {
+            t
+        } else {
+            let t = self.tets.len() as u32;
+            self.tets.push([DEAD; 4]);
+            self.adj.push([UNSET; 4]);
+            self.mark.push(0);
+            t
+        }
+    }
+
+    /// Orientation of tet `t` with its vertex `i` replaced by point `q`
+    /// (`t` finite): > 0 when `q` is on the same side of face `i` as vertex `i`.
+    #[inline(always)]
+    fn orient_replaced(&self, t: &[u32; 4], i: usize, q: &Point3) -> i32 {
+        let mut p = [
+            self.p(t[0]),
+            self.p(t[1]),
+            self.p(t[2]),
+            self.p(t[3]),
+        ];
+        p[i] = q;
+        orient3d(p[0], p[1], p[2], p[3])
+    }
+
+    #[inline]
+    fn in_conflict(&self, t: u32, q: &Point3) -> bool {
+        tet_in_conflict(&self.pts, &self.tets[t as usize], q)
+    }
+
+    /// Remembering stochastic walk from `self.last` to a tetrahedron in
+    /// conflict with `q`: either a finite tet whose closure contains `q`, or
+    /// an infinite tet whose hull facet `q` sees strictly.
+    fn locate(&mut self, q: &Point3) -> u32 {
+        let mut t = self.last;
+        let v = self.tets[t as usize];
+        if let Some(k) = v.iter().position(|&x| x == INFINITE) {
+            if self.orient_inf(&v, k, q) > 0 {
+                return t;
+            }
+            t = self.adj[t as usize][k] >> 2;
+        }
+        let mut prev = u32::MAX;
+        'walk: loop {
+            let v = self.tets[t as usize];
+            if let Some(k) = v.iter().position(|&x| x == INFINITE) {
+                // Entered through the hull facet with q strictly beyond it.
+                debug_assert!(self.orient_inf(&v, k, q) > 0);
+                let _ = k;
+                return t;
+            }
+            let r = (self.rng.next_u64() >> 62) as usize;
+            for j in 0..4 {
+                let f = (r + j) & 3;
+                let n = self.adj[t as usize][f] >> 2;
+                if n == prev {
+                    continue;
+                }
+                if self.orient_replaced(&v, f, q) < 0 {
+                    prev = t;
+                    t = n;
+                    continue 'walk;
+                }
+            }
+            return t;
+        }
+    }
+
+    /// Orientation of the infinite tet `v` (infinite vertex at `k`) with the
+    /// infinite vertex replaced by `q`: > 0 when `q` is beyond the hull facet.
+    #[inline]
+    fn orient_inf(&self, v: &[u32; 4], k: usize, q: &Point3) -> i32 {
+        let mut p: [&Point3; 4] = [q; 4];
+        for i in 0..4 {
+            if i != k {
+                p[i] = self.p(v[i]);
+            }
+        }
+        orient3d(p[0], p[1], p[2], p[3])
+    }
+
+    /// Inserts point `q` as vertex `vid`; returns the vertex it duplicates,
+    /// if any (then nothing changes).
+    fn insert(&mut self, vid: u32) -> Option<u32> {
+        let q = self.pts[vid as usize];
+        let start = self.locate(&q);
+        // A duplicate lies on a vertex of the located (finite) tet.
+        for &w in &self.tets[start as usize] {
+            if w != INFINITE && self.pts[w as usize] == q {
+                return Some(w);
+            }
+        }
+        self.stamp += 2;
+        if self.stamp >= u32::MAX - 4 {
+            self.mark.iter_mut().for_each(|m| *m = 0);
+            self.stamp = 2;
+        }
+        let conflict = self.stamp;
+        let clear = self.stamp + 1;
+
+        // Conflict region by depth-first search.
+        self.conflicts.clear();
+        self.boundary.clear();
+        self.stack.clear();
+        self.stack.push(start);
+        self.mark[start as usize] = conflict;
+        while let Some(c) = self.stack.pop() {
+            self.conflicts.push(c);
+            for f in 0..4 {
+                let n = self.adj[c as usize][f] >> 2;
+                let m = self.mark[n as usize];
+                if m == conflict {
+                    continue;
+                }
+                if m != clear && self.in_conflict(n, &q) {
+                    self.mark[n as usize] = conflict;
+                    self.stack.push(n);
+                } else {
+                    self.mark[n as usize] = clear;
+                    self.boundary.push((c, f as u8));
+                }
+            }
+        }
+
+        // One new tet per boundary facet: the conflict tet with the vertex
+        // across the facet replaced by q. Its outer neighbour is kept; the
+        // conflict tet's slot is overwritten to point at the new tet, which
+        // the edge rotation below reads.
+        self.new_tets.clear();
+        for bi in 0..self.boundary.len() {
+            let (c, f) = self.boundary[bi];
+            let f = f as usize;
+            let nt = self.alloc();
+            let mut v = self.tets[c as usize];
+            v[f] = vid;
+            self.tets[nt as usize] = v;
+            let outer = self.adj[c as usize][f];
+            self.adj[nt as usize] = [UNSET; 4];
+            self.adj[nt as usize][f] = outer;
+            self.adj[(outer >> 2) as usize][(outer & 3) as usize] = pack(nt, f);
+            self.adj[c as usize][f] = pack(nt, f);
+            self.new_tets.push(nt);
+        }
+
+        // Link the new tets to each other: the face of a new tet opposite
+        // index g (g != f) contains q and the edge (a, b) of the old facet;
+        // rotate around (a, b) through the cavity to the next boundary facet.
+        for bi in 0..self.boundary.len() {
+            let (c, f) = self.boundary[bi];
+            let f = f as usize;
+            let nt = self.new_tets[bi];
+            for g in 0..4 {
+                if g == f || self.adj[nt as usize][g] != UNSET {
+                    continue;
+                }
+                let cv = self.tets[c as usize];
+                let (a, b) = {
+                    let mut e = [0u32; 2];
+                    let mut k = 0;
+                    for (i, &w) in cv.iter().enumerate() {
+                        if i != f && i != g {
+                            e[k] = w;
+                            k += 1;
+                        }
+                    }
+                    (e[0], e[1])
+                };
+                let mut cur = c;
+                let mut cross = g;
+                let mut other = f;
+                loop {
+                    let packed = self.adj[cur as usize][cross];
+                    let n = packed >> 2;
+                    if self.mark[n as usize] != conflict {
+                        // Boundary facet of `cur`: `n` is the new tet built on it.
+                        self.adj[nt as usize][g] = pack(n, other);
+                        self.adj[n as usize][other] = pack(nt, g);
+                        break;
+                    }
+                    let nv = self.tets[n as usize];
+                    let m = (packed & 3) as usize;
+                    let mut ia = 4;
+                    let mut ib = 4;
+                    for (i, &w) in nv.iter().enumerate() {
+                        if w == a {
+                            ia = i;
+                        } else if w == b {
+                            ib = i;
+                        }
+                    }
+                    debug_assert!(ia < 4 && ib < 4 && m != ia && m != ib);
+                    let r = 6 - ia - ib - m;
+                    cur = n;
+                    cross = r;
+                    other = m;
+                }
+            }
+        }
+
+        // Free the cavity.
+        for &c in &self.conflicts {
+            self.tets[c as usize] = [DEAD; 4];
+            self.free.push(c);
+        }
+        // Start the next walk from a new finite tet if there is one.
+        let mut last = self.new_tets[0];
+        for &nt in self.new_tets.iter().rev() {
+            if !self.tets[nt as usize].contains(&INFINITE) {
+                last = nt;
+                break;
+            }
+        }
+        self.last = last;
+        None
+    }
+}
+
+/// Checks the input and finds four affinely independent points, or the
+/// dimension if there are none.
+fn initial_simplex(points: &[Point3], order: &[u32]) -> Result<[u32; 4], usize> {
+    let p0 = order[0];
+    let a = &points[p0 as usize];
+    let Some(&p1) = order.iter().find(|&&i| points[i as usize] != *a) else {
+        return Err(0);
+    };
+    let b = &points[p1 as usize];
+    let Some(&p2) = order
+        .iter()
+        .find(|&&i| !collinear(a, b, &points[i as usize]))
+    else {
+        return Err(1);
+    };
+    let c = &points[p2 as usize];
+    let Some(&p3) = order
+        .iter()
+        .find(|&&i| orient3d(a, b, c, &points[i as usize]) != 0)
+    else {
+        return Err(2);
+    };
+    Ok([p0, p1, p2, p3])
+}
+
+/// Vertex mapping for inputs of dimension < 3: merge duplicates by sorting.
+fn lower_dimensional(points: &[Point3], dim: usize) -> Triangulation {
+    let n = points.len();
+    let mut idx: Vec<u32> = (0..n as u32).collect();
+    idx.sort_by(|&i, &j| {
+        let (p, q) = (&points[i as usize], &points[j as usize]);
+        p.partial_cmp(q)
+            .unwrap_or(std::cmp::Ordering::Equal)
+            .then(i.cmp(&j))
+    });
+    let mut pts = Vec::new();
+    let mut vert_input = Vec::new();
+    let mut input_vert = vec![0u32; n];
+    for (k, &i) in idx.iter().enumerate() {
+        if k == 0 || points[idx[k - 1] as usize] != points[i as usize] {
+            pts.push(points[i as usize]);
+            vert_input.push(i);
+        }
+        input_vert[i as usize] = (pts.len() - 1) as u32;
+    }
+    let nv = pts.len();
+    Triangulation {
+        pts,
+        vert_input,
+        input_vert,
+        tets: Vec::new(),
+        adj: Vec::new(),
+        num_finite: 0,
+        vert_tet: vec![u32::MAX; nv],
+        dim,
+    }
+}
+
+pub(super) fn build(points: &[[f64; 3]]) -> Result<Triangulation, DelaunayError> {
+    let n = points.len();
+    if n == 0 {
+        return Err(DelaunayError::Empty);
+    }
+    if n >= (u32::MAX - 2) as usize / 8 {
+        return Err(DelaunayError::TooManyPoints(n));
+    }
+    for (index, p) in points.iter().enumerate() {
+        for (coord, &value) in p.iter().enumerate() {
+            if !value.is_finite() {
+                return Err(DelaunayError::NonFinite {
+                    index,
+                    coord,
+                    value,
+                });
+            }
+        }
+    }
+    // (-0.0 == 0.0 for every comparison below, so signed zeros are one point.)
+    let order = brio_order(points, 0x5EED_0A11_A1FA_u64);
+    let init = match initial_simplex(points, &order) {
+        Ok(s) => s,
+        Err(dim) => return Ok(lower_dimensional(points, dim)),
+    };
+
+    // Uniform points give about 6.8 tets per point; untouched capacity costs
+    // address space, not resident memory.
+    let expected_tets = 7 * n + n / 2 + 64;
+    let mut b = Builder {
+        pts: Vec::with_capacity(n),
+        tets: Vec::with_capacity(expected_tets),
+        adj: Vec::with_capacity(expected_tets),
+        mark: Vec::with_capacity(expected_tets),
+        free: Vec::new(),
+        stamp: 0,
+        rng: SplitMix64::new(0xC0FFEE),
+        stack: Vec::new(),
+        conflicts: Vec::new(),
+        boundary: Vec::new(),
+        new_tets: Vec::new(),
+        last: 0,
+    };
+    let mut vert_input: Vec<u32> = Vec::with_capacity(n);
+    let mut input_vert = vec![u32::MAX; n];
+
+    // The first tetrahedron and its four infinite neighbours.
+    let mut s = init;
+    if orient3d(
+        &points[s[0] as usize],
+        &points[s[1] as usize],
+        &points[s[2] as usize],
+        &points[s[3] as usize],
+    ) < 0
+    {
+        s.swap(0, 1);
+    }
+    for (v, &i) in s.iter().enumerate() {
+        b.pts.push(points[i as usize]);
+        vert_input.push(i);
+        input_vert[i as usize] = v as u32;
+    }
+    let t0 = b.alloc();
+    b.tets[t0 as usize] = [0, 1, 2, 3];
+    for i in 0..4 {
+        let ti = b.alloc();
+        // Replace vertex i by the infinite vertex, then swap two finite
+        // vertices so that the infinite vertex sits on the outer side.
+        let mut v = [0u32, 1, 2, 3];
+        v[i] = INFINITE;
+        let f = FACE[i];
+        v.swap(f[0], f[1]);
+        b.tets[ti as usize] = v;
+    }
+    link_by_faces(&mut b.tets, &mut b.adj, &[0, 1, 2, 3, 4]);
+    b.last = t0;
+
+    for &i in &order {
+        if input_vert[i as usize] != u32::MAX {
+            continue; // one of the initial four
+        }
+        let vid = b.pts.len() as u32;
+        b.pts.push(points[i as usize]);
+        match b.insert(vid) {
+            None => {
+                vert_input.push(i);
+                input_vert[i as usize] = vid;
+            }
+            Some(w) => {
+                b.pts.pop();
+                input_vert[i as usize] = w;
+                if i < vert_input[w as usize] {
+                    vert_input[w as usize] = i;
+                }
+            }
+        }
+    }
+    drop(std::mem::take(&mut b.mark));
+    Ok(compact(b, vert_input, input_vert))
+}
+
+/// Links the faces of a few tets by brute force (used for the first five).
+fn link_by_faces(tets: &mut [[u32; 4]], adj: &mut [[u32; 4]], ids: &[u32]) {
+    for &t in ids {
+        for i in 0..4 {
+            let mut fa: Vec<u32> = (0..4)
+                .filter(|&k| k != i)
+                .map(|k| tets[t as usize][k])
+                .collect();
+            fa.sort_unstable();
+            for &u in ids {
+                if u == t {
+                    continue;
+                }
+                for j in 0..4 {
+                    let mut fb: Vec<u32> = (0..4)
+                        .filter(|&k| k != j)
+                        .map(|k| tets[u as usize][k])
+                        .collect();
+                    fb.sort_unstable();
+                    if fa == fb {
+                        adj[t as usize][i] = pack(u, j);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Drops dead tets and renumbers: finite tets first, then infinite ones.
+fn compact(b: Builder, vert_input: Vec<u32>, input_vert: Vec<u32>) -> Triangulation {
+    let Builder {
+        pts,
+        mut tets,
+        mut adj,
+        ..
+    } = b;
+    let total = tets.len();
+    let mut newid = vec![u32::MAX; total];
+    let mut next = 0u32;
+    for (t, v) in tets.iter().enumerate() {
+        if v[0] != DEAD && !v.contains(&INFINITE) {
+            newid[t] = next;
+            next += 1;
+        }
+    }
+    let num_finite = next as usize;
+    for (t, v) in tets.iter().enumerate() {
+        if v[0] != DEAD && v.contains(&INFINITE) {
+            newid[t] = next;
+            next += 1;
+        }
+    }
+    let alive = next as usize;
+    for a in adj.iter_mut() {
+        for s in a.iter_mut() {
+            if *s != UNSET {
+                *s = (newid[(*s >> 2) as usize] << 2) | (*s & 3);
+            }
+        }
+    }
+    // Apply the permutation in place: after the inner loop, position `i`
+    // holds its final tet or a dead one, and every swap settles one tet.
+    for i in 0..total {
+        while newid[i] != u32::MAX && newid[i] as usize != i {
+            let d = newid[i] as usize;
+            tets.swap(i, d);
+            adj.swap(i, d);
+            newid.swap(i, d);
+        }
+    }
+    tets.truncate(alive);
+    adj.truncate(alive);
+    tets.shrink_to_fit();
+    adj.shrink_to_fit();
+    let mut vert_tet = vec![u32::MAX; pts.len()];
+    for (t, v) in tets.iter().enumerate() {
+        for &w in v {
+            if w != INFINITE {
+                vert_tet[w as usize] = t as u32;
+            }
+        }
+    }
+    Triangulation {
+        pts,
+        vert_input,
+        input_vert,
+        tets,
+        adj,
+        num_finite,
+        vert_tet,
+        dim: 3,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::FACE;
+
+    #[test]
+    fn face_table_is_even() {
+        for (i, f) in FACE.iter().enumerate() {
+            let perm = [f[0], f[1], f[2], i];
+            let mut inv = 0;
+            for a in 0..4 {
+                for b in a + 1..4 {
+                    if perm[a] > perm[b] {
+                        inv += 1;
+                    }
+                }
+            }
+            assert_eq!(inv % 2, 0, "face {i}");
+        }
+    }
+}
