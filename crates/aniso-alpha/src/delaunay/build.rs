@@ -11,6 +11,19 @@ use crate::geometry::Point3;
 const DEAD: u32 = u32::MAX - 1;
 /// An adjacency slot not yet linked.
 const UNSET: u32 = u32::MAX;
+/// Flag: the tet is in the current conflict region.
+const IN_CONFLICT: u8 = 1;
+/// Flag: the tet was tested and is not in conflict.
+const CLEAR: u8 = 2;
+
+/// One tetrahedron: vertex ids and packed neighbours (`4 * tet + mirror`),
+/// interleaved so that visiting a tet touches one 32-byte block.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(C, align(32))]
+pub(crate) struct Cell {
+    pub(crate) v: [u32; 4],
+    pub(crate) n: [u32; 4],
+}
 
 /// Faces: for vertex index `i`, the other three indices in an order that
 /// makes `(face[i][0], face[i][1], face[i][2], i)` an even permutation of
@@ -22,25 +35,19 @@ fn pack(t: u32, i: usize) -> u32 {
     (t << 2) | i as u32
 }
 
-/// Whether inserting `q` destroys the tetrahedron with vertices `v`, under
+/// Whether inserting `q` destroys the tetrahedron with vertices `v` (an
+/// infinite tet has the infinite vertex at index 3), under
 /// CGAL's symbolic perturbation: for a finite tet, `q` is inside its
 /// circumsphere; for an infinite tet, `q` is strictly beyond its hull facet,
 /// or in the facet's plane and inside its circumcircle.
 pub(crate) fn tet_in_conflict(pts: &[Point3], v: &[u32; 4], q: &Point3) -> bool {
     let p = |w: u32| &pts[w as usize];
-    if let Some(k) = v.iter().position(|&x| x == INFINITE) {
-        let mut r: [&Point3; 4] = [q; 4];
-        for i in 0..4 {
-            if i != k {
-                r[i] = p(v[i]);
-            }
-        }
-        let o = orient3d(r[0], r[1], r[2], r[3]);
+    if v[3] == INFINITE {
+        let o = orient3d(p(v[0]), p(v[1]), p(v[2]), q);
         if o != 0 {
             return o > 0;
         }
-        let f = FACE[k];
-        coplanar_incircle_perturbed(p(v[f[0]]), p(v[f[1]]), p(v[f[2]]), q) > 0
+        coplanar_incircle_perturbed(p(v[0]), p(v[1]), p(v[2]), q) > 0
     } else {
         insphere_perturbed(p(v[0]), p(v[1]), p(v[2]), p(v[3]), q) > 0
     }
@@ -49,11 +56,11 @@ pub(crate) fn tet_in_conflict(pts: &[Point3], v: &[u32; 4], q: &Point3) -> bool 
 /// Working state of the incremental construction.
 struct Builder {
     pts: Vec<Point3>,
-    tets: Vec<[u32; 4]>,
-    adj: Vec<[u32; 4]>,
-    mark: Vec<u32>,
+    cells: Vec<Cell>,
+    /// Per-tet flag during one insertion: 0, [`IN_CONFLICT`] or [`CLEAR`];
+    /// reset to 0 before the insertion returns.
+    mark: Vec<u8>,
     free: Vec<u32>,
-    stamp: u32,
     rng: SplitMix64,
     // Scratch, reused across insertions.
     stack: Vec<u32>,
@@ -74,9 +81,11 @@ impl Builder {
         if let Some(t) = self.free.pop() {
             t
         } else {
-            let t = self.tets.len() as u32;
-            self.tets.push([DEAD; 4]);
-            self.adj.push([UNSET; 4]);
+            let t = self.cells.len() as u32;
+            self.cells.push(Cell {
+                v: [DEAD; 4],
+                n: [UNSET; 4],
+            });
             self.mark.push(0);
             t
         }
@@ -98,38 +107,37 @@ impl Builder {
 
     #[inline]
     fn in_conflict(&self, t: u32, q: &Point3) -> bool {
-        tet_in_conflict(&self.pts, &self.tets[t as usize], q)
+        tet_in_conflict(&self.pts, &self.cells[t as usize].v, q)
     }
 
     /// Remembering stochastic walk from `self.last` to a tetrahedron in
     /// conflict with `q`: either a finite tet whose closure contains `q`, or
     /// an infinite tet whose hull facet `q` sees strictly.
+    #[inline(never)]
     fn locate(&mut self, q: &Point3) -> u32 {
         let mut t = self.last;
-        let v = self.tets[t as usize];
-        if let Some(k) = v.iter().position(|&x| x == INFINITE) {
-            if self.orient_inf(&v, k, q) > 0 {
+        let v = self.cells[t as usize].v;
+        if v[3] == INFINITE {
+            if orient3d(self.p(v[0]), self.p(v[1]), self.p(v[2]), q) > 0 {
                 return t;
             }
-            t = self.adj[t as usize][k] >> 2;
+            t = self.cells[t as usize].n[3] >> 2;
         }
         let mut prev = u32::MAX;
         'walk: loop {
-            let v = self.tets[t as usize];
-            if let Some(k) = v.iter().position(|&x| x == INFINITE) {
+            let c = self.cells[t as usize];
+            if c.v[3] == INFINITE {
                 // Entered through the hull facet with q strictly beyond it.
-                debug_assert!(self.orient_inf(&v, k, q) > 0);
-                let _ = k;
                 return t;
             }
             let r = (self.rng.next_u64() >> 62) as usize;
             for j in 0..4 {
                 let f = (r + j) & 3;
-                let n = self.adj[t as usize][f] >> 2;
+                let n = c.n[f] >> 2;
                 if n == prev {
                     continue;
                 }
-                if self.orient_replaced(&v, f, q) < 0 {
+                if self.orient_replaced(&c.v, f, q) < 0 {
                     prev = t;
                     t = n;
                     continue 'walk;
@@ -139,57 +147,38 @@ impl Builder {
         }
     }
 
-    /// Orientation of the infinite tet `v` (infinite vertex at `k`) with the
-    /// infinite vertex replaced by `q`: > 0 when `q` is beyond the hull facet.
-    #[inline]
-    fn orient_inf(&self, v: &[u32; 4], k: usize, q: &Point3) -> i32 {
-        let mut p: [&Point3; 4] = [q; 4];
-        for i in 0..4 {
-            if i != k {
-                p[i] = self.p(v[i]);
-            }
-        }
-        orient3d(p[0], p[1], p[2], p[3])
-    }
-
     /// Inserts point `q` as vertex `vid`; returns the vertex it duplicates,
     /// if any (then nothing changes).
+    #[inline(never)]
     fn insert(&mut self, vid: u32) -> Option<u32> {
         let q = self.pts[vid as usize];
         let start = self.locate(&q);
         // A duplicate lies on a vertex of the located (finite) tet.
-        for &w in &self.tets[start as usize] {
+        for &w in &self.cells[start as usize].v {
             if w != INFINITE && self.pts[w as usize] == q {
                 return Some(w);
             }
         }
-        self.stamp += 2;
-        if self.stamp >= u32::MAX - 4 {
-            self.mark.iter_mut().for_each(|m| *m = 0);
-            self.stamp = 2;
-        }
-        let conflict = self.stamp;
-        let clear = self.stamp + 1;
 
         // Conflict region by depth-first search.
         self.conflicts.clear();
         self.boundary.clear();
         self.stack.clear();
         self.stack.push(start);
-        self.mark[start as usize] = conflict;
+        self.mark[start as usize] = IN_CONFLICT;
         while let Some(c) = self.stack.pop() {
             self.conflicts.push(c);
             for f in 0..4 {
-                let n = self.adj[c as usize][f] >> 2;
+                let n = self.cells[c as usize].n[f] >> 2;
                 let m = self.mark[n as usize];
-                if m == conflict {
+                if m == IN_CONFLICT {
                     continue;
                 }
-                if m != clear && self.in_conflict(n, &q) {
-                    self.mark[n as usize] = conflict;
+                if m != CLEAR && self.in_conflict(n, &q) {
+                    self.mark[n as usize] = IN_CONFLICT;
                     self.stack.push(n);
                 } else {
-                    self.mark[n as usize] = clear;
+                    self.mark[n as usize] = CLEAR;
                     self.boundary.push((c, f as u8));
                 }
             }
@@ -204,14 +193,15 @@ impl Builder {
             let (c, f) = self.boundary[bi];
             let f = f as usize;
             let nt = self.alloc();
-            let mut v = self.tets[c as usize];
+            let mut v = self.cells[c as usize].v;
             v[f] = vid;
-            self.tets[nt as usize] = v;
-            let outer = self.adj[c as usize][f];
-            self.adj[nt as usize] = [UNSET; 4];
-            self.adj[nt as usize][f] = outer;
-            self.adj[(outer >> 2) as usize][(outer & 3) as usize] = pack(nt, f);
-            self.adj[c as usize][f] = pack(nt, f);
+            self.cells[nt as usize].v = v;
+            let outer = self.cells[c as usize].n[f];
+            self.mark[(outer >> 2) as usize] = 0;
+            self.cells[nt as usize].n = [UNSET; 4];
+            self.cells[nt as usize].n[f] = outer;
+            self.cells[(outer >> 2) as usize].n[(outer & 3) as usize] = pack(nt, f);
+            self.cells[c as usize].n[f] = pack(nt, f);
             self.new_tets.push(nt);
         }
 
@@ -223,10 +213,10 @@ impl Builder {
             let f = f as usize;
             let nt = self.new_tets[bi];
             for g in 0..4 {
-                if g == f || self.adj[nt as usize][g] != UNSET {
+                if g == f || self.cells[nt as usize].n[g] != UNSET {
                     continue;
                 }
-                let cv = self.tets[c as usize];
+                let cv = self.cells[c as usize].v;
                 let (a, b) = {
                     let mut e = [0u32; 2];
                     let mut k = 0;
@@ -242,15 +232,15 @@ impl Builder {
                 let mut cross = g;
                 let mut other = f;
                 loop {
-                    let packed = self.adj[cur as usize][cross];
+                    let packed = self.cells[cur as usize].n[cross];
                     let n = packed >> 2;
-                    if self.mark[n as usize] != conflict {
+                    if self.mark[n as usize] != IN_CONFLICT {
                         // Boundary facet of `cur`: `n` is the new tet built on it.
-                        self.adj[nt as usize][g] = pack(n, other);
-                        self.adj[n as usize][other] = pack(nt, g);
+                        self.cells[nt as usize].n[g] = pack(n, other);
+                        self.cells[n as usize].n[other] = pack(nt, g);
                         break;
                     }
-                    let nv = self.tets[n as usize];
+                    let nv = self.cells[n as usize].v;
                     let m = (packed & 3) as usize;
                     let mut ia = 4;
                     let mut ib = 4;
@@ -272,13 +262,14 @@ impl Builder {
 
         // Free the cavity.
         for &c in &self.conflicts {
-            self.tets[c as usize] = [DEAD; 4];
+            self.cells[c as usize].v = [DEAD; 4];
+            self.mark[c as usize] = 0;
             self.free.push(c);
         }
         // Start the next walk from a new finite tet if there is one.
         let mut last = self.new_tets[0];
         for &nt in self.new_tets.iter().rev() {
-            if !self.tets[nt as usize].contains(&INFINITE) {
+            if self.cells[nt as usize].v[3] != INFINITE {
                 last = nt;
                 break;
             }
@@ -338,8 +329,7 @@ fn lower_dimensional(points: &[Point3], dim: usize) -> Triangulation {
         pts,
         vert_input,
         input_vert,
-        tets: Vec::new(),
-        adj: Vec::new(),
+        cells: Vec::new(),
         num_finite: 0,
         vert_tet: vec![u32::MAX; nv],
         dim,
@@ -377,11 +367,9 @@ pub(super) fn build(points: &[[f64; 3]]) -> Result<Triangulation, DelaunayError>
     let expected_tets = 7 * n + n / 2 + 64;
     let mut b = Builder {
         pts: Vec::with_capacity(n),
-        tets: Vec::with_capacity(expected_tets),
-        adj: Vec::with_capacity(expected_tets),
+        cells: Vec::with_capacity(expected_tets),
         mark: Vec::with_capacity(expected_tets),
         free: Vec::new(),
-        stamp: 0,
         rng: SplitMix64::new(0xC0FFEE),
         stack: Vec::new(),
         conflicts: Vec::new(),
@@ -409,18 +397,15 @@ pub(super) fn build(points: &[[f64; 3]]) -> Result<Triangulation, DelaunayError>
         input_vert[i as usize] = v as u32;
     }
     let t0 = b.alloc();
-    b.tets[t0 as usize] = [0, 1, 2, 3];
+    b.cells[t0 as usize].v = [0, 1, 2, 3];
     for i in 0..4 {
         let ti = b.alloc();
-        // Replace vertex i by the infinite vertex, then swap two finite
-        // vertices so that the infinite vertex sits on the outer side.
-        let mut v = [0u32, 1, 2, 3];
-        v[i] = INFINITE;
+        // Face i of the first tet, reversed so that the infinite vertex (at
+        // index 3, as in every infinite tet) is on its outer side.
         let f = FACE[i];
-        v.swap(f[0], f[1]);
-        b.tets[ti as usize] = v;
+        b.cells[ti as usize].v = [f[1] as u32, f[0] as u32, f[2] as u32, INFINITE];
     }
-    link_by_faces(&mut b.tets, &mut b.adj, &[0, 1, 2, 3, 4]);
+    link_by_faces(&mut b.cells, &[0, 1, 2, 3, 4]);
     b.last = t0;
 
     for &i in &order {
@@ -448,12 +433,12 @@ pub(super) fn build(points: &[[f64; 3]]) -> Result<Triangulation, DelaunayError>
 }
 
 /// Links the faces of a few tets by brute force (used for the first five).
-fn link_by_faces(tets: &mut [[u32; 4]], adj: &mut [[u32; 4]], ids: &[u32]) {
+fn link_by_faces(cells: &mut [Cell], ids: &[u32]) {
     for &t in ids {
         for i in 0..4 {
             let mut fa: Vec<u32> = (0..4)
                 .filter(|&k| k != i)
-                .map(|k| tets[t as usize][k])
+                .map(|k| cells[t as usize].v[k])
                 .collect();
             fa.sort_unstable();
             for &u in ids {
@@ -463,11 +448,11 @@ fn link_by_faces(tets: &mut [[u32; 4]], adj: &mut [[u32; 4]], ids: &[u32]) {
                 for j in 0..4 {
                     let mut fb: Vec<u32> = (0..4)
                         .filter(|&k| k != j)
-                        .map(|k| tets[u as usize][k])
+                        .map(|k| cells[u as usize].v[k])
                         .collect();
                     fb.sort_unstable();
                     if fa == fb {
-                        adj[t as usize][i] = pack(u, j);
+                        cells[t as usize].n[i] = pack(u, j);
                     }
                 }
             }
@@ -475,55 +460,39 @@ fn link_by_faces(tets: &mut [[u32; 4]], adj: &mut [[u32; 4]], ids: &[u32]) {
     }
 }
 
-/// Drops dead tets and renumbers: finite tets first, then infinite ones.
+/// Drops dead tets by moving live tets from the end into the holes (only
+/// the cells on the free list move; the rest stay where they are).
 fn compact(b: Builder, vert_input: Vec<u32>, input_vert: Vec<u32>) -> Triangulation {
-    let Builder {
-        pts,
-        mut tets,
-        mut adj,
-        ..
-    } = b;
-    let total = tets.len();
-    let mut newid = vec![u32::MAX; total];
-    let mut next = 0u32;
-    for (t, v) in tets.iter().enumerate() {
-        if v[0] != DEAD && !v.contains(&INFINITE) {
-            newid[t] = next;
-            next += 1;
+    let Builder { pts, mut cells, .. } = b;
+    let dead = |c: &Cell| c.v[0] == DEAD;
+    let mut end = cells.len();
+    let mut i = 0;
+    loop {
+        while end > 0 && dead(&cells[end - 1]) {
+            end -= 1;
         }
-    }
-    let num_finite = next as usize;
-    for (t, v) in tets.iter().enumerate() {
-        if v[0] != DEAD && v.contains(&INFINITE) {
-            newid[t] = next;
-            next += 1;
+        while i < end && !dead(&cells[i]) {
+            i += 1;
         }
-    }
-    let alive = next as usize;
-    for a in adj.iter_mut() {
-        for s in a.iter_mut() {
-            if *s != UNSET {
-                *s = (newid[(*s >> 2) as usize] << 2) | (*s & 3);
-            }
+        if i >= end {
+            break;
         }
-    }
-    // Apply the permutation in place: after the inner loop, position `i`
-    // holds its final tet or a dead one, and every swap settles one tet.
-    for i in 0..total {
-        while newid[i] != u32::MAX && newid[i] as usize != i {
-            let d = newid[i] as usize;
-            tets.swap(i, d);
-            adj.swap(i, d);
-            newid.swap(i, d);
+        // Move the live cell at end - 1 into the hole at i.
+        let src = end - 1;
+        cells[i] = cells[src];
+        for k in 0..4 {
+            let p = cells[i].n[k];
+            let (n, j) = ((p >> 2) as usize, (p & 3) as usize);
+            cells[n].n[j] = pack(i as u32, k);
         }
+        cells[src].v[0] = DEAD;
+        end -= 1;
     }
-    tets.truncate(alive);
-    adj.truncate(alive);
-    tets.shrink_to_fit();
-    adj.shrink_to_fit();
+    cells.truncate(end);
+    let num_finite = cells.iter().filter(|c| c.v[3] != INFINITE).count();
     let mut vert_tet = vec![u32::MAX; pts.len()];
-    for (t, v) in tets.iter().enumerate() {
-        for &w in v {
+    for (t, c) in cells.iter().enumerate() {
+        for &w in &c.v {
             if w != INFINITE {
                 vert_tet[w as usize] = t as u32;
             }
@@ -533,8 +502,7 @@ fn compact(b: Builder, vert_input: Vec<u32>, input_vert: Vec<u32>) -> Triangulat
         pts,
         vert_input,
         input_vert,
-        tets,
-        adj,
+        cells,
         num_finite,
         vert_tet,
         dim: 3,

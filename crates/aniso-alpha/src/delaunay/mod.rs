@@ -19,9 +19,8 @@
 //! hull facet is the finite face of one infinite tetrahedron, and hull
 //! facets are ordinary adjacency. An infinite tet is oriented so that
 //! replacing the infinite vertex by a point outside the hull (beyond its
-//! facet) gives a positively oriented tetrahedron. After construction the
-//! finite tetrahedra are numbered `0 .. num_finite_tets()`, the infinite ones
-//! after them.
+//! facet) gives a positively oriented tetrahedron; its infinite vertex is
+//! always at local index 3.
 //!
 //! Vertex ids are assigned in insertion order (a spatially coherent order);
 //! [`Triangulation::input_index`] and [`Triangulation::vertex_of_input`]
@@ -103,11 +102,9 @@ pub struct Triangulation {
     vert_input: Vec<u32>,
     /// Input index -> vertex id.
     input_vert: Vec<u32>,
-    /// Tetrahedron -> vertex ids.
-    tets: Vec<[u32; 4]>,
-    /// Tetrahedron -> packed neighbours (`4 * tet + mirror`).
-    adj: Vec<[u32; 4]>,
-    /// Number of finite tetrahedra (they come first).
+    /// Tetrahedra: vertex ids and packed neighbours (`4 * tet + mirror`).
+    cells: Vec<build::Cell>,
+    /// Number of finite tetrahedra.
     num_finite: usize,
     /// Vertex id -> one incident tetrahedron.
     vert_tet: Vec<u32>,
@@ -181,39 +178,42 @@ impl Triangulation {
     /// Number of tetrahedra including the infinite ones (those incident to
     /// the infinite vertex, one per hull facet).
     pub fn num_tets(&self) -> usize {
-        self.tets.len()
+        self.cells.len()
     }
 
     /// The finite tetrahedra as vertex ids, each positively oriented.
-    pub fn finite_tets(&self) -> &[[u32; 4]] {
-        &self.tets[..self.num_finite]
+    pub fn finite_tets(&self) -> impl Iterator<Item = [u32; 4]> + '_ {
+        self.cells
+            .iter()
+            .filter(|c| c.v[3] != INFINITE)
+            .map(|c| c.v)
     }
 
     /// The finite tetrahedra with indices into the input (the smallest
     /// index of a duplicated point), each positively oriented.
-    pub fn finite_tets_input(&self) -> impl ExactSizeIterator<Item = [u32; 4]> + '_ {
+    pub fn finite_tets_input(&self) -> impl Iterator<Item = [u32; 4]> + '_ {
         self.finite_tets()
-            .iter()
             .map(move |t| t.map(|v| self.vert_input[v as usize]))
     }
 
-    /// The four vertices of tetrahedron `t` (one may be [`INFINITE`]).
+    /// The four vertices of tetrahedron `t`; for an infinite tet the last
+    /// one is [`INFINITE`].
     #[inline]
     pub fn tet(&self, t: u32) -> [u32; 4] {
-        self.tets[t as usize]
+        self.cells[t as usize].v
     }
 
     /// Whether tetrahedron `t` is incident to the infinite vertex.
     #[inline]
     pub fn is_infinite(&self, t: u32) -> bool {
-        t as usize >= self.num_finite
+        self.cells[t as usize].v[3] == INFINITE
     }
 
     /// The neighbour of `t` across the face opposite its vertex `i`, and the
     /// index of that shared face in the neighbour (the mirror index).
     #[inline]
     pub fn neighbor(&self, t: u32, i: usize) -> (u32, usize) {
-        let p = self.adj[t as usize][i];
+        let p = self.cells[t as usize].n[i];
         (p >> 2, (p & 3) as usize)
     }
 

@@ -35,8 +35,8 @@ const HILBERT_BITS: u32 = 21;
 /// (Skilling's transpose algorithm: undo excess work, Gray-encode, then
 /// interleave the bits with x most significant).
 #[inline]
-fn hilbert_key(mut x: [u32; 3]) -> u64 {
-    let m: u32 = 1 << (HILBERT_BITS - 1);
+fn hilbert_key(mut x: [u32; 3], bits: u32) -> u64 {
+    let m: u32 = 1 << (bits - 1);
     let mut q = m;
     while q > 1 {
         let p = q - 1;
@@ -65,7 +65,7 @@ fn hilbert_key(mut x: [u32; 3]) -> u64 {
         *xi ^= t;
     }
     let mut key = 0u64;
-    for b in (0..HILBERT_BITS).rev() {
+    for b in (0..bits).rev() {
         for xi in &x {
             key = (key << 1) | ((xi >> b) & 1) as u64;
         }
@@ -75,6 +75,10 @@ fn hilbert_key(mut x: [u32; 3]) -> u64 {
 
 /// Sorts `idx` in place along a Hilbert curve of the bounding box `[lo, hi]`.
 fn hilbert_sort(points: &[[f64; 3]], idx: &mut [u32], lo: [f64; 3], scale: [f64; 3]) {
+    // About 8 grid cells per point are enough to order a round.
+    let n = idx.len().max(2) as f64;
+    let bits = ((n.log2() / 3.0).ceil() as u32 + 1).clamp(2, HILBERT_BITS);
+    let shift = HILBERT_BITS - bits;
     let max = ((1u64 << HILBERT_BITS) - 1) as f64;
     let mut keyed: Vec<(u64, u32)> = idx
         .iter()
@@ -84,7 +88,7 @@ fn hilbert_sort(points: &[[f64; 3]], idx: &mut [u32], lo: [f64; 3], scale: [f64;
             for k in 0..3 {
                 q[k] = ((p[k] - lo[k]) * scale[k]).clamp(0.0, max) as u32;
             }
-            (hilbert_key(q), i)
+            (hilbert_key(q.map(|c| c >> shift), bits), i)
         })
         .collect();
     keyed.sort_unstable();
@@ -151,7 +155,7 @@ mod tests {
         for x in 0..n {
             for y in 0..n {
                 for z in 0..n {
-                    cells.push((hilbert_key([x, y, z]), [x, y, z]));
+                    cells.push((hilbert_key([x, y, z], HILBERT_BITS), [x, y, z]));
                 }
             }
         }

@@ -33,8 +33,8 @@ pub struct Edge {
 impl Triangulation {
     /// Every finite triangle once, with the tetrahedra on both sides.
     pub fn triangles(&self) -> impl Iterator<Item = Triangle> + '_ {
-        (0..self.tets.len() as u32).flat_map(move |t| {
-            let v = self.tets[t as usize];
+        (0..self.cells.len() as u32).flat_map(move |t| {
+            let v = self.cells[t as usize].v;
             let finite = !self.is_infinite(t);
             (0..4).filter_map(move |i| {
                 if !finite && v[i] != INFINITE {
@@ -57,7 +57,7 @@ impl Triangulation {
     pub fn num_triangles(&self) -> usize {
         // Each tet has 4 faces, each face is shared by 2 tets; the faces
         // incident to the infinite vertex are 3 per infinite tet.
-        (4 * self.tets.len() - 3 * (self.tets.len() - self.num_finite)) / 2
+        (4 * self.cells.len() - 3 * (self.cells.len() - self.num_finite)) / 2
     }
 
     /// The tetrahedra around the edge `(t.local[0], t.local[1])`, in
@@ -78,8 +78,8 @@ impl Triangulation {
     /// Every finite edge once. Each is reported by the tetrahedron with the
     /// smallest id in its ring.
     pub fn edges(&self) -> impl Iterator<Item = Edge> + '_ {
-        (0..self.tets.len() as u32).flat_map(move |t| {
-            let v = self.tets[t as usize];
+        (0..self.cells.len() as u32).flat_map(move |t| {
+            let v = self.cells[t as usize].v;
             const PAIRS: [[usize; 2]; 6] = [[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]];
             PAIRS.iter().filter_map(move |&[i, j]| {
                 if v[i] == INFINITE || v[j] == INFINITE {
@@ -103,11 +103,10 @@ impl Triangulation {
     /// The convex hull's facets as vertex triples oriented outward
     /// (counter-clockwise seen from outside).
     pub fn hull_facets(&self) -> impl Iterator<Item = [u32; 3]> + '_ {
-        self.tets[self.num_finite..].iter().map(|v| {
-            let k = v.iter().position(|&x| x == INFINITE).unwrap_or(0);
-            let f = FACE[k];
-            [v[f[0]], v[f[1]], v[f[2]]]
-        })
+        self.cells
+            .iter()
+            .filter(|c| c.v[3] == INFINITE)
+            .map(|c| [c.v[0], c.v[1], c.v[2]])
     }
 
     /// All tetrahedra incident to vertex `v` (infinite ones included for a
@@ -123,7 +122,7 @@ impl Triangulation {
         while k < out.len() {
             let t = out[k];
             k += 1;
-            let tv = self.tets[t as usize];
+            let tv = self.cells[t as usize].v;
             for i in 0..4 {
                 if tv[i] == v {
                     continue;
@@ -139,7 +138,7 @@ impl Triangulation {
 
     /// Circumcentre and circumradius of finite tetrahedron `t`.
     pub fn tet_circumsphere(&self, t: u32) -> (Point3, f64) {
-        let v = self.tets[t as usize];
+        let v = self.cells[t as usize].v;
         circum::tet_circumsphere(
             self.point(v[0]),
             self.point(v[1]),
@@ -196,7 +195,7 @@ impl Iterator for EdgeRing<'_> {
         if n == self.start {
             self.done = true;
         } else {
-            let nv = self.tri.tets[n as usize];
+            let nv = self.tri.cells[n as usize].v;
             let ia = nv.iter().position(|&w| w == self.a).unwrap_or(0);
             let ib = nv.iter().position(|&w| w == self.b).unwrap_or(0);
             self.cur = n;

@@ -78,7 +78,7 @@ impl Triangulation {
     ///
     /// Costs about as much as the construction; meant for tests.
     pub fn validate(&self) -> Result<(), ValidationError> {
-        let nt = self.tets.len();
+        let nt = self.cells.len();
         for (i, &v) in self.input_vert.iter().enumerate() {
             if v as usize >= self.pts.len() || self.vert_input[v as usize] as usize > i {
                 return Err(ValidationError::Vertex { index: i });
@@ -97,9 +97,9 @@ impl Triangulation {
         }
         let mut used = vec![false; self.pts.len()];
         for t in 0..nt as u32 {
-            let v = self.tets[t as usize];
+            let v = self.cells[t as usize].v;
             let infs = v.iter().filter(|&&x| x == INFINITE).count();
-            if infs != usize::from(self.is_infinite(t)) {
+            if infs > 1 || (infs == 1 && v[3] != INFINITE) {
                 return Err(ValidationError::Orientation { tet: t });
             }
             for &w in &v {
@@ -121,10 +121,10 @@ impl Triangulation {
                 if n as usize >= nt || n == t || self.neighbor(n, j) != (t, i) {
                     return Err(ValidationError::Adjacency { tet: t, face: i });
                 }
-                if sorted_face(&v, i) != sorted_face(&self.tets[n as usize], j) {
+                if sorted_face(&v, i) != sorted_face(&self.cells[n as usize].v, j) {
                     return Err(ValidationError::Adjacency { tet: t, face: i });
                 }
-                let w = self.tets[n as usize][j];
+                let w = self.cells[n as usize].v[j];
                 if w != INFINITE && tet_in_conflict(&self.pts, &v, self.point(w)) {
                     return Err(ValidationError::NotDelaunay { tet: t, face: i });
                 }

@@ -22,9 +22,123 @@ use robust::{Coord, Coord3D};
 /// A point in 3D.
 pub type Point3 = [f64; 3];
 
-const EPSILON: f64 = f64::EPSILON * 0.5;
-const O3D_ERRBOUND_A: f64 = (7.0 + 56.0 * EPSILON) * EPSILON;
-const ISP_ERRBOUND_A: f64 = (16.0 + 224.0 * EPSILON) * EPSILON;
+
+
+/// Exact difference `a − b` if it is representable, else `None`
+/// (Knuth's two-diff: the rounding error of the subtraction is zero).
+#[inline(always)]
+fn exact_diff(a: f64, b: f64) -> Option<f64> {
+    let x = a - b;
+    let bvirt = a - x;
+    let avirt = x + bvirt;
+    let bround = bvirt - b;
+    let around = a - avirt;
+    if around + bround == 0.0 {
+        Some(x)
+    } else {
+        None
+    }
+}
+
+/// Maximum bit width of the scaled integers of the integer stage: with
+/// |d| < 2^23 the in-sphere determinant stays below 2^122 in `i128`.
+const INT_BITS: i32 = 23;
+
+/// Writes `d` as integers `k_i` with `d_i = k_i · 2^L` for a common `L`, if
+/// every `d_i` is finite, normal (or zero) and they all fit in
+/// [`INT_BITS`] bits after scaling. This is the case for grid-like data
+/// (integer or dyadic coordinates), which is where exact ties happen.
+#[inline]
+fn scaled_ints<const N: usize>(d: &[f64; N]) -> Option<[i64; N]> {
+    let mut lo = i32::MAX;
+    let mut hi = i32::MIN;
+    for &x in d {
+        if x == 0.0 {
+            continue;
+        }
+        let bits = x.to_bits();
+        let exp = ((bits >> 52) & 0x7ff) as i32;
+        if exp == 0 || exp == 0x7ff {
+            return None;
+        }
+        let mant = (bits & ((1u64 << 52) - 1)) | (1u64 << 52);
+        let low = exp - 1075 + mant.trailing_zeros() as i32;
+        let high = exp - 1075 + 53;
+        lo = lo.min(low);
+        hi = hi.max(high);
+    }
+    if lo == i32::MAX {
+        return Some([0; N]);
+    }
+    if hi - lo > INT_BITS {
+        return None;
+    }
+    let mut out = [0i64; N];
+    for (o, &x) in out.iter_mut().zip(d) {
+        if x == 0.0 {
+            continue;
+        }
+        let bits = x.to_bits();
+        let exp = ((bits >> 52) & 0x7ff) as i32;
+        let mant = (bits & ((1u64 << 52) - 1)) | (1u64 << 52);
+        let shift = exp - 1075 - lo; // value = mant · 2^(exp−1075) = k · 2^lo
+        let k = if shift >= 0 {
+            (mant << shift) as i64
+        } else {
+            (mant >> (-shift)) as i64
+        };
+        *o = if x < 0.0 { -k } else { k };
+    }
+    Some(out)
+}
+
+/// Exact sign of `det[a − d, b − d, c − d]` (Shewchuk's orient3d) by the
+/// integer stage, when it applies.
+fn orient3d_int(a: &Point3, b: &Point3, c: &Point3, d: &Point3) -> Option<i32> {
+    let mut diffs = [0.0; 9];
+    for k in 0..3 {
+        diffs[k] = exact_diff(a[k], d[k])?;
+        diffs[3 + k] = exact_diff(b[k], d[k])?;
+        diffs[6 + k] = exact_diff(c[k], d[k])?;
+    }
+    let q = scaled_ints(&diffs)?;
+    let m = |i: usize, j: usize, k: usize, l: usize| (q[i] * q[j] - q[k] * q[l]) as i128;
+    // rows a, b, c; columns x, y, z
+    let det = q[2] as i128 * m(3, 7, 6, 4) + q[5] as i128 * m(6, 1, 0, 7)
+        + q[8] as i128 * m(0, 4, 3, 1);
+    Some(det.signum() as i32)
+}
+
+/// Exact sign of Shewchuk's insphere determinant by the integer stage,
+/// when it applies.
+fn insphere_int(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> Option<i32> {
+    let mut diffs = [0.0; 12];
+    for (r, p) in [a, b, c, d].iter().enumerate() {
+        for k in 0..3 {
+            diffs[3 * r + k] = exact_diff(p[k], e[k])?;
+        }
+    }
+    let q = scaled_ints(&diffs)?;
+    let x = |r: usize| q[3 * r];
+    let y = |r: usize| q[3 * r + 1];
+    let z = |r: usize| q[3 * r + 2];
+    let lift = |r: usize| (x(r) * x(r) + y(r) * y(r) + z(r) * z(r)) as i128;
+    // 2x2 minors in (x, y).
+    let xy = |r: usize, s: usize| (x(r) * y(s) - x(s) * y(r)) as i128;
+    let ab = xy(0, 1);
+    let bc = xy(1, 2);
+    let cd = xy(2, 3);
+    let da = xy(3, 0);
+    let ac = xy(0, 2);
+    let bd = xy(1, 3);
+    let zi = |r: usize| z(r) as i128;
+    let abc = zi(0) * bc - zi(1) * ac + zi(2) * ab;
+    let bcd = zi(1) * cd - zi(2) * bd + zi(3) * bc;
+    let cda = zi(2) * da + zi(3) * ac + zi(0) * cd;
+    let dab = zi(3) * ab + zi(0) * bd + zi(1) * da;
+    let det = (lift(3) * abc - lift(2) * dab) + (lift(1) * cda - lift(0) * bcd);
+    Some(det.signum() as i32)
+}
 
 #[inline(always)]
 fn c3(p: &Point3) -> Coord3D<f64> {
@@ -70,22 +184,21 @@ pub fn orient3d(a: &Point3, b: &Point3, c: &Point3, d: &Point3) -> i32 {
     let bdz = b[2] - d[2];
     let cdz = c[2] - d[2];
 
-    let bdxcdy = bdx * cdy;
-    let cdxbdy = cdx * bdy;
-    let cdxady = cdx * ady;
-    let adxcdy = adx * cdy;
-    let adxbdy = adx * bdy;
-    let bdxady = bdx * ady;
-
-    let det = adz * (bdxcdy - cdxbdy) + bdz * (cdxady - adxcdy) + cdz * (adxbdy - bdxady);
-    let permanent = (bdxcdy.abs() + cdxbdy.abs()) * adz.abs()
-        + (cdxady.abs() + adxcdy.abs()) * bdz.abs()
-        + (adxbdy.abs() + bdxady.abs()) * cdz.abs();
-    let errbound = O3D_ERRBOUND_A * permanent;
-    if det > errbound || -det > errbound {
+    let det = adz * (bdx * cdy - cdx * bdy)
+        + bdz * (cdx * ady - adx * cdy)
+        + cdz * (adx * bdy - bdx * ady);
+    // Semi-static filter: Shewchuk's bound is O3D_ERRBOUND_A times the
+    // permanent, and the permanent is at most 6·X·Y·Z where X, Y, Z bound
+    // the absolute differences per axis. 4.7e-15 > 6·(7 + 56ε)ε with margin
+    // for the rounding of the product itself.
+    let mx = adx.abs().max(bdx.abs()).max(cdx.abs());
+    let my = ady.abs().max(bdy.abs()).max(cdy.abs());
+    let mz = adz.abs().max(bdz.abs()).max(cdz.abs());
+    let eps = 4.7e-15 * (mx * my * mz);
+    if (det > eps || -det > eps) && eps < f64::MAX && eps > f64::MIN_POSITIVE {
         return -sign(det);
     }
-    -sign(robust::orient3d(c3(a), c3(b), c3(c), c3(d)))
+    orient3d_slow(a, b, c, d)
 }
 
 /// Exact in-sphere test: `1` if `e` is strictly inside the circumsphere of
@@ -115,24 +228,12 @@ pub fn insphere(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> i
     let cez = c[2] - e[2];
     let dez = d[2] - e[2];
 
-    let aexbey = aex * bey;
-    let bexaey = bex * aey;
-    let ab = aexbey - bexaey;
-    let bexcey = bex * cey;
-    let cexbey = cex * bey;
-    let bc = bexcey - cexbey;
-    let cexdey = cex * dey;
-    let dexcey = dex * cey;
-    let cd = cexdey - dexcey;
-    let dexaey = dex * aey;
-    let aexdey = aex * dey;
-    let da = dexaey - aexdey;
-    let aexcey = aex * cey;
-    let cexaey = cex * aey;
-    let ac = aexcey - cexaey;
-    let bexdey = bex * dey;
-    let dexbey = dex * bey;
-    let bd = bexdey - dexbey;
+    let ab = aex * bey - bex * aey;
+    let bc = bex * cey - cex * bey;
+    let cd = cex * dey - dex * cey;
+    let da = dex * aey - aex * dey;
+    let ac = aex * cey - cex * aey;
+    let bd = bex * dey - dex * bey;
 
     let abc = aez * bc - bez * ac + cez * ab;
     let bcd = bez * cd - cez * bd + dez * bc;
@@ -146,37 +247,38 @@ pub fn insphere(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> i
 
     let det = (dlift * abc - clift * dab) + (blift * cda - alift * bcd);
 
-    let aezp = aez.abs();
-    let bezp = bez.abs();
-    let cezp = cez.abs();
-    let dezp = dez.abs();
-    let aexbeyp = aexbey.abs();
-    let bexaeyp = bexaey.abs();
-    let bexceyp = bexcey.abs();
-    let cexbeyp = cexbey.abs();
-    let cexdeyp = cexdey.abs();
-    let dexceyp = dexcey.abs();
-    let dexaeyp = dexaey.abs();
-    let aexdeyp = aexdey.abs();
-    let aexceyp = aexcey.abs();
-    let cexaeyp = cexaey.abs();
-    let bexdeyp = bexdey.abs();
-    let dexbeyp = dexbey.abs();
-    let permanent = ((cexdeyp + dexceyp) * bezp
-        + (dexbeyp + bexdeyp) * cezp
-        + (bexceyp + cexbeyp) * dezp)
-        * alift
-        + ((dexaeyp + aexdeyp) * cezp + (aexceyp + cexaeyp) * dezp + (cexdeyp + dexceyp) * aezp)
-            * blift
-        + ((aexbeyp + bexaeyp) * dezp + (bexdeyp + dexbeyp) * aezp + (dexaeyp + aexdeyp) * bezp)
-            * clift
-        + ((bexceyp + cexbeyp) * aezp + (cexaeyp + aexceyp) * bezp + (aexbeyp + bexaeyp) * cezp)
-            * dlift;
-    let errbound = ISP_ERRBOUND_A * permanent;
+    // Semi-static filter: Shewchuk's bound is ISP_ERRBOUND_A times the
+    // permanent, and the permanent is at most 72·M²·X·Y·Z where X, Y, Z
+    // bound the absolute differences per axis and M = max(X, Y, Z) (each
+    // lift is at most 3M², each 3x3 permanent at most 6XYZ). 1.28e-13 >
+    // 72·(16 + 224ε)ε = 1.27898e-13, with margin for rounding.
+    let mx = aex.abs().max(bex.abs()).max(cex.abs()).max(dex.abs());
+    let my = aey.abs().max(bey.abs()).max(cey.abs()).max(dey.abs());
+    let mz = aez.abs().max(bez.abs()).max(cez.abs()).max(dez.abs());
+    let m = mx.max(my).max(mz);
+    let eps = 1.28e-13 * (mx * my * mz) * (m * m);
     // Shewchuk's insphere is positive for "inside" when (a, b, c, d) has *his*
     // positive orientation, which is CGAL's negative one: negate.
-    if det > errbound || -det > errbound {
+    if (det > eps || -det > eps) && eps < f64::MAX && eps > f64::MIN_POSITIVE {
         return -sign(det);
+    }
+    insphere_slow(a, b, c, d, e)
+}
+
+#[cold]
+#[inline(never)]
+fn orient3d_slow(a: &Point3, b: &Point3, c: &Point3, d: &Point3) -> i32 {
+    if let Some(s) = orient3d_int(a, b, c, d) {
+        return -s;
+    }
+    -sign(robust::orient3d(c3(a), c3(b), c3(c), c3(d)))
+}
+
+#[cold]
+#[inline(never)]
+fn insphere_slow(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> i32 {
+    if let Some(s) = insphere_int(a, b, c, d, e) {
+        return -s;
     }
     -sign(robust::insphere(c3(a), c3(b), c3(c), c3(d), c3(e)))
 }
@@ -378,6 +480,53 @@ mod tests {
                 assert_eq!(insphere(&p[0], &p[1], &p[2], &p[3], &e), expected);
             }
         }
+    }
+
+    #[test]
+    fn integer_stage_agrees_with_robust() {
+        let mut s = 99u64;
+        let mut next = |range: u64| {
+            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (s >> 33) % range
+        };
+        let mut used = 0;
+        for round in 0..20000 {
+            // Dyadic grids of various scales and offsets, some near the
+            // 23-bit limit, some beyond it (then the stage must decline).
+            let bits = [3u64, 10, 20, 22, 23, 24][round % 6];
+            let scale = [1.0, 0.125, 1024.0, 3.0][round % 4];
+            let offset = [0.0, 1e6, -37.5][round % 3];
+            let pts: Vec<[f64; 3]> = (0..5)
+                .map(|_| {
+                    let mut p = [0.0; 3];
+                    for c in &mut p {
+                        *c = offset + scale * (next(1 << bits) as f64 - (1u64 << (bits - 1)) as f64);
+                    }
+                    p
+                })
+                .collect();
+            let (a, b, c, d, e) = (&pts[0], &pts[1], &pts[2], &pts[3], &pts[4]);
+            let o_ref = sign(robust::orient3d(c3(a), c3(b), c3(c), c3(d)));
+            if let Some(o) = orient3d_int(a, b, c, d) {
+                assert_eq!(o, o_ref);
+                used += 1;
+            }
+            let i_ref = sign(robust::insphere(c3(a), c3(b), c3(c), c3(d), c3(e)));
+            if let Some(i) = insphere_int(a, b, c, d, e) {
+                assert_eq!(i, i_ref, "{pts:?}");
+            }
+            // Force coplanar / cospherical configurations too.
+            let e2 = [a[0], b[1], c[2]];
+            let f_ref = sign(robust::insphere(c3(a), c3(b), c3(c), c3(d), c3(&e2)));
+            if let Some(i) = insphere_int(a, b, c, d, &e2) {
+                assert_eq!(i, f_ref);
+            }
+        }
+        assert!(used > 5000, "integer stage used {used} times");
+        // Cube corners: exact zeros.
+        let z = [0.0, 0.0, 0.0];
+        assert_eq!(insphere_int(&z, &[1.0, 0.0, 0.0], &[0.0, 1.0, 0.0], &[0.0, 0.0, 1.0], &[1.0, 1.0, 1.0]), Some(0));
+        assert_eq!(orient3d_int(&z, &[1.0, 0.0, 0.0], &[0.0, 1.0, 0.0], &[1.0, 1.0, 0.0]), Some(0));
     }
 
     #[test]
