@@ -2,6 +2,7 @@
 //!
 //! `cargo run --release --example triangulate -- uniform 1000000`
 //! `cargo run --release --example triangulate -- grid 50`
+//! `cargo run --release --example triangulate -- points.bin` (raw little-endian f64 triples)
 use aniso_alpha::delaunay::Triangulation;
 use std::time::Instant;
 
@@ -18,6 +19,16 @@ fn main() {
         ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
     };
     let pts: Vec<[f64; 3]> = match kind {
+        f if f.ends_with(".bin") => {
+            let bytes = std::fs::read(f).expect("read .bin");
+            bytes
+                .chunks_exact(24)
+                .map(|c| {
+                    let g = |k: usize| f64::from_le_bytes(c[8 * k..8 * k + 8].try_into().unwrap());
+                    [g(0), g(1), g(2)]
+                })
+                .collect()
+        }
         "grid" => {
             let mut v = Vec::new();
             for x in 0..n {

@@ -21,6 +21,9 @@
 //! ```
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
+// Index loops over the 4 vertices / faces of a tetrahedron read better than
+// iterator chains in the geometry code.
+#![allow(clippy::needless_range_loop)]
 
 pub mod delaunay;
 pub mod geometry;

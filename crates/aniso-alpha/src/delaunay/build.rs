@@ -40,6 +40,7 @@ fn pack(t: u32, i: usize) -> u32 {
 /// CGAL's symbolic perturbation: for a finite tet, `q` is inside its
 /// circumsphere; for an infinite tet, `q` is strictly beyond its hull facet,
 /// or in the facet's plane and inside its circumcircle.
+#[inline(always)]
 pub(crate) fn tet_in_conflict(pts: &[Point3], v: &[u32; 4], q: &Point3) -> bool {
     let p = |w: u32| &pts[w as usize];
     if v[3] == INFINITE {
@@ -63,12 +64,54 @@ struct Builder {
     free: Vec<u32>,
     rng: SplitMix64,
     // Scratch, reused across insertions.
-    stack: Vec<u32>,
     conflicts: Vec<u32>,
-    boundary: Vec<(u32, u8)>,
+    /// New tets of the current insertion, packed with the face index of
+    /// their outer neighbour.
     new_tets: Vec<u32>,
+    /// Per-vertex head of the edge lists used to link new tets (all
+    /// `u32::MAX` between insertions).
+    vhead: Vec<u32>,
+    links: Vec<Link>,
     last: u32,
 }
+
+/// An entry of the per-vertex edge lists: edge (a, b), a < b, seen on face
+/// `face` (packed) of a new tet.
+#[derive(Clone, Copy, Debug)]
+struct Link {
+    a: u32,
+    b: u32,
+    face: u32,
+    next: u32,
+}
+
+/// For faces `f != g` of a tet, the local indices of the two vertices on
+/// both faces (the edge they share).
+const EDGE_OF_FACES: [[(usize, usize); 4]; 4] = {
+    let mut t = [[(0, 0); 4]; 4];
+    let mut f = 0;
+    while f < 4 {
+        let mut g = 0;
+        while g < 4 {
+            if f != g {
+                let mut e = [0usize; 2];
+                let mut k = 0;
+                let mut i = 0;
+                while i < 4 {
+                    if i != f && i != g {
+                        e[k] = i;
+                        k += 1;
+                    }
+                    i += 1;
+                }
+                t[f][g] = (e[0], e[1]);
+            }
+            g += 1;
+        }
+        f += 1;
+    }
+    t
+};
 
 impl Builder {
     #[inline(always)]
@@ -95,19 +138,9 @@ impl Builder {
     /// (`t` finite): > 0 when `q` is on the same side of face `i` as vertex `i`.
     #[inline(always)]
     fn orient_replaced(&self, t: &[u32; 4], i: usize, q: &Point3) -> i32 {
-        let mut p = [
-            self.p(t[0]),
-            self.p(t[1]),
-            self.p(t[2]),
-            self.p(t[3]),
-        ];
+        let mut p = [self.p(t[0]), self.p(t[1]), self.p(t[2]), self.p(t[3])];
         p[i] = q;
         orient3d(p[0], p[1], p[2], p[3])
-    }
-
-    #[inline]
-    fn in_conflict(&self, t: u32, q: &Point3) -> bool {
-        tet_in_conflict(&self.pts, &self.cells[t as usize].v, q)
     }
 
     /// Remembering stochastic walk from `self.last` to a tetrahedron in
@@ -160,117 +193,105 @@ impl Builder {
             }
         }
 
-        // Conflict region by depth-first search.
+        // Conflict region by graph search; `conflicts` doubles as the stack.
+        // Each boundary facet found (conflict tet c, face f, outer tet
+        // not in conflict) immediately gets its new tet: c with vertex f
+        // replaced by q, keeping c's outer neighbour.
         self.conflicts.clear();
-        self.boundary.clear();
-        self.stack.clear();
-        self.stack.push(start);
+        self.new_tets.clear();
+        self.conflicts.push(start);
         self.mark[start as usize] = IN_CONFLICT;
-        while let Some(c) = self.stack.pop() {
-            self.conflicts.push(c);
+        let mut k = 0;
+        while k < self.conflicts.len() {
+            let c = self.conflicts[k];
+            k += 1;
+            let cell = self.cells[c as usize];
             for f in 0..4 {
-                let n = self.cells[c as usize].n[f] >> 2;
-                let m = self.mark[n as usize];
+                let outer = cell.n[f];
+                let n = (outer >> 2) as usize;
+                let m = self.mark[n];
                 if m == IN_CONFLICT {
                     continue;
                 }
-                if m != CLEAR && self.in_conflict(n, &q) {
-                    self.mark[n as usize] = IN_CONFLICT;
-                    self.stack.push(n);
-                } else {
-                    self.mark[n as usize] = CLEAR;
-                    self.boundary.push((c, f as u8));
-                }
-            }
-        }
-
-        // One new tet per boundary facet: the conflict tet with the vertex
-        // across the facet replaced by q. Its outer neighbour is kept; the
-        // conflict tet's slot is overwritten to point at the new tet, which
-        // the edge rotation below reads.
-        self.new_tets.clear();
-        for bi in 0..self.boundary.len() {
-            let (c, f) = self.boundary[bi];
-            let f = f as usize;
-            let nt = self.alloc();
-            let mut v = self.cells[c as usize].v;
-            v[f] = vid;
-            self.cells[nt as usize].v = v;
-            let outer = self.cells[c as usize].n[f];
-            self.mark[(outer >> 2) as usize] = 0;
-            self.cells[nt as usize].n = [UNSET; 4];
-            self.cells[nt as usize].n[f] = outer;
-            self.cells[(outer >> 2) as usize].n[(outer & 3) as usize] = pack(nt, f);
-            self.cells[c as usize].n[f] = pack(nt, f);
-            self.new_tets.push(nt);
-        }
-
-        // Link the new tets to each other: the face of a new tet opposite
-        // index g (g != f) contains q and the edge (a, b) of the old facet;
-        // rotate around (a, b) through the cavity to the next boundary facet.
-        for bi in 0..self.boundary.len() {
-            let (c, f) = self.boundary[bi];
-            let f = f as usize;
-            let nt = self.new_tets[bi];
-            for g in 0..4 {
-                if g == f || self.cells[nt as usize].n[g] != UNSET {
+                if m != CLEAR && tet_in_conflict(&self.pts, &self.cells[n].v, &q) {
+                    self.mark[n] = IN_CONFLICT;
+                    self.conflicts.push(n as u32);
                     continue;
                 }
-                let cv = self.cells[c as usize].v;
-                let (a, b) = {
-                    let mut e = [0u32; 2];
-                    let mut k = 0;
-                    for (i, &w) in cv.iter().enumerate() {
-                        if i != f && i != g {
-                            e[k] = w;
-                            k += 1;
-                        }
-                    }
-                    (e[0], e[1])
+                self.mark[n] = CLEAR;
+                let nt = self.alloc();
+                let mut v = cell.v;
+                v[f] = vid;
+                let mut nn = [UNSET; 4];
+                nn[f] = outer;
+                self.cells[nt as usize] = Cell { v, n: nn };
+                self.cells[n].n[(outer & 3) as usize] = pack(nt, f);
+                self.new_tets.push(pack(nt, f));
+            }
+        }
+
+        // Link the new tets to each other. The face of a new tet opposite
+        // index g (g != f) holds q and an edge (a, b) of the cavity's
+        // boundary; exactly two new tets share it. Pair them through short
+        // per-vertex lists keyed by the smaller endpoint (the infinite
+        // vertex is the largest id, so it is never a key).
+        self.links.clear();
+        let cells = &mut self.cells[..];
+        let vhead = &mut self.vhead[..];
+        let mark = &mut self.mark[..];
+        for &packed in &self.new_tets {
+            let (nt, f) = ((packed >> 2) as usize, (packed & 3) as usize);
+            let v = cells[nt].v;
+            // The outer tet was marked CLEAR; reset it.
+            mark[(cells[nt].n[f] >> 2) as usize] = 0;
+            for g in 0..4 {
+                if g == f {
+                    continue;
+                }
+                let (i, j) = EDGE_OF_FACES[f][g];
+                let (a, b) = if v[i] < v[j] {
+                    (v[i], v[j])
+                } else {
+                    (v[j], v[i])
                 };
-                let mut cur = c;
-                let mut cross = g;
-                let mut other = f;
+                let mut e = vhead[a as usize];
                 loop {
-                    let packed = self.cells[cur as usize].n[cross];
-                    let n = packed >> 2;
-                    if self.mark[n as usize] != IN_CONFLICT {
-                        // Boundary facet of `cur`: `n` is the new tet built on it.
-                        self.cells[nt as usize].n[g] = pack(n, other);
-                        self.cells[n as usize].n[other] = pack(nt, g);
+                    if e == u32::MAX {
+                        self.links.push(Link {
+                            a,
+                            b,
+                            face: pack(nt as u32, g),
+                            next: vhead[a as usize],
+                        });
+                        vhead[a as usize] = (self.links.len() - 1) as u32;
                         break;
                     }
-                    let nv = self.cells[n as usize].v;
-                    let m = (packed & 3) as usize;
-                    let mut ia = 4;
-                    let mut ib = 4;
-                    for (i, &w) in nv.iter().enumerate() {
-                        if w == a {
-                            ia = i;
-                        } else if w == b {
-                            ib = i;
-                        }
+                    let l = self.links[e as usize];
+                    if l.b == b {
+                        let (mt, h) = ((l.face >> 2) as usize, (l.face & 3) as usize);
+                        cells[nt].n[g] = pack(mt as u32, h);
+                        cells[mt].n[h] = pack(nt as u32, g);
+                        break;
                     }
-                    debug_assert!(ia < 4 && ib < 4 && m != ia && m != ib);
-                    let r = 6 - ia - ib - m;
-                    cur = n;
-                    cross = r;
-                    other = m;
+                    e = l.next;
                 }
             }
+        }
+        for l in &self.links {
+            vhead[l.a as usize] = u32::MAX;
         }
 
         // Free the cavity.
         for &c in &self.conflicts {
-            self.cells[c as usize].v = [DEAD; 4];
-            self.mark[c as usize] = 0;
-            self.free.push(c);
+            cells[c as usize].v = [DEAD; 4];
+            mark[c as usize] = 0;
         }
+        self.free.extend_from_slice(&self.conflicts);
         // Start the next walk from a new finite tet if there is one.
-        let mut last = self.new_tets[0];
-        for &nt in self.new_tets.iter().rev() {
-            if self.cells[nt as usize].v[3] != INFINITE {
-                last = nt;
+        let mut last = self.new_tets[0] >> 2;
+        for &p in self.new_tets.iter().rev() {
+            if cells[(p >> 2) as usize].v[3] != INFINITE {
+                last = p >> 2;
                 break;
             }
         }
@@ -371,10 +392,10 @@ pub(super) fn build(points: &[[f64; 3]]) -> Result<Triangulation, DelaunayError>
         mark: Vec::with_capacity(expected_tets),
         free: Vec::new(),
         rng: SplitMix64::new(0xC0FFEE),
-        stack: Vec::new(),
         conflicts: Vec::new(),
-        boundary: Vec::new(),
         new_tets: Vec::new(),
+        vhead: vec![u32::MAX; n],
+        links: Vec::new(),
         last: 0,
     };
     let mut vert_input: Vec<u32> = Vec::with_capacity(n);

@@ -61,13 +61,20 @@ impl std::fmt::Display for DelaunayError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             DelaunayError::Empty => write!(f, "no points to triangulate"),
-            DelaunayError::NonFinite { index, coord, value } => write!(
+            DelaunayError::NonFinite {
+                index,
+                coord,
+                value,
+            } => write!(
                 f,
                 "point {index} has a non-finite {} coordinate ({value})",
                 ["x", "y", "z"][*coord]
             ),
             DelaunayError::TooManyPoints(n) => {
-                write!(f, "{n} points is more than this library can index (2^32 - 2)")
+                write!(
+                    f,
+                    "{n} points is more than this library can index (2^32 - 2)"
+                )
             }
         }
     }

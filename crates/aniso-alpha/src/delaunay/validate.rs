@@ -53,7 +53,10 @@ impl std::fmt::Display for ValidationError {
                 write!(f, "facet {face} of tet {tet} is not locally Delaunay")
             }
             ValidationError::Euler { chi } => {
-                write!(f, "Euler characteristic of the finite complex is {chi}, not 1")
+                write!(
+                    f,
+                    "Euler characteristic of the finite complex is {chi}, not 1"
+                )
             }
             ValidationError::Vertex { index } => write!(f, "vertex/input {index} is missing"),
         }
@@ -158,7 +161,9 @@ impl Triangulation {
     /// triangulation was built from.
     pub fn validate_with_input(&self, points: &[[f64; 3]]) -> Result<(), ValidationError> {
         if points.len() != self.input_vert.len() {
-            return Err(ValidationError::Vertex { index: points.len() });
+            return Err(ValidationError::Vertex {
+                index: points.len(),
+            });
         }
         for (i, p) in points.iter().enumerate() {
             if self.point(self.input_vert[i]) != p {

@@ -101,11 +101,7 @@ pub fn tri_circumsphere(a: &Point3, b: &Point3, c: &Point3) -> (Point3, f64) {
 pub fn edge_circumsphere(a: &Point3, b: &Point3) -> (Point3, f64) {
     let d = sub(b, a);
     (
-        [
-            a[0] + 0.5 * d[0],
-            a[1] + 0.5 * d[1],
-            a[2] + 0.5 * d[2],
-        ],
+        [a[0] + 0.5 * d[0], a[1] + 0.5 * d[1], a[2] + 0.5 * d[2]],
         0.5 * dot(&d, &d).sqrt(),
     )
 }

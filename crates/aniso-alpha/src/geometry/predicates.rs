@@ -22,8 +22,6 @@ use robust::{Coord, Coord3D};
 /// A point in 3D.
 pub type Point3 = [f64; 3];
 
-
-
 /// Exact difference `a − b` if it is representable, else `None`
 /// (Knuth's two-diff: the rounding error of the subtraction is zero).
 #[inline(always)]
@@ -104,8 +102,8 @@ fn orient3d_int(a: &Point3, b: &Point3, c: &Point3, d: &Point3) -> Option<i32> {
     let q = scaled_ints(&diffs)?;
     let m = |i: usize, j: usize, k: usize, l: usize| (q[i] * q[j] - q[k] * q[l]) as i128;
     // rows a, b, c; columns x, y, z
-    let det = q[2] as i128 * m(3, 7, 6, 4) + q[5] as i128 * m(6, 1, 0, 7)
-        + q[8] as i128 * m(0, 4, 3, 1);
+    let det =
+        q[2] as i128 * m(3, 7, 6, 4) + q[5] as i128 * m(6, 1, 0, 7) + q[8] as i128 * m(0, 4, 3, 1);
     Some(det.signum() as i32)
 }
 
@@ -140,6 +138,17 @@ fn insphere_int(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> O
     Some(det.signum() as i32)
 }
 
+/// `max` for non-NaN inputs, compiled to a single instruction (unlike
+/// `f64::max`, which must handle NaN).
+#[inline(always)]
+fn fmax(a: f64, b: f64) -> f64 {
+    if a > b {
+        a
+    } else {
+        b
+    }
+}
+
 #[inline(always)]
 fn c3(p: &Point3) -> Coord3D<f64> {
     Coord3D {
@@ -171,7 +180,7 @@ fn sign(x: f64) -> i32 {
 /// assert_eq!(orient3d(&o, &[0.0, 1.0, 0.0], &[1.0, 0.0, 0.0], &[0.0, 0.0, 1.0]), -1);
 /// assert_eq!(orient3d(&o, &[1.0, 0.0, 0.0], &[0.0, 1.0, 0.0], &[1.0, 1.0, 0.0]), 0);
 /// ```
-#[inline]
+#[inline(always)]
 pub fn orient3d(a: &Point3, b: &Point3, c: &Point3, d: &Point3) -> i32 {
     // Shewchuk's orient3d(a, b, c, d) = det[a − d, b − d, c − d] = −det[b − a, c − a, d − a].
     let adx = a[0] - d[0];
@@ -191,9 +200,9 @@ pub fn orient3d(a: &Point3, b: &Point3, c: &Point3, d: &Point3) -> i32 {
     // permanent, and the permanent is at most 6·X·Y·Z where X, Y, Z bound
     // the absolute differences per axis. 4.7e-15 > 6·(7 + 56ε)ε with margin
     // for the rounding of the product itself.
-    let mx = adx.abs().max(bdx.abs()).max(cdx.abs());
-    let my = ady.abs().max(bdy.abs()).max(cdy.abs());
-    let mz = adz.abs().max(bdz.abs()).max(cdz.abs());
+    let mx = fmax(fmax(adx.abs(), bdx.abs()), cdx.abs());
+    let my = fmax(fmax(ady.abs(), bdy.abs()), cdy.abs());
+    let mz = fmax(fmax(adz.abs(), bdz.abs()), cdz.abs());
     let eps = 4.7e-15 * (mx * my * mz);
     if (det > eps || -det > eps) && eps < f64::MAX && eps > f64::MIN_POSITIVE {
         return -sign(det);
@@ -213,7 +222,7 @@ pub fn orient3d(a: &Point3, b: &Point3, c: &Point3, d: &Point3) -> i32 {
 /// assert_eq!(insphere(&t[0], &t[1], &t[2], &t[3], &[1.0, 1.0, 1.0]), 0);
 /// assert_eq!(insphere(&t[0], &t[1], &t[2], &t[3], &[2.0, 2.0, 2.0]), -1);
 /// ```
-#[inline]
+#[inline(always)]
 pub fn insphere(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> i32 {
     let aex = a[0] - e[0];
     let bex = b[0] - e[0];
@@ -252,10 +261,10 @@ pub fn insphere(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> i
     // bound the absolute differences per axis and M = max(X, Y, Z) (each
     // lift is at most 3M², each 3x3 permanent at most 6XYZ). 1.28e-13 >
     // 72·(16 + 224ε)ε = 1.27898e-13, with margin for rounding.
-    let mx = aex.abs().max(bex.abs()).max(cex.abs()).max(dex.abs());
-    let my = aey.abs().max(bey.abs()).max(cey.abs()).max(dey.abs());
-    let mz = aez.abs().max(bez.abs()).max(cez.abs()).max(dez.abs());
-    let m = mx.max(my).max(mz);
+    let mx = fmax(fmax(aex.abs(), bex.abs()), fmax(cex.abs(), dex.abs()));
+    let my = fmax(fmax(aey.abs(), bey.abs()), fmax(cey.abs(), dey.abs()));
+    let mz = fmax(fmax(aez.abs(), bez.abs()), fmax(cez.abs(), dez.abs()));
+    let m = fmax(fmax(mx, my), mz);
     let eps = 1.28e-13 * (mx * my * mz) * (m * m);
     // Shewchuk's insphere is positive for "inside" when (a, b, c, d) has *his*
     // positive orientation, which is CGAL's negative one: negate.
@@ -366,11 +375,19 @@ pub fn lex_less(a: &Point3, b: &Point3) -> bool {
 /// tet vertex `i`, the orientation of the tet with vertex `i` replaced by
 /// `e` decides, unless it is zero, in which case the next point is looked
 /// at. This reproduces CGAL 5.5's `side_of_oriented_sphere(..., perturb = true)`.
+#[inline(always)]
 pub fn insphere_perturbed(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> i32 {
     let s = insphere(a, b, c, d, e);
     if s != 0 {
         return s;
     }
+    insphere_tie(a, b, c, d, e)
+}
+
+/// The symbolic perturbation of [`insphere_perturbed`] on an exact tie.
+#[cold]
+#[inline(never)]
+fn insphere_tie(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> i32 {
     let pts: [&Point3; 5] = [a, b, c, d, e];
     let mut idx = [0usize, 1, 2, 3, 4];
     // Sort descending by lexicographic order (insertion sort on 5 items).
@@ -443,7 +460,9 @@ mod tests {
         // Small integers: the naive determinant is exact.
         let mut s = 12345u64;
         let mut next = || {
-            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             ((s >> 33) % 7) as f64 - 3.0
         };
         for _ in 0..5000 {
@@ -486,7 +505,9 @@ mod tests {
     fn integer_stage_agrees_with_robust() {
         let mut s = 99u64;
         let mut next = |range: u64| {
-            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             (s >> 33) % range
         };
         let mut used = 0;
@@ -500,7 +521,8 @@ mod tests {
                 .map(|_| {
                     let mut p = [0.0; 3];
                     for c in &mut p {
-                        *c = offset + scale * (next(1 << bits) as f64 - (1u64 << (bits - 1)) as f64);
+                        *c =
+                            offset + scale * (next(1 << bits) as f64 - (1u64 << (bits - 1)) as f64);
                     }
                     p
                 })
@@ -525,13 +547,30 @@ mod tests {
         assert!(used > 5000, "integer stage used {used} times");
         // Cube corners: exact zeros.
         let z = [0.0, 0.0, 0.0];
-        assert_eq!(insphere_int(&z, &[1.0, 0.0, 0.0], &[0.0, 1.0, 0.0], &[0.0, 0.0, 1.0], &[1.0, 1.0, 1.0]), Some(0));
-        assert_eq!(orient3d_int(&z, &[1.0, 0.0, 0.0], &[0.0, 1.0, 0.0], &[1.0, 1.0, 0.0]), Some(0));
+        assert_eq!(
+            insphere_int(
+                &z,
+                &[1.0, 0.0, 0.0],
+                &[0.0, 1.0, 0.0],
+                &[0.0, 0.0, 1.0],
+                &[1.0, 1.0, 1.0]
+            ),
+            Some(0)
+        );
+        assert_eq!(
+            orient3d_int(&z, &[1.0, 0.0, 0.0], &[0.0, 1.0, 0.0], &[1.0, 1.0, 0.0]),
+            Some(0)
+        );
     }
 
     #[test]
     fn insphere_sign_convention() {
-        let t = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        let t = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+        ];
         assert_eq!(orient3d(&t[0], &t[1], &t[2], &t[3]), 1);
         assert_eq!(insphere(&t[0], &t[1], &t[2], &t[3], &[0.1, 0.1, 0.1]), 1);
         // Negatively oriented: reversed.
@@ -558,24 +597,51 @@ mod tests {
         let p0 = [0.0, 0.0, 0.0];
         let p1 = [2.0, 0.0, 0.0];
         let p2 = [0.0, 2.0, 0.0];
-        assert_eq!(coplanar_side_of_bounded_circle(&p0, &p1, &p2, &[1.0, 1.0, 0.0]), 1);
-        assert_eq!(coplanar_side_of_bounded_circle(&p0, &p1, &p2, &[2.0, 2.0, 0.0]), 0);
-        assert_eq!(coplanar_side_of_bounded_circle(&p0, &p1, &p2, &[3.0, 3.0, 0.0]), -1);
+        assert_eq!(
+            coplanar_side_of_bounded_circle(&p0, &p1, &p2, &[1.0, 1.0, 0.0]),
+            1
+        );
+        assert_eq!(
+            coplanar_side_of_bounded_circle(&p0, &p1, &p2, &[2.0, 2.0, 0.0]),
+            0
+        );
+        assert_eq!(
+            coplanar_side_of_bounded_circle(&p0, &p1, &p2, &[3.0, 3.0, 0.0]),
+            -1
+        );
         // Reversed orientation of the triangle gives the same answer.
-        assert_eq!(coplanar_side_of_bounded_circle(&p1, &p0, &p2, &[1.0, 1.0, 0.0]), 1);
+        assert_eq!(
+            coplanar_side_of_bounded_circle(&p1, &p0, &p2, &[1.0, 1.0, 0.0]),
+            1
+        );
         // A vertical plane x = 1: falls back to another projection.
         let q0 = [1.0, 0.0, 0.0];
         let q1 = [1.0, 2.0, 0.0];
         let q2 = [1.0, 0.0, 2.0];
-        assert_eq!(coplanar_side_of_bounded_circle(&q0, &q1, &q2, &[1.0, 1.0, 1.0]), 1);
-        assert_eq!(coplanar_side_of_bounded_circle(&q0, &q1, &q2, &[1.0, 2.0, 2.0]), 0);
-        assert_eq!(coplanar_side_of_bounded_circle(&q0, &q1, &q2, &[1.0, 5.0, 2.0]), -1);
+        assert_eq!(
+            coplanar_side_of_bounded_circle(&q0, &q1, &q2, &[1.0, 1.0, 1.0]),
+            1
+        );
+        assert_eq!(
+            coplanar_side_of_bounded_circle(&q0, &q1, &q2, &[1.0, 2.0, 2.0]),
+            0
+        );
+        assert_eq!(
+            coplanar_side_of_bounded_circle(&q0, &q1, &q2, &[1.0, 5.0, 2.0]),
+            -1
+        );
         // A plane y = 3 (needs the xz projection).
         let r0 = [0.0, 3.0, 0.0];
         let r1 = [2.0, 3.0, 0.0];
         let r2 = [0.0, 3.0, 2.0];
-        assert_eq!(coplanar_side_of_bounded_circle(&r0, &r1, &r2, &[1.0, 3.0, 1.0]), 1);
-        assert_eq!(coplanar_side_of_bounded_circle(&r0, &r1, &r2, &[2.0, 3.0, 2.0]), 0);
+        assert_eq!(
+            coplanar_side_of_bounded_circle(&r0, &r1, &r2, &[1.0, 3.0, 1.0]),
+            1
+        );
+        assert_eq!(
+            coplanar_side_of_bounded_circle(&r0, &r1, &r2, &[2.0, 3.0, 2.0]),
+            0
+        );
     }
 
     #[test]
