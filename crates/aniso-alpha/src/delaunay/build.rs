@@ -3,7 +3,8 @@
 use super::order::{brio_order, SplitMix64};
 use super::{DelaunayError, Triangulation, INFINITE};
 use crate::geometry::predicates::{
-    collinear, coplanar_incircle_perturbed, insphere_perturbed, orient3d,
+    collinear, coplanar_incircle_perturbed, insphere_perturbed_k, orient3d, Filtered, Kernel,
+    SmallGrid,
 };
 use crate::geometry::Point3;
 
@@ -41,21 +42,22 @@ fn pack(t: u32, i: usize) -> u32 {
 /// circumsphere; for an infinite tet, `q` is strictly beyond its hull facet,
 /// or in the facet's plane and inside its circumcircle.
 #[inline(always)]
-pub(crate) fn tet_in_conflict(pts: &[Point3], v: &[u32; 4], q: &Point3) -> bool {
+pub(crate) fn tet_in_conflict<K: Kernel>(pts: &[Point3], v: &[u32; 4], q: &Point3) -> bool {
     let p = |w: u32| &pts[w as usize];
     if v[3] == INFINITE {
-        let o = orient3d(p(v[0]), p(v[1]), p(v[2]), q);
+        let o = K::orient3d(p(v[0]), p(v[1]), p(v[2]), q);
         if o != 0 {
             return o > 0;
         }
         coplanar_incircle_perturbed(p(v[0]), p(v[1]), p(v[2]), q) > 0
     } else {
-        insphere_perturbed(p(v[0]), p(v[1]), p(v[2]), p(v[3]), q) > 0
+        insphere_perturbed_k::<K>(p(v[0]), p(v[1]), p(v[2]), p(v[3]), q) > 0
     }
 }
 
 /// Working state of the incremental construction.
-struct Builder {
+struct Builder<K: Kernel> {
+    kernel: std::marker::PhantomData<K>,
     pts: Vec<Point3>,
     cells: Vec<Cell>,
     /// Per-tet flag during one insertion: 0, [`IN_CONFLICT`] or [`CLEAR`];
@@ -113,7 +115,7 @@ const EDGE_OF_FACES: [[(usize, usize); 4]; 4] = {
     t
 };
 
-impl Builder {
+impl<K: Kernel> Builder<K> {
     #[inline(always)]
     fn p(&self, v: u32) -> &Point3 {
         &self.pts[v as usize]
@@ -140,7 +142,7 @@ impl Builder {
     fn orient_replaced(&self, t: &[u32; 4], i: usize, q: &Point3) -> i32 {
         let mut p = [self.p(t[0]), self.p(t[1]), self.p(t[2]), self.p(t[3])];
         p[i] = q;
-        orient3d(p[0], p[1], p[2], p[3])
+        K::orient3d(p[0], p[1], p[2], p[3])
     }
 
     /// Remembering stochastic walk from `self.last` to a tetrahedron in
@@ -151,7 +153,7 @@ impl Builder {
         let mut t = self.last;
         let v = self.cells[t as usize].v;
         if v[3] == INFINITE {
-            if orient3d(self.p(v[0]), self.p(v[1]), self.p(v[2]), q) > 0 {
+            if K::orient3d(self.p(v[0]), self.p(v[1]), self.p(v[2]), q) > 0 {
                 return t;
             }
             t = self.cells[t as usize].n[3] >> 2;
@@ -213,7 +215,7 @@ impl Builder {
                 if m == IN_CONFLICT {
                     continue;
                 }
-                if m != CLEAR && tet_in_conflict(&self.pts, &self.cells[n].v, &q) {
+                if m != CLEAR && tet_in_conflict::<K>(&self.pts, &self.cells[n].v, &q) {
                     self.mark[n] = IN_CONFLICT;
                     self.conflicts.push(n as u32);
                     continue;
@@ -386,7 +388,23 @@ pub(super) fn build(points: &[[f64; 3]]) -> Result<Triangulation, DelaunayError>
     // Uniform points give about 6.8 tets per point; untouched capacity costs
     // address space, not resident memory.
     let expected_tets = 7 * n + n / 2 + 64;
-    let mut b = Builder {
+    if SmallGrid::applies(points) {
+        Ok(run::<SmallGrid>(points, &order, init, expected_tets))
+    } else {
+        Ok(run::<Filtered>(points, &order, init, expected_tets))
+    }
+}
+
+/// The incremental construction proper, monomorphised over the kernel.
+fn run<K: Kernel>(
+    points: &[Point3],
+    order: &[u32],
+    init: [u32; 4],
+    expected_tets: usize,
+) -> Triangulation {
+    let n = points.len();
+    let mut b = Builder::<K> {
+        kernel: std::marker::PhantomData,
         pts: Vec::with_capacity(n),
         cells: Vec::with_capacity(expected_tets),
         mark: Vec::with_capacity(expected_tets),
@@ -429,7 +447,7 @@ pub(super) fn build(points: &[[f64; 3]]) -> Result<Triangulation, DelaunayError>
     link_by_faces(&mut b.cells, &[0, 1, 2, 3, 4]);
     b.last = t0;
 
-    for &i in &order {
+    for &i in order {
         if input_vert[i as usize] != u32::MAX {
             continue; // one of the initial four
         }
@@ -450,7 +468,7 @@ pub(super) fn build(points: &[[f64; 3]]) -> Result<Triangulation, DelaunayError>
         }
     }
     drop(std::mem::take(&mut b.mark));
-    Ok(compact(b, vert_input, input_vert))
+    compact(b, vert_input, input_vert)
 }
 
 /// Links the faces of a few tets by brute force (used for the first five).
@@ -483,7 +501,7 @@ fn link_by_faces(cells: &mut [Cell], ids: &[u32]) {
 
 /// Drops dead tets by moving live tets from the end into the holes (only
 /// the cells on the free list move; the rest stay where they are).
-fn compact(b: Builder, vert_input: Vec<u32>, input_vert: Vec<u32>) -> Triangulation {
+fn compact<K: Kernel>(b: Builder<K>, vert_input: Vec<u32>, input_vert: Vec<u32>) -> Triangulation {
     let Builder { pts, mut cells, .. } = b;
     let dead = |c: &Cell| c.v[0] == DEAD;
     let mut end = cells.len();

@@ -274,9 +274,46 @@ pub fn insphere(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> i
     insphere_slow(a, b, c, d, e)
 }
 
+/// Whether every value is an integer of magnitude below `limit`. For
+/// integer inputs below 2^52 the differences are exact, and a determinant
+/// of small integer differences whose every intermediate stays below 2^53
+/// is computed exactly by plain `f64` arithmetic.
+#[inline(always)]
+fn small_ints<const N: usize>(d: &[f64; N], limit: f64) -> bool {
+    d.iter().all(|&x| x.abs() < limit && x == (x as i64) as f64)
+}
+
 #[cold]
 #[inline(never)]
 fn orient3d_slow(a: &Point3, b: &Point3, c: &Point3, d: &Point3) -> i32 {
+    // Integer differences below 2^16: |det| < 6·2^48 and every product and
+    // sum of the evaluation is an exact f64.
+    let diffs = [
+        a[0] - d[0],
+        a[1] - d[1],
+        a[2] - d[2],
+        b[0] - d[0],
+        b[1] - d[1],
+        b[2] - d[2],
+        c[0] - d[0],
+        c[1] - d[1],
+        c[2] - d[2],
+    ];
+    // The inputs must be integers themselves (then, below 2^52, their
+    // differences are exact); checking only the rounded differences would
+    // accept 3 − 1e−20 as the integer 3.
+    if small_ints(&diffs, 65536.0)
+        && small_ints(a, 4.5e15)
+        && small_ints(b, 4.5e15)
+        && small_ints(c, 4.5e15)
+        && small_ints(d, 4.5e15)
+    {
+        let [adx, ady, adz, bdx, bdy, bdz, cdx, cdy, cdz] = diffs;
+        let det = adz * (bdx * cdy - cdx * bdy)
+            + bdz * (cdx * ady - adx * cdy)
+            + cdz * (adx * bdy - bdx * ady);
+        return -sign(det);
+    }
     if let Some(s) = orient3d_int(a, b, c, d) {
         return -s;
     }
@@ -286,10 +323,163 @@ fn orient3d_slow(a: &Point3, b: &Point3, c: &Point3, d: &Point3) -> i32 {
 #[cold]
 #[inline(never)]
 fn insphere_slow(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> i32 {
+    // Integer differences below 2^9: lifts < 3·2^18, 2x2 minors < 2^19,
+    // 3x3 minors < 3·2^28, |det| < 4·3·2^18·3·2^28 < 2^53: plain f64 is
+    // exact (and subtracting integers below 2^53 is exact too).
+    let mut diffs = [0.0; 12];
+    for (r, p) in [a, b, c, d].iter().enumerate() {
+        for k in 0..3 {
+            diffs[3 * r + k] = p[k] - e[k];
+        }
+    }
+    if small_ints(&diffs, 512.0)
+        && small_ints(a, 4.5e15)
+        && small_ints(b, 4.5e15)
+        && small_ints(c, 4.5e15)
+        && small_ints(d, 4.5e15)
+        && small_ints(e, 4.5e15)
+    {
+        let [aex, aey, aez, bex, bey, bez, cex, cey, cez, dex, dey, dez] = diffs;
+        let ab = aex * bey - bex * aey;
+        let bc = bex * cey - cex * bey;
+        let cd = cex * dey - dex * cey;
+        let da = dex * aey - aex * dey;
+        let ac = aex * cey - cex * aey;
+        let bd = bex * dey - dex * bey;
+        let abc = aez * bc - bez * ac + cez * ab;
+        let bcd = bez * cd - cez * bd + dez * bc;
+        let cda = cez * da + dez * ac + aez * cd;
+        let dab = dez * ab + aez * bd + bez * da;
+        let alift = aex * aex + aey * aey + aez * aez;
+        let blift = bex * bex + bey * bey + bez * bez;
+        let clift = cex * cex + cey * cey + cez * cez;
+        let dlift = dex * dex + dey * dey + dez * dez;
+        let det = (dlift * abc - clift * dab) + (blift * cda - alift * bcd);
+        return -sign(det);
+    }
     if let Some(s) = insphere_int(a, b, c, d, e) {
         return -s;
     }
     -sign(robust::insphere(c3(a), c3(b), c3(c), c3(d), c3(e)))
+}
+
+/// A choice of implementation for the two hot predicates. Both kernels
+/// return exact signs; [`SmallGrid`] is only valid for inputs that
+/// [`SmallGrid::applies`] accepts.
+pub trait Kernel: Copy + Send + Sync {
+    /// Exact sign of `det[b − a, c − a, d − a]`, as [`orient3d`].
+    fn orient3d(a: &Point3, b: &Point3, c: &Point3, d: &Point3) -> i32;
+    /// Exact in-sphere sign, as [`insphere`].
+    fn insphere(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> i32;
+}
+
+/// The general kernel: floating-point filter, then exact stages.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Filtered;
+
+impl Kernel for Filtered {
+    #[inline(always)]
+    fn orient3d(a: &Point3, b: &Point3, c: &Point3, d: &Point3) -> i32 {
+        orient3d(a, b, c, d)
+    }
+    #[inline(always)]
+    fn insphere(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> i32 {
+        insphere(a, b, c, d, e)
+    }
+}
+
+/// A kernel for points on a small dyadic grid (e.g. integer grids up to
+/// 512 wide): every coordinate is `k · 2^L` for one `L`, with the extent of
+/// the set below `2^9 · 2^L` on every axis. Then every difference is an
+/// integer multiple of `2^L` below `2^9` steps and plain `f64` evaluation of
+/// both determinants is exact (|insphere| < 2^53 steps, see
+/// `insphere_slow`), so no filter is needed. Degenerate grids are exactly
+/// where the filtered kernel is slowest (most tests are exact ties).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SmallGrid;
+
+impl SmallGrid {
+    /// Whether the points satisfy the condition of [`SmallGrid`].
+    pub fn applies(points: &[Point3]) -> bool {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        let mut low_bit = i32::MAX;
+        for p in points {
+            for k in 0..3 {
+                let x = p[k];
+                if !x.is_finite() {
+                    return false;
+                }
+                lo[k] = lo[k].min(x);
+                hi[k] = hi[k].max(x);
+                if x != 0.0 {
+                    let bits = x.to_bits();
+                    let exp = ((bits >> 52) & 0x7ff) as i32;
+                    if exp == 0 {
+                        return false; // subnormal
+                    }
+                    let mant = (bits & ((1u64 << 52) - 1)) | (1u64 << 52);
+                    low_bit = low_bit.min(exp - 1075 + mant.trailing_zeros() as i32);
+                }
+            }
+        }
+        if low_bit == i32::MAX {
+            return true; // all zero
+        }
+        let step = 2f64.powi(low_bit);
+        if step == 0.0 || !step.is_normal() {
+            return false;
+        }
+        (0..3).all(|k| {
+            // Every coordinate is k·step with |k| < 2^52 (so differences of
+            // coordinates are exact) and the extent is below 2^9 steps.
+            (hi[k] - lo[k]) / step < 512.0
+                && lo[k].abs() / step < 4.5e15
+                && hi[k].abs() / step < 4.5e15
+        })
+    }
+}
+
+impl Kernel for SmallGrid {
+    #[inline(always)]
+    fn orient3d(a: &Point3, b: &Point3, c: &Point3, d: &Point3) -> i32 {
+        let adx = a[0] - d[0];
+        let bdx = b[0] - d[0];
+        let cdx = c[0] - d[0];
+        let ady = a[1] - d[1];
+        let bdy = b[1] - d[1];
+        let cdy = c[1] - d[1];
+        let adz = a[2] - d[2];
+        let bdz = b[2] - d[2];
+        let cdz = c[2] - d[2];
+        let det = adz * (bdx * cdy - cdx * bdy)
+            + bdz * (cdx * ady - adx * cdy)
+            + cdz * (adx * bdy - bdx * ady);
+        -sign(det)
+    }
+    #[inline(always)]
+    fn insphere(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> i32 {
+        let [aex, aey, aez] = [a[0] - e[0], a[1] - e[1], a[2] - e[2]];
+        let [bex, bey, bez] = [b[0] - e[0], b[1] - e[1], b[2] - e[2]];
+        let [cex, cey, cez] = [c[0] - e[0], c[1] - e[1], c[2] - e[2]];
+        let [dex, dey, dez] = [d[0] - e[0], d[1] - e[1], d[2] - e[2]];
+        let ab = aex * bey - bex * aey;
+        let bc = bex * cey - cex * bey;
+        let cd = cex * dey - dex * cey;
+        let da = dex * aey - aex * dey;
+        let ac = aex * cey - cex * aey;
+        let bd = bex * dey - dex * bey;
+        let abc = aez * bc - bez * ac + cez * ab;
+        let bcd = bez * cd - cez * bd + dez * bc;
+        let cda = cez * da + dez * ac + aez * cd;
+        let dab = dez * ab + aez * bd + bez * da;
+        let alift = aex * aex + aey * aey + aez * aez;
+        let blift = bex * bex + bey * bey + bez * bez;
+        let clift = cex * cex + cey * cey + cez * cez;
+        let dlift = dex * dex + dey * dey + dez * dez;
+        let det = (dlift * abc - clift * dab) + (blift * cda - alift * bcd);
+        -sign(det)
+    }
 }
 
 /// Exact 2D orientation of the projections of `a, b, c` onto coordinates
@@ -377,17 +567,29 @@ pub fn lex_less(a: &Point3, b: &Point3) -> bool {
 /// at. This reproduces CGAL 5.5's `side_of_oriented_sphere(..., perturb = true)`.
 #[inline(always)]
 pub fn insphere_perturbed(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> i32 {
-    let s = insphere(a, b, c, d, e);
+    insphere_perturbed_k::<Filtered>(a, b, c, d, e)
+}
+
+/// [`insphere_perturbed`] with the predicates of kernel `K`.
+#[inline(always)]
+pub fn insphere_perturbed_k<K: Kernel>(
+    a: &Point3,
+    b: &Point3,
+    c: &Point3,
+    d: &Point3,
+    e: &Point3,
+) -> i32 {
+    let s = K::insphere(a, b, c, d, e);
     if s != 0 {
         return s;
     }
-    insphere_tie(a, b, c, d, e)
+    insphere_tie::<K>(a, b, c, d, e)
 }
 
 /// The symbolic perturbation of [`insphere_perturbed`] on an exact tie.
 #[cold]
 #[inline(never)]
-fn insphere_tie(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> i32 {
+fn insphere_tie<K: Kernel>(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> i32 {
     let pts: [&Point3; 5] = [a, b, c, d, e];
     let mut idx = [0usize, 1, 2, 3, 4];
     // Sort descending by lexicographic order (insertion sort on 5 items).
@@ -404,7 +606,7 @@ fn insphere_tie(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> i
         }
         let mut q = [a, b, c, d];
         q[i] = e;
-        let o = orient3d(q[0], q[1], q[2], q[3]);
+        let o = K::orient3d(q[0], q[1], q[2], q[3]);
         if o != 0 {
             return o;
         }
@@ -561,6 +763,86 @@ mod tests {
             orient3d_int(&z, &[1.0, 0.0, 0.0], &[0.0, 1.0, 0.0], &[1.0, 1.0, 0.0]),
             Some(0)
         );
+    }
+
+    #[test]
+    fn small_integer_shortcut_rejects_rounded_differences() {
+        // d = 1e-20 makes every difference round to an integer, but the
+        // points are not integers: the true orientation is not zero.
+        let a = [3.0, 0.0, 0.0];
+        let b = [0.0, 3.0, 0.0];
+        let c = [0.0, 0.0, 3.0];
+        let d = [1.0, 1.0, 1.0 + 1e-15];
+        let naive_zero = [1.0, 1.0, 1.0];
+        assert_eq!(orient3d(&a, &b, &c, &naive_zero), 0);
+        assert_eq!(orient3d(&a, &b, &c, &d), 1);
+        assert_eq!(
+            orient3d(&a, &b, &c, &d),
+            -sign(robust::orient3d(c3(&a), c3(&b), c3(&c), c3(&d)))
+        );
+        let tiny = [1e-20, 0.0, 0.0];
+        let s = orient3d(&[3.0, 1.0, 0.0], &[0.0, 3.0, 1.0], &[1.0, 0.0, 3.0], &tiny);
+        assert_eq!(
+            s,
+            -sign(robust::orient3d(
+                c3(&[3.0, 1.0, 0.0]),
+                c3(&[0.0, 3.0, 1.0]),
+                c3(&[1.0, 0.0, 3.0]),
+                c3(&tiny)
+            ))
+        );
+        // Cospherical cube corners with e off by 1e-20 in x.
+        let t = [
+            [1.0, 0.0, 0.0],
+            [0.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+        ];
+        let e = [1.0 + 0.0, 1.0, 1.0];
+        assert_eq!(insphere(&t[0], &t[1], &t[2], &t[3], &e), 0);
+        let e2 = [1e-20, 1.0, 1.0];
+        let r = -sign(robust::insphere(
+            c3(&t[0]),
+            c3(&t[1]),
+            c3(&t[2]),
+            c3(&t[3]),
+            c3(&e2),
+        ));
+        assert_eq!(insphere(&t[0], &t[1], &t[2], &t[3], &e2), r);
+    }
+
+    #[test]
+    fn small_grid_kernel_agrees_with_filtered() {
+        let mut s = 5u64;
+        let mut next = |m: u64| {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 33) % m
+        };
+        for round in 0..20000 {
+            let step = [1.0, 0.25, 8.0][round % 3];
+            let offset = [0.0, 1024.0, -3.0 * 1024.0 * 1024.0][round % 3];
+            let pts: Vec<[f64; 3]> = (0..5)
+                .map(|_| {
+                    [0; 3].map(|_: i32| {
+                        offset + step * (next(511) as f64 - (round % 2) as f64 * 200.0)
+                    })
+                })
+                .collect();
+            assert!(SmallGrid::applies(&pts), "{pts:?}");
+            let (a, b, c, d, e) = (&pts[0], &pts[1], &pts[2], &pts[3], &pts[4]);
+            assert_eq!(SmallGrid::orient3d(a, b, c, d), orient3d(a, b, c, d));
+            assert_eq!(SmallGrid::insphere(a, b, c, d, e), insphere(a, b, c, d, e));
+        }
+        assert!(!SmallGrid::applies(&[[0.0, 0.0, 0.0], [513.0, 0.0, 0.0]]));
+        assert!(SmallGrid::applies(&[[0.0, 0.0, 0.0], [512.0, 0.0, 0.0]])); // step 512
+        assert!(SmallGrid::applies(&[[0.0, 0.0, 0.0], [511.0, 0.0, 0.0]]));
+        assert!(!SmallGrid::applies(&[[0.0, 0.0, 0.0], [0.1, 0.0, 0.0]]));
+        assert!(SmallGrid::applies(&[
+            [1e6, 0.0, 0.0],
+            [1e6 + 5.0, 0.5, 0.0]
+        ]));
     }
 
     #[test]
