@@ -334,7 +334,6 @@ fn read_ascii(
             break;
         }
         let ln = h.lines + k + 1;
-        last = ln;
         toks.clear();
         toks.extend(
             raw.split(|b| b.is_ascii_whitespace())
@@ -343,6 +342,7 @@ fn read_ascii(
         if toks.is_empty() {
             continue;
         }
+        last = ln;
         if toks.len() < acc {
             return Err(IoError::parse(
                 path,

@@ -439,9 +439,7 @@ fn read_ascii(
         for i in 0..el.count {
             let (ln, raw) = loop {
                 match lines.next() {
-                    Some((k, l)) if l.iter().all(|b| b.is_ascii_whitespace()) => {
-                        last_line = header.lines + k + 1;
-                    }
+                    Some((_, l)) if l.iter().all(|b| b.is_ascii_whitespace()) => {}
                     Some((k, l)) => break (header.lines + k + 1, l),
                     None => {
                         return Err(IoError::parse(
