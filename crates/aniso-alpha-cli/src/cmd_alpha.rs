@@ -41,7 +41,10 @@ pub struct AlphaArgs {
 
 /// Runs `alpha`.
 pub fn run(args: &AlphaArgs, timings: &mut Timings) -> Result<(), CliError> {
-    common::check_outputs([args.intervals.as_deref(), args.output.as_deref()])?;
+    common::check_outputs([args.intervals.as_deref()])?;
+    if let Some(out) = &args.output {
+        common::check_mesh_output(out)?;
+    }
     let cloud = common::read_input(&args.input, &ReadOptions::default(), timings)?;
     let _ = cloud;
     Err(CliError::not_available("alpha"))

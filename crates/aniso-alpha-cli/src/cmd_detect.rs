@@ -66,11 +66,10 @@ pub struct DetectArgs {
 
 /// Runs `detect`.
 pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
-    common::check_outputs([
-        args.labels.as_deref(),
-        args.output.as_deref(),
-        args.report.as_deref(),
-    ])?;
+    common::check_outputs([args.labels.as_deref(), args.report.as_deref()])?;
+    if let Some(out) = &args.output {
+        common::check_mesh_output(out)?;
+    }
     if let Some(input) = &args.input {
         let cloud = common::read_input(input, &ReadOptions::default(), timings)?;
         let _ = cloud;

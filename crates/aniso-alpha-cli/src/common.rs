@@ -7,7 +7,7 @@ use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-use aniso_alpha::io::{self as aio, PointCloud, ReadOptions};
+use aniso_alpha::io::{self as aio, Mesh, PlyEncoding, PointCloud, ReadOptions};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 // ------------------------------------------------------------------ errors
@@ -256,6 +256,49 @@ pub fn check_outputs<'a>(
     Ok(())
 }
 
+/// Output formats for simplices.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MeshFormat {
+    /// `.ply` (binary little endian).
+    Ply,
+    /// `.obj`.
+    Obj,
+}
+
+/// The mesh format of an output path, by extension (`.ply` or `.obj`).
+pub fn mesh_format(path: &Path) -> Result<MeshFormat, CliError> {
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    match ext.as_str() {
+        "ply" => Ok(MeshFormat::Ply),
+        "obj" => Ok(MeshFormat::Obj),
+        _ => Err(CliError::msg(format!(
+            "{}: unknown output extension (expected .ply or .obj)",
+            path.display()
+        ))),
+    }
+}
+
+/// [`check_output`] plus a known mesh extension; call it early.
+pub fn check_mesh_output(path: &Path) -> Result<(), CliError> {
+    mesh_format(path)?;
+    check_output(path)
+}
+
+/// Writes simplices as PLY (binary) or OBJ by extension, atomically, as
+/// phase `write`.
+#[allow(dead_code)] // used by alpha/detect once wired
+pub fn write_mesh(path: &Path, mesh: &Mesh<'_>, timings: &mut Timings) -> Result<(), CliError> {
+    let format = mesh_format(path)?;
+    timings.phase("write", || match format {
+        MeshFormat::Ply => aio::write_ply(path, mesh, PlyEncoding::BinaryLittleEndian),
+        MeshFormat::Obj => aio::write_obj(path, mesh),
+    })?;
+    Ok(())
+}
+
 /// Writes an output atomically (complete or absent), as phase `write`.
 #[allow(dead_code)] // used by the subcommands once wired
 pub fn write_output(
@@ -359,6 +402,30 @@ mod tests {
         assert_eq!(v["read"], 0.75);
         assert_eq!(v["write"], 0.25);
         assert!(v["total"].is_number());
+    }
+
+    #[test]
+    fn meshes_by_extension() {
+        let dir = std::env::temp_dir().join(format!("aniso-cli-mesh-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let pts = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        let mesh = Mesh {
+            faces: &[[0, 1, 2]],
+            ..Mesh::new(&pts)
+        };
+        let mut t = Timings::new();
+        write_mesh(&dir.join("m.PLY"), &mesh, &mut t).unwrap();
+        write_mesh(&dir.join("m.obj"), &mesh, &mut t).unwrap();
+        let back = aio::read_points(&dir.join("m.PLY"), &ReadOptions::default()).unwrap();
+        assert_eq!(back.points, pts);
+        assert!(std::fs::read_to_string(dir.join("m.obj"))
+            .unwrap()
+            .contains("f 1 2 3"));
+        let e = write_mesh(&dir.join("m.stl"), &mesh, &mut t).unwrap_err();
+        assert!(e.to_string().contains("m.stl: unknown output extension"));
+        assert!(check_mesh_output(&dir.join("m.txt")).is_err());
+        assert!(check_mesh_output(&dir.join("nope").join("m.ply")).is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
