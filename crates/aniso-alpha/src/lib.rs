@@ -10,6 +10,8 @@
 //!   that CGAL uses, and circumsphere constructions;
 //! * [`delaunay`]: the triangulation (flat `u32` arrays, bulk construction,
 //!   queries, `validate()`);
+//! * [`io`]: point file readers (text, PLY, LAS/LAZ, PCD), atomic writers
+//!   (PLY, OBJ, labels) and their typed errors;
 //!
 //! ```
 //! use aniso_alpha::delaunay::Triangulation;
@@ -27,3 +29,4 @@
 
 pub mod delaunay;
 pub mod geometry;
+pub mod io;

@@ -1,0 +1,435 @@
+//! Helpers shared by the subcommands: errors, reading input with a progress
+//! bar, atomic outputs, phase timings, progress bars, fast integer output.
+
+use std::fmt;
+use std::io::{IsTerminal, Write};
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use aniso_alpha::io::{self as aio, Mesh, PlyEncoding, PointCloud, ReadOptions};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+// ------------------------------------------------------------------ errors
+
+/// An error for the user: printed by `main` as one line `error: <message>`,
+/// exit status 1. Any `std::error::Error` converts into it with `?`.
+#[derive(Debug)]
+pub struct CliError(String);
+
+impl CliError {
+    /// An error with this message.
+    pub fn msg(message: impl Into<String>) -> Self {
+        CliError(message.into())
+    }
+
+    /// An error about a file whose message does not name it (e.g. an
+    /// engine error on the points of `path`): `<path>: <error>`.
+    #[allow(dead_code)] // used by the subcommands once the library layers are wired
+    pub fn in_file(path: &Path, err: impl fmt::Display) -> Self {
+        CliError(format!("{}: {err}", path.display()))
+    }
+
+    /// The error of a subcommand whose library layer is not in this build.
+    pub fn not_available(subcommand: &str) -> Self {
+        CliError(format!("{subcommand}: not available in this build yet"))
+    }
+
+    /// The message on one line (newlines folded).
+    pub fn one_line(&self) -> String {
+        self.0
+            .trim_end()
+            .chars()
+            .map(|c| if c == '\n' || c == '\r' { ' ' } else { c })
+            .collect()
+    }
+}
+
+impl fmt::Display for CliError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl<E: std::error::Error> From<E> for CliError {
+    fn from(e: E) -> Self {
+        CliError(e.to_string())
+    }
+}
+
+// ------------------------------------------------------------------ quiet
+
+static QUIET: AtomicBool = AtomicBool::new(false);
+
+/// Sets `--quiet`: no progress bars, no informational messages.
+pub fn set_quiet(quiet: bool) {
+    QUIET.store(quiet, Ordering::Relaxed);
+}
+
+/// Whether `--quiet` was given.
+pub fn quiet() -> bool {
+    QUIET.load(Ordering::Relaxed)
+}
+
+/// Prints an informational line on stderr, unless `--quiet`.
+#[allow(dead_code)] // used by detect/synth once wired
+pub fn info(message: impl fmt::Display) {
+    if !quiet() {
+        eprintln!("{message}");
+    }
+}
+
+/// Writes `text` to stdout; a closed pipe (`| head`) is not an error.
+#[allow(dead_code)] // used by eval once wired
+pub fn print_stdout(text: &str) -> Result<(), CliError> {
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|_| out.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(CliError::msg(format!(
+            "cannot write to standard output: {e}"
+        ))),
+        _ => Ok(()),
+    }
+}
+
+// --------------------------------------------------------------- progress
+
+fn draw_target() -> ProgressDrawTarget {
+    if quiet() || !std::io::stderr().is_terminal() {
+        ProgressDrawTarget::hidden()
+    } else {
+        ProgressDrawTarget::stderr()
+    }
+}
+
+/// A progress bar of `len` steps on stderr, hidden with `--quiet` or when
+/// stderr is not a terminal. Call `inc`/`set_position`, then
+/// `finish_and_clear`.
+#[allow(dead_code)] // used by the subcommands once wired
+pub fn progress(len: u64, msg: &str) -> ProgressBar {
+    let style = ProgressStyle::with_template(
+        "{msg:>14} [{bar:40}] {pos}/{len} ({percent}%, {elapsed} elapsed, eta {eta})",
+    )
+    .unwrap_or_else(|_| ProgressStyle::default_bar())
+    .progress_chars("=> ");
+    ProgressBar::with_draw_target(Some(len), draw_target())
+        .with_style(style)
+        .with_message(msg.to_string())
+}
+
+/// Like [`progress`], counting bytes.
+pub fn progress_bytes(len: u64, msg: &str) -> ProgressBar {
+    let style = ProgressStyle::with_template(
+        "{msg:>14} [{bar:40}] {bytes}/{total_bytes} ({bytes_per_sec}, eta {eta})",
+    )
+    .unwrap_or_else(|_| ProgressStyle::default_bar())
+    .progress_chars("=> ");
+    ProgressBar::with_draw_target(Some(len), draw_target())
+        .with_style(style)
+        .with_message(msg.to_string())
+}
+
+/// A spinner for a phase of unknown length (hidden like [`progress`]).
+#[allow(dead_code)] // used by the subcommands once wired
+pub fn spinner(msg: &str) -> ProgressBar {
+    let bar = ProgressBar::with_draw_target(None, draw_target())
+        .with_style(
+            ProgressStyle::with_template("{spinner} {msg} ({elapsed})")
+                .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+        )
+        .with_message(msg.to_string());
+    if !bar.is_hidden() {
+        bar.enable_steady_tick(Duration::from_millis(120));
+    }
+    bar
+}
+
+// ---------------------------------------------------------------- timings
+
+/// Wall time per phase, for `--timings`: one JSON object on stderr,
+/// e.g. `{"read":0.012,"triangulate":1.5,"write":0.2,"total":1.72}`.
+#[derive(Debug)]
+pub struct Timings {
+    start: Instant,
+    phases: Vec<(&'static str, f64)>,
+}
+
+impl Default for Timings {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Timings {
+    /// Starts the clock for `total`.
+    pub fn new() -> Self {
+        Timings {
+            start: Instant::now(),
+            phases: Vec::new(),
+        }
+    }
+
+    /// Runs `f` as phase `name` (times of a repeated name add up).
+    pub fn phase<T>(&mut self, name: &'static str, f: impl FnOnce() -> T) -> T {
+        let t = Instant::now();
+        let out = f();
+        self.add(name, t.elapsed().as_secs_f64());
+        out
+    }
+
+    /// Adds `seconds` to phase `name`.
+    pub fn add(&mut self, name: &'static str, seconds: f64) {
+        match self.phases.iter_mut().find(|(n, _)| *n == name) {
+            Some((_, s)) => *s += seconds,
+            None => self.phases.push((name, seconds)),
+        }
+    }
+
+    /// The JSON object: phases in the order first seen, then `total`.
+    pub fn to_json(&self) -> String {
+        let mut map = serde_json::Map::new();
+        for (name, s) in &self.phases {
+            map.insert((*name).to_string(), round_json(*s));
+        }
+        map.insert(
+            "total".to_string(),
+            round_json(self.start.elapsed().as_secs_f64()),
+        );
+        serde_json::Value::Object(map).to_string()
+    }
+}
+
+fn round_json(s: f64) -> serde_json::Value {
+    serde_json::Value::from((s * 1e6).round() / 1e6)
+}
+
+// ------------------------------------------------------------ input/output
+
+/// Reads a point file (format by extension) with a progress bar, as
+/// phase `read`. Errors name the file and, for text, the line.
+pub fn read_input(
+    path: &Path,
+    options: &ReadOptions,
+    timings: &mut Timings,
+) -> Result<PointCloud, CliError> {
+    timings.phase("read", || {
+        let bar = progress_bytes(0, "reading");
+        let cloud = aio::read_points_with_progress(path, options, &mut |done, total| {
+            bar.set_length(total);
+            bar.set_position(done);
+        });
+        bar.finish_and_clear();
+        Ok(cloud?)
+    })
+}
+
+/// Reads a point file that must carry labels (ground truth): text column
+/// `label_column`, PLY `structure`/`label`, PCD `label`, LAS classification.
+#[allow(dead_code)] // used by eval once wired
+pub fn read_truth(
+    path: &Path,
+    label_column: usize,
+    timings: &mut Timings,
+) -> Result<(PointCloud, Vec<i64>), CliError> {
+    let mut cloud = read_input(path, &ReadOptions::with_labels(label_column), timings)?;
+    match cloud.labels.take() {
+        Some(labels) => Ok((cloud, labels)),
+        None => Err(CliError::in_file(
+            path,
+            "no labels in file (PLY needs a 'structure' or 'label' vertex property, PCD a 'label' field)",
+        )),
+    }
+}
+
+/// Fails early, before any long computation, when `path` cannot be an
+/// output (missing folder, a directory).
+pub fn check_output(path: &Path) -> Result<(), CliError> {
+    Ok(aio::check_output_path(path)?)
+}
+
+/// [`check_output`] for each given optional output.
+pub fn check_outputs<'a>(
+    paths: impl IntoIterator<Item = Option<&'a Path>>,
+) -> Result<(), CliError> {
+    for p in paths.into_iter().flatten() {
+        check_output(p)?;
+    }
+    Ok(())
+}
+
+/// Output formats for simplices.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MeshFormat {
+    /// `.ply` (binary little endian).
+    Ply,
+    /// `.obj`.
+    Obj,
+}
+
+/// The mesh format of an output path, by extension (`.ply` or `.obj`).
+pub fn mesh_format(path: &Path) -> Result<MeshFormat, CliError> {
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    match ext.as_str() {
+        "ply" => Ok(MeshFormat::Ply),
+        "obj" => Ok(MeshFormat::Obj),
+        _ => Err(CliError::msg(format!(
+            "{}: unknown output extension (expected .ply or .obj)",
+            path.display()
+        ))),
+    }
+}
+
+/// [`check_output`] plus a known mesh extension; call it early.
+pub fn check_mesh_output(path: &Path) -> Result<(), CliError> {
+    mesh_format(path)?;
+    check_output(path)
+}
+
+/// Writes simplices as PLY (binary) or OBJ by extension, atomically, as
+/// phase `write`.
+#[allow(dead_code)] // used by alpha/detect once wired
+pub fn write_mesh(path: &Path, mesh: &Mesh<'_>, timings: &mut Timings) -> Result<(), CliError> {
+    let format = mesh_format(path)?;
+    timings.phase("write", || match format {
+        MeshFormat::Ply => aio::write_ply(path, mesh, PlyEncoding::BinaryLittleEndian),
+        MeshFormat::Obj => aio::write_obj(path, mesh),
+    })?;
+    Ok(())
+}
+
+/// Writes an output atomically (complete or absent), as phase `write`.
+#[allow(dead_code)] // used by the subcommands once wired
+pub fn write_output(
+    path: &Path,
+    timings: &mut Timings,
+    write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> Result<(), CliError> {
+    Ok(timings.phase("write", || aio::atomic_write(path, write))?)
+}
+
+/// Writes `value` as pretty JSON (plus a newline), atomically.
+#[allow(dead_code)] // used by detect/eval once wired
+pub fn write_json(
+    path: &Path,
+    value: &impl serde::Serialize,
+    timings: &mut Timings,
+) -> Result<(), CliError> {
+    write_output(path, timings, |w| {
+        serde_json::to_writer_pretty(&mut *w, value)?;
+        w.write_all(b"\n")
+    })
+}
+
+/// Appends the decimal form of `v` to `buf` (no allocation).
+pub fn push_u32(buf: &mut Vec<u8>, mut v: u32) {
+    let mut tmp = [0u8; 10];
+    let mut i = tmp.len();
+    loop {
+        i -= 1;
+        tmp[i] = b'0' + (v % 10) as u8;
+        v /= 10;
+        if v == 0 {
+            break;
+        }
+    }
+    buf.extend_from_slice(&tmp[i..]);
+}
+
+// ----------------------------------------------------------- value parsers
+
+/// clap parser for `a,b,c` (three finite numbers).
+pub fn parse_triple(s: &str) -> Result<[f64; 3], String> {
+    let v: Vec<&str> = s.split(',').map(str::trim).collect();
+    if v.len() != 3 {
+        return Err(format!("expected three comma-separated numbers, got '{s}'"));
+    }
+    let mut out = [0.0; 3];
+    for (o, t) in out.iter_mut().zip(&v) {
+        *o = t
+            .parse::<f64>()
+            .ok()
+            .filter(|x| x.is_finite())
+            .ok_or_else(|| format!("'{t}' is not a finite number"))?;
+    }
+    Ok(out)
+}
+
+/// clap parser for `e1,e2,e3`, each > 0.
+pub fn parse_positive_triple(s: &str) -> Result<[f64; 3], String> {
+    let t = parse_triple(s)?;
+    if t.iter().any(|&x| x <= 0.0) {
+        return Err(format!("every component must be > 0, got '{s}'"));
+    }
+    Ok(t)
+}
+
+/// clap parser for a finite number > 0.
+pub fn parse_positive(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(x) if x.is_finite() && x > 0.0 => Ok(x),
+        _ => Err(format!("expected a finite number > 0, got '{s}'")),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn integers_and_triples() {
+        let mut b = Vec::new();
+        for v in [0u32, 7, 10, 4_294_967_295] {
+            push_u32(&mut b, v);
+            b.push(b' ');
+        }
+        assert_eq!(b, b"0 7 10 4294967295 ");
+        assert_eq!(parse_triple("1, -2,3e1"), Ok([1.0, -2.0, 30.0]));
+        assert!(parse_triple("1,2").is_err());
+        assert!(parse_triple("1,nan,2").is_err());
+        assert!(parse_positive_triple("1,0,2").is_err());
+        assert!(parse_positive("-1").is_err());
+    }
+
+    #[test]
+    fn timings_json() {
+        let mut t = Timings::new();
+        t.add("read", 0.5);
+        t.add("write", 0.25);
+        t.add("read", 0.25);
+        let v: serde_json::Value = serde_json::from_str(&t.to_json()).unwrap();
+        assert_eq!(v["read"], 0.75);
+        assert_eq!(v["write"], 0.25);
+        assert!(v["total"].is_number());
+    }
+
+    #[test]
+    fn meshes_by_extension() {
+        let dir = std::env::temp_dir().join(format!("aniso-cli-mesh-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let pts = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        let mesh = Mesh {
+            faces: &[[0, 1, 2]],
+            ..Mesh::new(&pts)
+        };
+        let mut t = Timings::new();
+        write_mesh(&dir.join("m.PLY"), &mesh, &mut t).unwrap();
+        write_mesh(&dir.join("m.obj"), &mesh, &mut t).unwrap();
+        let back = aio::read_points(&dir.join("m.PLY"), &ReadOptions::default()).unwrap();
+        assert_eq!(back.points, pts);
+        assert!(std::fs::read_to_string(dir.join("m.obj"))
+            .unwrap()
+            .contains("f 1 2 3"));
+        let e = write_mesh(&dir.join("m.stl"), &mesh, &mut t).unwrap_err();
+        assert!(e.to_string().contains("m.stl: unknown output extension"));
+        assert!(check_mesh_output(&dir.join("m.txt")).is_err());
+        assert!(check_mesh_output(&dir.join("nope").join("m.ply")).is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn errors_fold_to_one_line() {
+        assert_eq!(CliError::msg("a\nb  c\n").one_line(), "a b  c");
+    }
+}

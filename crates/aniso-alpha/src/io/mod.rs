@@ -1,0 +1,304 @@
+//! Reading point clouds and writing results.
+//!
+//! Readers pick the format from the file extension (case-insensitive):
+//!
+//! | extension | format |
+//! |---|---|
+//! | `.xyz` `.txt` `.csv` `.pts` | text: x y z in the first three columns, whitespace or commas, `#` comments, one optional header line |
+//! | `.ply` | PLY ascii, binary little- or big-endian; x/y/z of any scalar type |
+//! | `.las` `.laz` | LAS/LAZ with scale and offset applied (cargo feature `las`) |
+//! | `.pcd` | PCD ascii, binary and binary_compressed |
+//!
+//! Point `i` of a [`PointCloud`] is the `i`-th point of the file. Every
+//! error is an [`IoError`] that names the file (and, for text, the line);
+//! no input makes a reader panic.
+//!
+//! Every output goes through [`atomic_write`], so it is written completely
+//! or not at all.
+//!
+//! ```
+//! use aniso_alpha::io::{read_points_bytes, ReadOptions};
+//! use std::path::Path;
+//! let scene = b"# x y z label\n0 0 0 -1\n1 0 0 2\n2 0 0 2\n";
+//! let cloud = read_points_bytes(Path::new("scene.xyz"), scene, &ReadOptions::with_labels(3)).unwrap();
+//! assert_eq!(cloud.points[1], [1.0, 0.0, 0.0]);
+//! assert_eq!(cloud.labels, Some(vec![-1, 2, 2]));
+//! ```
+
+mod atomic;
+mod error;
+mod labels;
+#[cfg(feature = "las")]
+mod las;
+mod lzf;
+mod obj;
+mod pcd;
+mod ply;
+mod text;
+
+use std::fs::File;
+use std::io::Read;
+use std::path::Path;
+
+pub use atomic::{atomic_write, check_output_path};
+pub use error::IoError;
+pub use labels::{read_labels, read_labels_bytes, write_labels};
+pub use obj::write_obj;
+pub use ply::{write_ply, write_ply_to, Mesh, PlyEncoding};
+
+/// A point cloud read from a file.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct PointCloud {
+    /// The points, in file order.
+    pub points: Vec<[f64; 3]>,
+    /// One label per point, when asked for and present (see
+    /// [`ReadOptions`]); -1 conventionally means background.
+    pub labels: Option<Vec<i64>>,
+}
+
+/// How to read a point file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct ReadOptions {
+    /// Text formats: 0-based column holding an integer label (`Some(3)` for
+    /// `x y z label` ground-truth files). Every data line must have it.
+    pub label_column: Option<usize>,
+    /// Binary formats: read labels when the file carries them: the PLY
+    /// vertex property `structure` or `label`, the PCD field `label`, the
+    /// LAS classification. Absent properties give `labels: None`.
+    pub read_labels: bool,
+}
+
+impl ReadOptions {
+    /// Options that read labels: from text column `label_column`, and from
+    /// the label property of the binary formats.
+    ///
+    /// ```
+    /// let o = aniso_alpha::io::ReadOptions::with_labels(3);
+    /// assert_eq!(o.label_column, Some(3));
+    /// assert!(o.read_labels);
+    /// ```
+    pub fn with_labels(label_column: usize) -> Self {
+        ReadOptions {
+            label_column: Some(label_column),
+            read_labels: true,
+        }
+    }
+}
+
+/// A point file format.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    /// Text: `.xyz`, `.txt`, `.csv`, `.pts`.
+    Text,
+    /// `.ply`.
+    Ply,
+    /// `.las` or `.laz`.
+    Las,
+    /// `.pcd`.
+    Pcd,
+}
+
+const EXPECTED_POINTS: &str = ".xyz, .txt, .csv, .pts, .ply, .las, .laz or .pcd";
+
+impl Format {
+    /// The format of a point file, from its extension (case-insensitive).
+    ///
+    /// ```
+    /// use aniso_alpha::io::Format;
+    /// use std::path::Path;
+    /// assert_eq!(Format::from_path(Path::new("a/B.PLY")).unwrap(), Format::Ply);
+    /// assert!(Format::from_path(Path::new("scan.e57")).is_err());
+    /// ```
+    pub fn from_path(path: &Path) -> Result<Format, IoError> {
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase())
+            .unwrap_or_default();
+        match ext.as_str() {
+            "xyz" | "txt" | "csv" | "pts" => Ok(Format::Text),
+            "ply" => Ok(Format::Ply),
+            "las" | "laz" => Ok(Format::Las),
+            "pcd" => Ok(Format::Pcd),
+            _ => Err(IoError::UnknownFormat {
+                path: path.to_path_buf(),
+                expected: EXPECTED_POINTS,
+            }),
+        }
+    }
+}
+
+/// Reads a point file, its format chosen by extension.
+///
+/// ```no_run
+/// use aniso_alpha::io::{read_points, ReadOptions};
+/// let cloud = read_points("scan.ply".as_ref(), &ReadOptions::default())?;
+/// println!("{} points", cloud.points.len());
+/// # Ok::<(), aniso_alpha::io::IoError>(())
+/// ```
+pub fn read_points(path: &Path, options: &ReadOptions) -> Result<PointCloud, IoError> {
+    read_points_with_progress(path, options, &mut |_, _| {})
+}
+
+/// [`read_points`], calling `progress(bytes_read, file_size)` while the
+/// file is loaded (for a progress bar).
+pub fn read_points_with_progress(
+    path: &Path,
+    options: &ReadOptions,
+    progress: &mut dyn FnMut(u64, u64),
+) -> Result<PointCloud, IoError> {
+    Format::from_path(path)?;
+    let bytes = read_file(path, progress)?;
+    read_points_bytes(path, &bytes, options)
+}
+
+/// Loads a whole file, with clear errors for a missing file or a directory.
+pub(crate) fn read_file(
+    path: &Path,
+    progress: &mut dyn FnMut(u64, u64),
+) -> Result<Vec<u8>, IoError> {
+    let open_err = |source| IoError::Open {
+        path: path.to_path_buf(),
+        source,
+    };
+    let meta = std::fs::metadata(path).map_err(open_err)?;
+    if meta.is_dir() {
+        return Err(IoError::IsDirectory {
+            path: path.to_path_buf(),
+        });
+    }
+    let total = meta.len();
+    let mut file = File::open(path).map_err(open_err)?;
+    let mut bytes = Vec::with_capacity(usize::try_from(total).unwrap_or(0).saturating_add(1));
+    let mut chunk = vec![0u8; 8 << 20];
+    loop {
+        let k = match file.read(&mut chunk) {
+            Ok(0) => break,
+            Ok(k) => k,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(open_err(e)),
+        };
+        bytes.extend_from_slice(&chunk[..k]);
+        progress(bytes.len() as u64, total.max(bytes.len() as u64));
+    }
+    Ok(bytes)
+}
+
+/// Parses a point file held in memory; `path` picks the format by
+/// extension and names the file in errors.
+pub fn read_points_bytes(
+    path: &Path,
+    bytes: &[u8],
+    options: &ReadOptions,
+) -> Result<PointCloud, IoError> {
+    match Format::from_path(path)? {
+        Format::Text => read_xyz_bytes(path, bytes, options),
+        Format::Ply => read_ply_bytes(path, bytes, options),
+        Format::Las => read_las_bytes(path, bytes, options),
+        Format::Pcd => read_pcd_bytes(path, bytes, options),
+    }
+}
+
+/// Parses a text point file (xyz/txt/csv/pts) held in memory; `name` only
+/// names it in errors. Uses `options.label_column`.
+///
+/// ```
+/// use aniso_alpha::io::{read_xyz_bytes, ReadOptions};
+/// let c = read_xyz_bytes("a.csv".as_ref(), b"x,y,z\n1,2,3\n", &ReadOptions::default()).unwrap();
+/// assert_eq!(c.points, vec![[1.0, 2.0, 3.0]]);
+/// ```
+pub fn read_xyz_bytes(
+    name: &Path,
+    bytes: &[u8],
+    options: &ReadOptions,
+) -> Result<PointCloud, IoError> {
+    text::read_text(name, bytes, options.label_column)
+}
+
+/// Parses a PLY file (ascii or binary) held in memory; `name` only names
+/// it in errors. Reads the `vertex` element's x, y, z (and, with
+/// `options.read_labels`, its `structure` or `label` property).
+///
+/// ```
+/// use aniso_alpha::io::{read_ply_bytes, ReadOptions};
+/// let ply = b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n1 2 3\n";
+/// let c = read_ply_bytes("m.ply".as_ref(), ply, &ReadOptions::default()).unwrap();
+/// assert_eq!(c.points, vec![[1.0, 2.0, 3.0]]);
+/// ```
+pub fn read_ply_bytes(
+    name: &Path,
+    bytes: &[u8],
+    options: &ReadOptions,
+) -> Result<PointCloud, IoError> {
+    ply::read_ply(name, bytes, options.read_labels)
+}
+
+/// Parses a PCD file (ascii, binary or binary_compressed) held in memory;
+/// `name` only names it in errors. With `options.read_labels`, a `label`
+/// field gives the labels.
+///
+/// ```
+/// use aniso_alpha::io::{read_pcd_bytes, ReadOptions};
+/// let pcd = b"VERSION .7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA ascii\n1 2 3\n";
+/// let c = read_pcd_bytes("c.pcd".as_ref(), pcd, &ReadOptions::default()).unwrap();
+/// assert_eq!(c.points, vec![[1.0, 2.0, 3.0]]);
+/// ```
+pub fn read_pcd_bytes(
+    name: &Path,
+    bytes: &[u8],
+    options: &ReadOptions,
+) -> Result<PointCloud, IoError> {
+    pcd::read_pcd(name, bytes, options.read_labels)
+}
+
+/// Parses a LAS or LAZ file held in memory (scale and offset applied);
+/// `name` only names it in errors. With `options.read_labels`, the
+/// classification gives the labels. Needs the cargo feature `las`;
+/// without it this returns [`IoError::Unsupported`].
+pub fn read_las_bytes(
+    name: &Path,
+    bytes: &[u8],
+    options: &ReadOptions,
+) -> Result<PointCloud, IoError> {
+    #[cfg(feature = "las")]
+    {
+        las::read_las(name, bytes, options.read_labels)
+    }
+    #[cfg(not(feature = "las"))]
+    {
+        let _ = (bytes, options);
+        Err(IoError::Unsupported {
+            path: name.to_path_buf(),
+            message: "LAS/LAZ support is not compiled in (cargo feature `las`)",
+        })
+    }
+}
+
+/// Fails with [`IoError::NoPoints`] on an empty cloud.
+pub(crate) fn non_empty(path: &Path, cloud: PointCloud) -> Result<PointCloud, IoError> {
+    if cloud.points.is_empty() {
+        Err(IoError::NoPoints {
+            path: path.to_path_buf(),
+        })
+    } else {
+        Ok(cloud)
+    }
+}
+
+/// Fails with [`IoError::NonFinite`] unless all three coordinates are finite.
+#[inline]
+pub(crate) fn check_finite(
+    path: &Path,
+    p: &[f64; 3],
+    index: usize,
+    line: Option<usize>,
+) -> Result<(), IoError> {
+    if p[0].is_finite() && p[1].is_finite() && p[2].is_finite() {
+        Ok(())
+    } else {
+        Err(IoError::NonFinite {
+            path: path.to_path_buf(),
+            line,
+            index,
+        })
+    }
+}
