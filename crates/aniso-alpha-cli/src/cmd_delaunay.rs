@@ -2,6 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
+use aniso_alpha::delaunay::Triangulation;
 use aniso_alpha::io::{atomic_write, IoError, ReadOptions};
 use clap::Args;
 
@@ -27,19 +28,33 @@ pub struct DelaunayArgs {
 pub fn run(args: &DelaunayArgs, timings: &mut Timings) -> Result<(), CliError> {
     common::check_output(&args.tets)?;
     let cloud = common::read_input(&args.input, &ReadOptions::default(), timings)?;
-    // Wiring once the engine is merged:
-    //   let bar = common::spinner("triangulating");
-    //   let tri = timings.phase("triangulate", || Triangulation::new(&cloud.points))
-    //       .map_err(|e| CliError::in_file(&args.input, e))?;
-    //   bar.finish_and_clear();
-    //   timings.phase("write", || write_tets(&args.tets, tri.finite_tets_input()))?;
-    let _ = cloud;
-    Err(CliError::not_available("delaunay"))
+    let bar = common::spinner("triangulating");
+    let tri = timings
+        .phase("triangulate", || Triangulation::new(&cloud.points))
+        .map_err(|e| CliError::in_file(&args.input, e))?;
+    bar.finish_and_clear();
+    if tri.dimension() < 3 {
+        common::info(format_args!(
+            "{}: the points span {} dimension(s): no tetrahedra",
+            args.input.display(),
+            tri.dimension()
+        ));
+    }
+    timings
+        .phase("write", || write_tets(&args.tets, tri.finite_tets_input()))
+        .map_err(|e| CliError::msg(e.to_string()))?;
+    common::info(format_args!(
+        "{} points ({} distinct), {} tetrahedra -> {}",
+        tri.num_input_points(),
+        tri.num_vertices(),
+        tri.num_finite_tets(),
+        args.tets.display()
+    ));
+    Ok(())
 }
 
 /// Writes tetrahedra, one per line `i j k l` (single spaces, `\n`),
 /// atomically through a large buffer with hand-rolled integer formatting.
-#[cfg_attr(not(test), allow(dead_code))] // called by `run` once the engine is wired
 pub fn write_tets(path: &Path, tets: impl Iterator<Item = [u32; 4]>) -> Result<(), IoError> {
     const CHUNK: usize = 1 << 20;
     atomic_write(path, |w| {

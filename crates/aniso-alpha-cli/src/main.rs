@@ -89,7 +89,9 @@ fn install_panic_hook() {
 }
 
 fn run(cli: Cli) -> Result<(), CliError> {
-    common::set_quiet(cli.global.quiet);
+    // With --timings, stderr carries exactly one JSON object for scripts:
+    // no informational lines around it.
+    common::set_quiet(cli.global.quiet || cli.global.timings);
     if let Some(n) = cli.global.threads {
         rayon::ThreadPoolBuilder::new()
             .num_threads(n.get())
