@@ -24,3 +24,7 @@
 
 pub mod delaunay;
 pub mod geometry;
+pub mod aniso;
+pub mod detect;
+pub mod eval;
+pub mod synth;

@@ -1,0 +1,1 @@
+//! Detection scores (SPEC §6).
