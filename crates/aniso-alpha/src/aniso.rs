@@ -203,7 +203,7 @@ pub fn completion_third_row(u: [f64; 3]) -> Mat3 {
 /// with n × a = b.
 pub fn completion_first_row(n: [f64; 3]) -> Mat3 {
     let c = completion_third_row(n); // rows (a, b, n), a × b = n
-    // (n, a, b): n × a = b holds for a right-handed (a, b, n).
+                                     // (n, a, b): n × a = b holds for a right-handed (a, b, n).
     [n, c[0], c[1]]
 }
 
@@ -421,9 +421,21 @@ mod tests {
     #[test]
     fn euler_matches_product_of_axis_rotations() {
         let (t, p, f): (f64, f64, f64) = (0.3, -0.2, 0.5);
-        let rz = [[t.cos(), -t.sin(), 0.0], [t.sin(), t.cos(), 0.0], [0.0, 0.0, 1.0]];
-        let rx = [[1.0, 0.0, 0.0], [0.0, p.cos(), -p.sin()], [0.0, p.sin(), p.cos()]];
-        let ry = [[f.cos(), 0.0, f.sin()], [0.0, 1.0, 0.0], [-f.sin(), 0.0, f.cos()]];
+        let rz = [
+            [t.cos(), -t.sin(), 0.0],
+            [t.sin(), t.cos(), 0.0],
+            [0.0, 0.0, 1.0],
+        ];
+        let rx = [
+            [1.0, 0.0, 0.0],
+            [0.0, p.cos(), -p.sin()],
+            [0.0, p.sin(), p.cos()],
+        ];
+        let ry = [
+            [f.cos(), 0.0, f.sin()],
+            [0.0, 1.0, 0.0],
+            [-f.sin(), 0.0, f.cos()],
+        ];
         let prod = mat_mul(&mat_mul(&rz, &rx), &ry);
         let r = rotation_from_euler(t, p, f);
         for i in 0..3 {
@@ -434,9 +446,21 @@ mod tests {
         assert!(is_proper(&r));
         // Against the fixture's R (grid_6_aniso.transform.txt).
         let fixture = [
-            [0.8665341013181509, -0.28962947762551555, 0.40648913508618606],
-            [0.16835030129256742, 0.93629336358419923, 0.30824164767741602],
-            [-0.46986894694951531, -0.19866933079506122, 0.86008933820504729],
+            [
+                0.8665341013181509,
+                -0.28962947762551555,
+                0.40648913508618606,
+            ],
+            [
+                0.16835030129256742,
+                0.9362933635841992,
+                0.308241647677416,
+            ],
+            [
+                -0.4698689469495153,
+                -0.19866933079506122,
+                0.8600893382050473,
+            ],
         ];
         for i in 0..3 {
             for j in 0..3 {

@@ -56,7 +56,10 @@ impl fmt::Display for EvalError {
                 what,
                 expected,
                 got,
-            } => write!(f, "{what} has {got} entries, expected {expected} (one per point)"),
+            } => write!(
+                f,
+                "{what} has {got} entries, expected {expected} (one per point)"
+            ),
         }
     }
 }
@@ -164,10 +167,13 @@ fn match_groups<T: Ord + Copy>(
         .map(|(&t, &size)| {
             let best = overlap
                 .range((t, (i64::MIN, i64::MIN))..=(t, (i64::MAX, i64::MAX)))
-                .fold(None, |best: Option<((i64, i64), usize)>, (&(_, p), &n)| match best {
-                    Some((_, m)) if m >= n => best,
-                    _ => Some((p, n)),
-                });
+                .fold(
+                    None,
+                    |best: Option<((i64, i64), usize)>, (&(_, p), &n)| match best {
+                        Some((_, m)) if m >= n => best,
+                        _ => Some((p, n)),
+                    },
+                );
             let (truth, part) = describe(t);
             match best {
                 Some((p, n)) => {
@@ -230,8 +236,10 @@ pub fn evaluate(
     };
 
     let truth_key: Vec<Option<i64>> = truth.iter().map(|&t| (t >= 0).then_some(t)).collect();
-    let pred_key: Vec<Option<(i64, i64)>> =
-        predicted.iter().map(|&p| (p >= 0).then_some((p, -1))).collect();
+    let pred_key: Vec<Option<(i64, i64)>> = predicted
+        .iter()
+        .map(|&p| (p >= 0).then_some((p, -1)))
+        .collect();
     let structures = match_groups(&truth_key, &pred_key, |t| (t, -1));
     let detected_structures = {
         let mut d: Vec<i64> = predicted.iter().copied().filter(|&p| p >= 0).collect();

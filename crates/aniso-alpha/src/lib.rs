@@ -10,6 +10,12 @@
 //!   that CGAL uses, and circumsphere constructions;
 //! * [`delaunay`]: the triangulation (flat `u32` arrays, bulk construction,
 //!   queries, `validate()`);
+//! * [`aniso`]: the anisotropy Q = diag(e)·R (Euler angles, line and plane
+//!   ellipsoids) and the exact point transform;
+//! * [`detect`]: orientation samplers, the path filter of non-significant
+//!   structures, connected components, least-squares line/plane fits;
+//! * [`synth`]: deterministic benchmark scenes with ground truth;
+//! * [`eval`]: detection scores (precision/recall/F1, structures found).
 //!
 //! ```
 //! use aniso_alpha::delaunay::Triangulation;
@@ -22,9 +28,9 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
-pub mod delaunay;
-pub mod geometry;
 pub mod aniso;
+pub mod delaunay;
 pub mod detect;
 pub mod eval;
+pub mod geometry;
 pub mod synth;

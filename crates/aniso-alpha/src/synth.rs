@@ -84,7 +84,11 @@ pub struct Scene {
 impl Scene {
     /// Number of true structures (largest label + 1).
     pub fn num_structures(&self) -> usize {
-        self.labels.iter().copied().max().map_or(0, |m| (m + 1).max(0) as usize)
+        self.labels
+            .iter()
+            .copied()
+            .max()
+            .map_or(0, |m| (m + 1).max(0) as usize)
     }
 }
 
@@ -443,7 +447,10 @@ impl SceneOptions {
                     (0..n).map(|i| i as f64 * h).collect()
                 };
                 t.sort_by(f64::total_cmp);
-                (t.iter().map(|&t| [t - len / 2.0, 0.0, 0.0]).collect(), vec![-1; n])
+                (
+                    t.iter().map(|&t| [t - len / 2.0, 0.0, 0.0]).collect(),
+                    vec![-1; n],
+                )
             }
             SceneKind::Planes => {
                 let n = self.points_per_structure;
@@ -451,7 +458,13 @@ impl SceneOptions {
                 let (w, d) = (h * (nu - 1) as f64, h * (nv - 1) as f64);
                 let pts: Vec<[f64; 3]> = if self.random_sampling {
                     (0..n)
-                        .map(|_| [rng.range(-w / 2.0, w / 2.0), rng.range(-d / 2.0, d / 2.0), 0.0])
+                        .map(|_| {
+                            [
+                                rng.range(-w / 2.0, w / 2.0),
+                                rng.range(-d / 2.0, d / 2.0),
+                                0.0,
+                            ]
+                        })
                         .collect()
                 } else {
                     (0..nu * nv)
@@ -508,14 +521,18 @@ impl SceneOptions {
                 .iter()
                 .map(|p| [p[0] + offset[0], p[1] + offset[1], p[2] + offset[2]])
                 .collect();
-            let inside = pts.iter().all(|p| p.iter().all(|&x| (0.0..=side).contains(&x)));
+            let inside = pts
+                .iter()
+                .all(|p| p.iter().all(|&x| (0.0..=side).contains(&x)));
             if !inside {
                 continue;
             }
             let c2 = self.clearance * self.clearance;
             let clear = placed.iter().enumerate().all(|(j, other)| {
                 (self.crossing && index == 1 && j == 0)
-                    || pts.iter().all(|p| other.iter().all(|q| dist2(*p, *q) >= c2))
+                    || pts
+                        .iter()
+                        .all(|p| other.iter().all(|q| dist2(*p, *q) >= c2))
             });
             if clear {
                 return Ok(pts);
@@ -601,9 +618,11 @@ fn crossing_anchor(kind: SceneKind, first: &[[f64; 3]]) -> [f64; 3] {
 fn crossing_angle_ok(kind: SceneKind, a: &[[f64; 3]], b: &[[f64; 3]]) -> bool {
     let axis = |p: &[[f64; 3]]| -> Option<[f64; 3]> {
         match kind {
-            SceneKind::Lines => {
-                normalize([p[p.len() - 1][0] - p[0][0], p[p.len() - 1][1] - p[0][1], p[p.len() - 1][2] - p[0][2]])
-            }
+            SceneKind::Lines => normalize([
+                p[p.len() - 1][0] - p[0][0],
+                p[p.len() - 1][1] - p[0][1],
+                p[p.len() - 1][2] - p[0][2],
+            ]),
             _ => {
                 // Normal from three non-collinear points of the patch.
                 let (p0, p1) = (p[0], p[1]);
@@ -611,7 +630,9 @@ fn crossing_angle_ok(kind: SceneKind, a: &[[f64; 3]], b: &[[f64; 3]]) -> bool {
                 p.iter().find_map(|q| {
                     let v = [q[0] - p0[0], q[1] - p0[1], q[2] - p0[2]];
                     let n = cross(u, v);
-                    (dot(n, n) > 1e-6 * dot(u, u) * dot(v, v)).then(|| normalize(n)).flatten()
+                    (dot(n, n) > 1e-6 * dot(u, u) * dot(v, v))
+                        .then(|| normalize(n))
+                        .flatten()
                 })
             }
         }
@@ -656,7 +677,11 @@ fn random_rotation(rng: &mut Rng) -> [[f64; 3]; 3] {
     let u = rng.unit_vector();
     let [a, b, _] = crate::aniso::completion_third_row(u);
     let (s, c) = rng.range(0.0, 2.0 * PI).sin_cos();
-    let r1 = [c * a[0] + s * b[0], c * a[1] + s * b[1], c * a[2] + s * b[2]];
+    let r1 = [
+        c * a[0] + s * b[0],
+        c * a[1] + s * b[1],
+        c * a[2] + s * b[2],
+    ];
     let r2 = cross(u, r1);
     [r1, r2, u]
 }
@@ -693,17 +718,26 @@ pub fn write_xyz_labels_parts(scene: &Scene, out: &mut impl Write) -> io::Result
 pub fn lines(seed: u64) -> Scene {
     // Default options always place (box ≫ structures); fall back to an
     // empty scene rather than panic if that ever changes.
-    SceneOptions::lines().seed(seed).generate().unwrap_or_else(|_| empty())
+    SceneOptions::lines()
+        .seed(seed)
+        .generate()
+        .unwrap_or_else(|_| empty())
 }
 
 /// The planes scene of Fig. 5 ([`SceneOptions::planes`]) with `seed`.
 pub fn planes(seed: u64) -> Scene {
-    SceneOptions::planes().seed(seed).generate().unwrap_or_else(|_| empty())
+    SceneOptions::planes()
+        .seed(seed)
+        .generate()
+        .unwrap_or_else(|_| empty())
 }
 
 /// The polyhedron scene of Fig. 10 ([`SceneOptions::polyhedron`]) with `seed`.
 pub fn polyhedron(seed: u64) -> Scene {
-    SceneOptions::polyhedron().seed(seed).generate().unwrap_or_else(|_| empty())
+    SceneOptions::polyhedron()
+        .seed(seed)
+        .generate()
+        .unwrap_or_else(|_| empty())
 }
 
 fn empty() -> Scene {
@@ -713,7 +747,6 @@ fn empty() -> Scene {
         parts: Vec::new(),
     }
 }
-
 
 /// A small deterministic PRNG: xoshiro256** seeded through SplitMix64, with
 /// uniform, Gaussian (Box–Muller) and unit-vector helpers. Same seed, same

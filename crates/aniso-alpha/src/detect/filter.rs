@@ -214,12 +214,12 @@ impl Incidence {
     /// (`only_degree_two`) or through any shared face.
     fn unite(&self, alive: &[bool], degree: &[u32], only_degree_two: bool, uf: &mut UnionFind) {
         uf.reset(self.n);
-        for f in 0..self.num_faces() {
+        for (f, w) in self.face_start.windows(2).enumerate() {
             if only_degree_two && degree[f] != 2 {
                 continue;
             }
             let mut first = None;
-            for &s in self.face(f) {
+            for &s in &self.face_simplices[w[0] as usize..w[1] as usize] {
                 if alive[s as usize] {
                     match first {
                         None => first = Some(s),
@@ -314,19 +314,17 @@ pub fn filter_mask<S: Simplex>(simplices: &[S], nb_c: u32) -> Result<Vec<bool>, 
         inc.unite(&alive, &degree, true, &mut uf);
         // Length of the shortest alive path.
         let mut shortest = u32::MAX;
-        for s in 0..n {
-            if alive[s] {
-                shortest = shortest.min(uf.size_of(s as u32));
-            }
+        for (s, _) in alive.iter().enumerate().filter(|(_, &a)| a) {
+            shortest = shortest.min(uf.size_of(s as u32));
         }
         if shortest > l {
             // Levels l .. shortest − 1 delete nothing (paths only merge).
             l = shortest;
             continue;
         }
-        for s in 0..n {
-            if alive[s] && uf.size_of(s as u32) <= l {
-                alive[s] = false;
+        for (s, a) in alive.iter_mut().enumerate() {
+            if *a && uf.size_of(s as u32) <= l {
+                *a = false;
                 n_alive -= 1;
                 for &f in inc.faces_of(s) {
                     degree[f as usize] -= 1;

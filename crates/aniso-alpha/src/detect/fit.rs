@@ -33,6 +33,9 @@
 //! assert!((plane.extent[0] - 2.0).abs() < 1e-12 && (plane.extent[1] - 1.0).abs() < 1e-12);
 //! ```
 
+// Small fixed-size matrix code reads best with explicit indices.
+#![allow(clippy::needless_range_loop)]
+
 use crate::aniso::{cross, dot, Mat3};
 use std::fmt;
 
@@ -168,7 +171,11 @@ pub fn symmetric_eigen(m: Mat3) -> ([f64; 3], Mat3) {
     }
     let mut order = [0usize, 1, 2];
     order.sort_by(|&i, &j| a[j][j].total_cmp(&a[i][i]));
-    let vals = [a[order[0]][order[0]], a[order[1]][order[1]], a[order[2]][order[2]]];
+    let vals = [
+        a[order[0]][order[0]],
+        a[order[1]][order[1]],
+        a[order[2]][order[2]],
+    ];
     let col = |j: usize| [v[0][j], v[1][j], v[2][j]];
     (vals, [col(order[0]), col(order[1]), col(order[2])])
 }
@@ -239,7 +246,7 @@ fn line_impl(n: usize, get: &dyn Fn(usize) -> [f64; 3]) -> Result<LineFit, FitEr
     check(n, 2, get)?;
     let (c, m) = moments(n, get);
     let (vals, vecs) = symmetric_eigen(m);
-    if !(vals[0] > 0.0) {
+    if vals[0].is_nan() || vals[0] <= 0.0 {
         return Err(FitError::Degenerate);
     }
     let d = canonical_sign(unit(vecs[0]));
@@ -266,7 +273,7 @@ fn plane_impl(n: usize, get: &dyn Fn(usize) -> [f64; 3]) -> Result<PlaneFit, Fit
     check(n, 3, get)?;
     let (c, m) = moments(n, get);
     let (vals, vecs) = symmetric_eigen(m);
-    if !(vals[0] > 0.0) || vals[1] <= 64.0 * f64::EPSILON * vals[0] {
+    if vals[0].is_nan() || vals[0] <= 0.0 || vals[1] <= 64.0 * f64::EPSILON * vals[0] {
         return Err(FitError::Degenerate);
     }
     let normal = canonical_sign(unit(vecs[2]));
@@ -338,7 +345,9 @@ mod tests {
     use crate::synth::Rng;
 
     fn angle(a: [f64; 3], b: [f64; 3]) -> f64 {
-        (dot(a, b).abs() / (dot(a, a) * dot(b, b)).sqrt()).min(1.0).acos()
+        (dot(a, b).abs() / (dot(a, a) * dot(b, b)).sqrt())
+            .min(1.0)
+            .acos()
     }
 
     #[test]
@@ -371,7 +380,10 @@ mod tests {
                 }
                 for r in 0..3 {
                     let mv = dot(m[r], vecs[i]);
-                    assert!((mv - vals[i] * vecs[i][r]).abs() < 1e-11, "case {case}: {m:?}");
+                    assert!(
+                        (mv - vals[i] * vecs[i][r]).abs() < 1e-11,
+                        "case {case}: {m:?}"
+                    );
                 }
             }
             let trace = m[0][0] + m[1][1] + m[2][2];
@@ -421,7 +433,11 @@ mod tests {
         assert!(angle(f.direction, d) < 2e-3, "{}", angle(f.direction, d));
         // Two perpendicular noise dimensions: rms ≈ σ√2.
         let want = sigma * 2f64.sqrt();
-        assert!((f.rms_residual - want).abs() < 0.05 * want, "{}", f.rms_residual);
+        assert!(
+            (f.rms_residual - want).abs() < 0.05 * want,
+            "{}",
+            f.rms_residual
+        );
         assert!((f.extent - 19.99).abs() < 0.5);
     }
 
@@ -473,7 +489,11 @@ mod tests {
             .collect();
         let f = fit_plane(&pts).unwrap();
         assert!(angle(f.normal, n) < 1e-3);
-        assert!((f.rms_residual - sigma).abs() < 0.05 * sigma, "{}", f.rms_residual);
+        assert!(
+            (f.rms_residual - sigma).abs() < 0.05 * sigma,
+            "{}",
+            f.rms_residual
+        );
         assert!((f.extent[0] - 20.0).abs() < 0.01 && (f.extent[1] - 10.0).abs() < 0.01);
     }
 
@@ -488,7 +508,12 @@ mod tests {
             fit_plane(&[[0.0; 3], [1.0, 0.0, 0.0]]),
             Err(FitError::TooFewPoints { needed: 3, got: 2 })
         );
-        let collinear = [[0.0, 0.0, 0.0], [1.0, 2.0, 3.0], [2.0, 4.0, 6.0], [0.3, 0.6, 0.9]];
+        let collinear = [
+            [0.0, 0.0, 0.0],
+            [1.0, 2.0, 3.0],
+            [2.0, 4.0, 6.0],
+            [0.3, 0.6, 0.9],
+        ];
         assert_eq!(fit_plane(&collinear), Err(FitError::Degenerate));
         assert!(fit_line(&collinear).is_ok());
         assert_eq!(

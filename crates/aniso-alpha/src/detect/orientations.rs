@@ -382,10 +382,18 @@ mod tests {
         }
         // θ_12 = π/2 and θ_0 = −π/2 would be the same axes: j starts at 1.
         let r = &a2[11];
-        let q = rotation_from_euler(PI / 2.0, euler_of_direction(dirs[0]).0, euler_of_direction(dirs[0]).1);
+        let q = rotation_from_euler(
+            PI / 2.0,
+            euler_of_direction(dirs[0]).0,
+            euler_of_direction(dirs[0]).1,
+        );
         assert_eq!(r, &q);
         assert!(matches!(
-            orientations(StructureKind::Planes, &Sampler::Box { m1: 0.3, m2: 0 }, false),
+            orientations(
+                StructureKind::Planes,
+                &Sampler::Box { m1: 0.3, m2: 0 },
+                false
+            ),
             Err(OrientationError::BadM2(0))
         ));
     }
@@ -409,7 +417,9 @@ mod tests {
             assert_eq!(r[0], dirs[i / 18]);
         }
         // The in-plane axes of one normal are spread over half a turn.
-        let t1 = (a3[0][1][0] * a3[1][1][0] + a3[0][1][1] * a3[1][1][1] + a3[0][1][2] * a3[1][1][2]).acos();
+        let t1 =
+            (a3[0][1][0] * a3[1][1][0] + a3[0][1][1] * a3[1][1][1] + a3[0][1][2] * a3[1][1][2])
+                .acos();
         assert!((t1 - 10f64.to_radians()).abs() < 1e-9);
         for bad in [0.0, -1.0, f64::NAN, 181.0] {
             assert!(fibonacci_directions(bad).is_err());

@@ -52,7 +52,10 @@ fn rng_is_deterministic_and_sane() {
     for _ in 0..70_000 {
         counts[r.below(7) as usize] += 1;
     }
-    assert!(counts.iter().all(|&c| (9_500..10_500).contains(&c)), "{counts:?}");
+    assert!(
+        counts.iter().all(|&c| (9_500..10_500).contains(&c)),
+        "{counts:?}"
+    );
     let u = r.unit_vector();
     assert!((dot(u, u) - 1.0).abs() < 1e-12);
 }
@@ -68,7 +71,10 @@ fn lines_scene() {
     assert!(s.parts.iter().all(|&p| p == -1));
     let side = opts.box_side();
     assert!((side - 184.5).abs() < 0.5, "{side}");
-    assert!(s.points.iter().all(|p| p.iter().all(|&x| (0.0..=side).contains(&x))));
+    assert!(s
+        .points
+        .iter()
+        .all(|p| p.iter().all(|&x| (0.0..=side).contains(&x))));
     for l in 0..5 {
         let m = members(&s, l);
         assert_eq!(m.len(), 10);
@@ -78,7 +84,16 @@ fn lines_scene() {
         // Regular step d = 7.
         let mut t: Vec<f64> = m
             .iter()
-            .map(|p| dot([p[0] - f.centroid[0], p[1] - f.centroid[1], p[2] - f.centroid[2]], f.direction))
+            .map(|p| {
+                dot(
+                    [
+                        p[0] - f.centroid[0],
+                        p[1] - f.centroid[1],
+                        p[2] - f.centroid[2],
+                    ],
+                    f.direction,
+                )
+            })
             .collect();
         t.sort_by(f64::total_cmp);
         assert!(t.windows(2).all(|w| (w[1] - w[0] - 7.0).abs() < 1e-9));
@@ -106,7 +121,11 @@ fn lines_fit_the_box_orientations() {
         let s = SceneOptions::lines().seed(seed).generate().unwrap();
         for l in 0..5 {
             let f = fit_line(&members(&s, l)).unwrap();
-            let step = [7.0 * f.direction[0], 7.0 * f.direction[1], 7.0 * f.direction[2]];
+            let step = [
+                7.0 * f.direction[0],
+                7.0 * f.direction[1],
+                7.0 * f.direction[2],
+            ];
             let best = a
                 .iter()
                 .map(|r| {
@@ -212,43 +231,94 @@ fn polyhedron_scene() {
     }
     assert!((dot(normals[1], normals[2]).abs() - 1.0).abs() < 1e-9);
     assert!(dot(normals[1], normals[3]).abs() < 1e-9);
-    assert!(s.parts.iter().zip(&s.labels).all(|(&p, &l)| (p >= 0) == (l >= 0)));
+    assert!(s
+        .parts
+        .iter()
+        .zip(&s.labels)
+        .all(|(&p, &l)| (p >= 0) == (l >= 0)));
 }
 
 #[test]
 fn crossing_and_options() {
-    let s = SceneOptions::lines().crossing(true).seed(4).generate().unwrap();
+    let s = SceneOptions::lines()
+        .crossing(true)
+        .seed(4)
+        .generate()
+        .unwrap();
     let (l0, l1) = (members(&s, 0), members(&s, 1));
     assert_eq!(l0.len() + l1.len(), 19, "the shared point is counted once");
     let (f0, f1) = (fit_line(&l0).unwrap(), fit_line(&l1).unwrap());
     assert!(dot(f0.direction, f1.direction).abs() <= (PI / 4.0).cos() + 1e-9);
     // Line 1 passes through a point of line 0.
     let through = l0.iter().any(|p| {
-        let q = [p[0] - f1.centroid[0], p[1] - f1.centroid[1], p[2] - f1.centroid[2]];
+        let q = [
+            p[0] - f1.centroid[0],
+            p[1] - f1.centroid[1],
+            p[2] - f1.centroid[2],
+        ];
         let t = dot(q, f1.direction);
         dot(q, q) - t * t < 1e-9
     });
     assert!(through);
 
-    let s = SceneOptions::planes().crossing(true).seed(4).generate().unwrap();
+    let s = SceneOptions::planes()
+        .crossing(true)
+        .seed(4)
+        .generate()
+        .unwrap();
     let (p0, p1) = (members(&s, 0), members(&s, 1));
     let (f0, f1) = (fit_plane(&p0).unwrap(), fit_plane(&p1).unwrap());
-    let off = [f1.centroid[0] - f0.centroid[0], f1.centroid[1] - f0.centroid[1], f1.centroid[2] - f0.centroid[2]];
+    let off = [
+        f1.centroid[0] - f0.centroid[0],
+        f1.centroid[1] - f0.centroid[1],
+        f1.centroid[2] - f0.centroid[2],
+    ];
     assert!(dot(off, off) < 1e-18, "same centre");
     assert!(dot(f0.normal, f1.normal).abs() <= (PI / 4.0).cos() + 1e-9);
 
-    let s = SceneOptions::lines().jitter(0.1).random_sampling(true).structures(2).background(10).seed(1).generate().unwrap();
+    let s = SceneOptions::lines()
+        .jitter(0.1)
+        .random_sampling(true)
+        .structures(2)
+        .background(10)
+        .seed(1)
+        .generate()
+        .unwrap();
     assert_eq!(s.points.len(), 30);
     let f = fit_line(&members(&s, 0)).unwrap();
-    assert!(f.rms_residual > 0.05 && f.rms_residual < 0.3, "{}", f.rms_residual);
-    let s = SceneOptions::polyhedron().random_sampling(true).background(0).seed(1).generate().unwrap();
+    assert!(
+        f.rms_residual > 0.05 && f.rms_residual < 0.3,
+        "{}",
+        f.rms_residual
+    );
+    let s = SceneOptions::polyhedron()
+        .random_sampling(true)
+        .background(0)
+        .seed(1)
+        .generate()
+        .unwrap();
     assert_eq!(s.points.len(), 190);
 
-    assert!(matches!(SceneOptions::lines().jitter(-1.0).generate(), Err(SynthError::BadOption { .. })));
-    assert!(matches!(SceneOptions::lines().spacing(f64::NAN).generate(), Err(SynthError::BadOption { .. })));
-    assert!(matches!(SceneOptions::lines().structures(1).crossing(true).generate(), Err(SynthError::BadOption { .. })));
     assert!(matches!(
-        SceneOptions::lines().structures(60).background(100).generate(),
+        SceneOptions::lines().jitter(-1.0).generate(),
+        Err(SynthError::BadOption { .. })
+    ));
+    assert!(matches!(
+        SceneOptions::lines().spacing(f64::NAN).generate(),
+        Err(SynthError::BadOption { .. })
+    ));
+    assert!(matches!(
+        SceneOptions::lines()
+            .structures(1)
+            .crossing(true)
+            .generate(),
+        Err(SynthError::BadOption { .. })
+    ));
+    assert!(matches!(
+        SceneOptions::lines()
+            .structures(60)
+            .background(100)
+            .generate(),
         Err(SynthError::CannotPlace)
     ));
     assert_eq!(lines(3), SceneOptions::lines().seed(3).generate().unwrap());
@@ -258,7 +328,11 @@ fn crossing_and_options() {
 
 #[test]
 fn write_format() {
-    let s = SceneOptions::polyhedron().background(5).seed(8).generate().unwrap();
+    let s = SceneOptions::polyhedron()
+        .background(5)
+        .seed(8)
+        .generate()
+        .unwrap();
     let mut out = Vec::new();
     write_xyz_labels(&s, &mut out).unwrap();
     let text = String::from_utf8(out).unwrap();
