@@ -54,7 +54,35 @@
 //! Structures get random orientations and positions inside the box, at
 //! least `clearance` apart (20 = 2αλ₃ for lines, 16 for planes and
 //! polyhedra) unless `crossing` is asked for: then structure 1 passes
-//! through (lines: the middle point of; planes: the centre of) structure 0.
+//! through structure 0 at ≥ 45° (lines: their middle samples coincide, and
+//! that shared point is kept once, labelled 0; planes: same centroid, so
+//! they cut each other along a line through both centres; polyhedra: same
+//! centroid).
+//!
+//! # Measured with the method layer
+//!
+//! `tests/lines_pipeline_bruteforce.rs` and
+//! `tests/planes_pipeline_bruteforce.rs` run the SPEC §4 loop on these
+//! scenes with a brute-force F_{k,α,Q} (no Delaunay), the box sampler, the
+//! path filter per orientation, the union, the component clean-up, the
+//! largest-structure labelling and [`crate::eval`]:
+//!
+//! | scene (seed) | background per ellipsoid | per-point F1 | structures found |
+//! |---|---:|---:|---:|
+//! | lines (1, 2, 3) | 0.005 | 0.98 (mean) | |
+//! | lines (1, 2, 3) | 0.01 | 0.92, 0.87, 0.89 | 5/5 each |
+//! | lines (1, 2, 3) | 0.02 | 0.61 (mean) | |
+//! | lines (1, 2, 3) | 0.03 | 0.36 (mean) | |
+//! | planes (1, 2, 3) | 0.01 | 0.96, 0.95, 0.96 | 3/3 (seed 1) |
+//! | planes (2, 3) | 0.03 | 0.89, 0.90 | |
+//! | planes (2, 3) | 0.1 | 0.72, 0.78 | |
+//! | polyhedron (1, 2, 3) | 0.01 | 0.98, 0.98, 0.98 | 1/1 (seed 1; its 5 facets form one component) |
+//! | polyhedron (2, 3) | 0.03 | 0.94, 0.96 | |
+//! | polyhedron (2, 3) | 0.1 | 0.84, 0.84 | |
+//!
+//! (SPEC §5's reference: lines F1 ≈ 0.9 at 0.01, collapsing at 3×; planes
+//! ≈ 0.83 at 10×.) Background points that touch a structure are what
+//! costs precision; recall is 1.0 (or one point short) in all these runs.
 //!
 //! ```
 //! use aniso_alpha::synth::{SceneOptions, write_xyz_labels};
@@ -810,7 +838,11 @@ impl Rng {
         a + (b - a) * self.uniform()
     }
 
-    /// Uniform integer in 0..n (n > 0), by rejection (no modulo bias).
+    /// Uniform integer in 0..n, by rejection (no modulo bias).
+    ///
+    /// # Panics
+    ///
+    /// If `n` is 0.
     pub fn below(&mut self, n: u64) -> u64 {
         assert!(n > 0, "Rng::below(0)");
         let zone = u64::MAX - (u64::MAX % n);

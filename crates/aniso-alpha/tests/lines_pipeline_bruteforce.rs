@@ -81,14 +81,22 @@ fn exposed_edges(q: &[[f64; 3]], alpha: f64) -> Vec<[u32; 2]> {
             let r = q[j as usize];
             let pr = sub(r, p);
             let len2 = dot(pr, pr);
-            let m = [(p[0] + r[0]) / 2.0, (p[1] + r[1]) / 2.0, (p[2] + r[2]) / 2.0];
+            let m = [
+                (p[0] + r[0]) / 2.0,
+                (p[1] + r[1]) / 2.0,
+                (p[2] + r[2]) / 2.0,
+            ];
             let rho2 = alpha * alpha - len2 / 4.0;
             if rho2 < 0.0 {
                 continue;
             }
             let rho = rho2.sqrt();
             let w = unit(pr);
-            let a0 = if w[0].abs() < 0.6 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
+            let a0 = if w[0].abs() < 0.6 {
+                [1.0, 0.0, 0.0]
+            } else {
+                [0.0, 1.0, 0.0]
+            };
             let e1 = unit(cross(w, a0));
             let e2 = cross(w, e1);
             // Excluded open arcs (start, length) in [0, 2π).
@@ -158,7 +166,9 @@ fn arcs() {
 }
 
 fn run_lines(seed: u64, density: f64) -> (f64, usize, usize) {
-    let opts = SceneOptions::lines().seed(seed).background_per_ellipsoid(density);
+    let opts = SceneOptions::lines()
+        .seed(seed)
+        .background_per_ellipsoid(density);
     let scene = opts.generate().unwrap();
     let p = opts.paper_params();
     let rotations = orientations(StructureKind::Lines, &Sampler::default(), false).unwrap();

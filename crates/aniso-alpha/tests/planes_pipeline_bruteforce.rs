@@ -102,7 +102,11 @@ fn exposed_triangles(q: &[[f64; 3]], alpha: f64) -> Vec<[u32; 3]> {
                 let cc = [a[0] + off[0], a[1] + off[1], a[2] + off[2]];
                 let h = (alpha * alpha - r2).sqrt() / n2.sqrt();
                 let exposed = [1.0, -1.0].iter().any(|&s| {
-                    let c0 = [cc[0] + s * h * n[0], cc[1] + s * h * n[1], cc[2] + s * h * n[2]];
+                    let c0 = [
+                        cc[0] + s * h * n[0],
+                        cc[1] + s * h * n[1],
+                        cc[2] + s * h * n[2],
+                    ];
                     ball_candidates.iter().all(|&m| {
                         if m as usize == i || m == j || m == k {
                             return true;
@@ -184,15 +188,25 @@ fn planes_sweep() {
     for density in [0.01, 0.03, 0.1] {
         for seed in 2..=3 {
             let ev = run(
-                SceneOptions::planes().seed(seed).background_per_ellipsoid(density),
+                SceneOptions::planes()
+                    .seed(seed)
+                    .background_per_ellipsoid(density),
                 "planes",
             );
-            eprintln!("SWEEP planes density {density} seed {seed}: F1 {:.3}", ev.f1);
+            eprintln!(
+                "SWEEP planes density {density} seed {seed}: F1 {:.3}",
+                ev.f1
+            );
             let ev = run(
-                SceneOptions::polyhedron().seed(seed).background_per_ellipsoid(density),
+                SceneOptions::polyhedron()
+                    .seed(seed)
+                    .background_per_ellipsoid(density),
                 "polyhedron",
             );
-            eprintln!("SWEEP polyhedron density {density} seed {seed}: F1 {:.3}", ev.f1);
+            eprintln!(
+                "SWEEP polyhedron density {density} seed {seed}: F1 {:.3}",
+                ev.f1
+            );
         }
     }
 }
