@@ -166,12 +166,16 @@ fn arcs() {
 }
 
 fn run_lines(seed: u64, density: f64) -> (f64, usize, usize) {
+    run_lines_with(seed, density, &Sampler::default())
+}
+
+fn run_lines_with(seed: u64, density: f64, sampler: &Sampler) -> (f64, usize, usize) {
     let opts = SceneOptions::lines()
         .seed(seed)
         .background_per_ellipsoid(density);
     let scene = opts.generate().unwrap();
     let p = opts.paper_params();
-    let rotations = orientations(StructureKind::Lines, &Sampler::default(), false).unwrap();
+    let rotations = orientations(StructureKind::Lines, sampler, false).unwrap();
     let mut union: BTreeSet<[u32; 2]> = BTreeSet::new();
     for r in &rotations {
         let a = Anisotropy::from_matrix_rows(*r, [1.0, 1.0, 1.0 / p.lambda3]).unwrap();
@@ -234,5 +238,28 @@ fn lines_density_sweep() {
             f1 += run_lines(seed, density).0;
         }
         eprintln!("SWEEP density {density}: mean F1 {:.3}", f1 / 3.0);
+    }
+}
+
+#[test]
+#[ignore = "sampler comparison; --ignored --nocapture"]
+fn lines_sampler_comparison() {
+    for (name, sampler) in [
+        ("box m1=0.3", Sampler::default()),
+        ("fibonacci 10deg", Sampler::Fibonacci { step_degrees: 10.0 }),
+        ("fibonacci 14deg", Sampler::Fibonacci { step_degrees: 14.0 }),
+    ] {
+        for density in [0.01, 0.02] {
+            let (mut f1, mut found) = (0.0, 0);
+            for seed in 1..=3 {
+                let r = run_lines_with(seed, density, &sampler);
+                f1 += r.0;
+                found += r.1;
+            }
+            eprintln!(
+                "COMPARE lines {name} density {density}: mean F1 {:.3}, found {found}/15",
+                f1 / 3.0
+            );
+        }
     }
 }

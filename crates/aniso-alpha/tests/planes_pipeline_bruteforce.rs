@@ -125,10 +125,14 @@ fn exposed_triangles(q: &[[f64; 3]], alpha: f64) -> Vec<[u32; 3]> {
 }
 
 fn run(opts: SceneOptions, name: &str) -> Evaluation {
+    run_with(opts, name, &Sampler::default(), false)
+}
+
+fn run_with(opts: SceneOptions, name: &str, sampler: &Sampler, l23: bool) -> Evaluation {
     let scene = opts.generate().unwrap();
     let p = opts.paper_params();
     let e = [1.0, 1.0 / p.lambda2, 1.0 / p.lambda3];
-    let rotations = orientations(StructureKind::Planes, &Sampler::default(), false).unwrap();
+    let rotations = orientations(StructureKind::Planes, sampler, l23).unwrap();
     let mut union: BTreeSet<[u32; 3]> = BTreeSet::new();
     for r in &rotations {
         let a = Anisotropy::from_matrix_rows(*r, e).unwrap();
@@ -206,6 +210,44 @@ fn planes_sweep() {
             eprintln!(
                 "SWEEP polyhedron density {density} seed {seed}: F1 {:.3}",
                 ev.f1
+            );
+        }
+    }
+}
+
+#[test]
+#[ignore = "sampler comparison; --ignored --nocapture"]
+fn planes_sampler_comparison() {
+    for (name, sampler) in [
+        ("box m1=0.3 m2=12", Sampler::default()),
+        ("fibonacci 10deg", Sampler::Fibonacci { step_degrees: 10.0 }),
+        ("fibonacci 15deg", Sampler::Fibonacci { step_degrees: 15.0 }),
+    ] {
+        for density in [0.01, 0.1] {
+            let mut f1 = 0.0;
+            for seed in 1..=2 {
+                f1 += run_with(
+                    SceneOptions::planes()
+                        .seed(seed)
+                        .background_per_ellipsoid(density),
+                    "planes",
+                    &sampler,
+                    false,
+                )
+                .f1;
+                f1 += run_with(
+                    SceneOptions::polyhedron()
+                        .seed(seed)
+                        .background_per_ellipsoid(density),
+                    "polyhedron",
+                    &sampler,
+                    false,
+                )
+                .f1;
+            }
+            eprintln!(
+                "COMPARE planes+polyhedron {name} density {density}: mean F1 {:.3}",
+                f1 / 4.0
             );
         }
     }
