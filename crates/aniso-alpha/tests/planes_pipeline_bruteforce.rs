@@ -10,6 +10,7 @@
 use aniso_alpha::aniso::Anisotropy;
 use aniso_alpha::detect::filter::{component_size_mask, components, filter};
 use aniso_alpha::detect::orientations::{orientations, Sampler};
+use aniso_alpha::detect::parts::{label_points, planar_parts};
 use aniso_alpha::detect::StructureKind;
 use aniso_alpha::eval::{evaluate, Evaluation};
 use aniso_alpha::synth::SceneOptions;
@@ -129,6 +130,7 @@ fn run(opts: SceneOptions, name: &str) -> Evaluation {
 }
 
 fn run_with(opts: SceneOptions, name: &str, sampler: &Sampler, l23: bool) -> Evaluation {
+    let opts_crossing = name.contains("crossing");
     let scene = opts.generate().unwrap();
     let p = opts.paper_params();
     let e = [1.0, 1.0 / p.lambda2, 1.0 / p.lambda3];
@@ -163,7 +165,17 @@ fn run_with(opts: SceneOptions, name: &str, sampler: &Sampler, l23: bool) -> Eva
             }
         }
     }
-    let ev = evaluate(&scene.labels, Some(&scene.parts), &label, None).unwrap();
+    // Facets: planar parts of the kept triangles (10°), each point labelled
+    // with its largest part.
+    let part_ids = planar_parts(&scene.points, &kept, 10.0).unwrap();
+    let part_label = label_points(scene.points.len(), &kept, &part_ids).unwrap();
+    let ev = evaluate(&scene.labels, Some(&scene.parts), &label, Some(&part_label)).unwrap();
+    if opts_crossing {
+        // Crossing planes: the planar parts are the structures.
+        let ev2 = evaluate(&scene.labels, None, &part_label, None).unwrap();
+        eprintln!("{name}, parts as structures:\n{ev2}");
+        return ev2;
+    }
     eprintln!(
         "{name}: {} union triangles, {} kept in {n_comp} components\n{ev}",
         union.len(),
@@ -184,6 +196,16 @@ fn polyhedron_scene_is_detected_at_paper_parameters() {
     let ev = run(SceneOptions::polyhedron().seed(1), "polyhedron seed 1");
     assert_eq!(ev.structures_found, 1);
     assert!(ev.f1 > 0.8, "{}", ev.f1);
+    assert_eq!(ev.parts_found, 5, "facets as planar parts");
+}
+
+#[test]
+fn crossing_planes_are_split_into_two() {
+    let ev = run(
+        SceneOptions::planes().crossing(true).seed(1),
+        "planes crossing seed 1",
+    );
+    assert_eq!(ev.structures_found, 3);
 }
 
 #[test]

@@ -121,11 +121,13 @@ impl fmt::Display for FilterError {
 impl std::error::Error for FilterError {}
 
 /// Flat incidence structure of a simplex set.
-struct Incidence {
+pub(crate) struct Incidence {
     /// Input position → unique simplex.
-    input_to_unique: Vec<u32>,
+    pub(crate) input_to_unique: Vec<u32>,
+    /// Unique simplex → its first input position.
+    pub(crate) unique_to_input: Vec<u32>,
     /// Number of unique simplices.
-    n: usize,
+    pub(crate) n: usize,
     /// Faces of unique simplex s: `simplex_faces[s*K .. s*K+K]`.
     simplex_faces: Vec<u32>,
     /// CSR: simplices of face f are `face_simplices[face_start[f]..face_start[f+1]]`.
@@ -135,7 +137,7 @@ struct Incidence {
 }
 
 impl Incidence {
-    fn new<S: Simplex>(simplices: &[S]) -> Result<Self, FilterError> {
+    pub(crate) fn new<S: Simplex>(simplices: &[S]) -> Result<Self, FilterError> {
         // Incidence counts (3 per triangle) must fit u32 as well.
         if simplices.len() >= (u32::MAX / 3) as usize {
             return Err(FilterError::TooManySimplices(simplices.len()));
@@ -146,13 +148,15 @@ impl Incidence {
         }
         // Merge repeated simplices.
         let mut order: Vec<u32> = (0..canon.len() as u32).collect();
-        order.sort_unstable_by(|&a, &b| canon[a as usize].cmp(&canon[b as usize]));
+        order.sort_unstable_by(|&a, &b| canon[a as usize].cmp(&canon[b as usize]).then(a.cmp(&b)));
         let mut input_to_unique = vec![0u32; canon.len()];
         let mut unique: Vec<S> = Vec::with_capacity(canon.len());
+        let mut unique_to_input: Vec<u32> = Vec::with_capacity(canon.len());
         for &i in &order {
             let s = canon[i as usize];
             if unique.last() != Some(&s) {
                 unique.push(s);
+                unique_to_input.push(i);
             }
             input_to_unique[i as usize] = (unique.len() - 1) as u32;
         }
@@ -184,6 +188,7 @@ impl Incidence {
         face_start.push(pairs.len() as u32);
         Ok(Self {
             input_to_unique,
+            unique_to_input,
             n,
             simplex_faces,
             face_start,
@@ -192,15 +197,15 @@ impl Incidence {
         })
     }
 
-    fn num_faces(&self) -> usize {
+    pub(crate) fn num_faces(&self) -> usize {
         self.face_start.len() - 1
     }
 
-    fn face(&self, f: usize) -> &[u32] {
+    pub(crate) fn face(&self, f: usize) -> &[u32] {
         &self.face_simplices[self.face_start[f] as usize..self.face_start[f + 1] as usize]
     }
 
-    fn faces_of(&self, s: usize) -> &[u32] {
+    pub(crate) fn faces_of(&self, s: usize) -> &[u32] {
         &self.simplex_faces[s * self.k..(s + 1) * self.k]
     }
 

@@ -4,11 +4,14 @@
 //! * [`orientations`]: the paper's "box" sampler of rotations and a
 //!   near-uniform Fibonacci alternative (SPEC §4);
 //! * [`filter`]: the path filter (SPEC §3) and connected components;
-//! * [`fit`]: least-squares lines and planes.
+//! * [`fit`]: least-squares lines and planes;
+//! * [`parts`]: splitting structures into straight/flat parts, and point
+//!   labelling.
 
 pub mod filter;
 pub mod fit;
 pub mod orientations;
+pub mod parts;
 
 /// Which structures are sought: k = 1 (lines, edges) or k = 2 (planes,
 /// triangles).
