@@ -12,6 +12,7 @@
 use aniso_alpha::aniso::Anisotropy;
 use aniso_alpha::detect::filter::{component_size_mask, components, filter};
 use aniso_alpha::detect::orientations::{orientations, Sampler};
+use aniso_alpha::detect::parts::{label_points, linear_parts};
 use aniso_alpha::detect::StructureKind;
 use aniso_alpha::eval::evaluate;
 use aniso_alpha::synth::SceneOptions;
@@ -170,9 +171,18 @@ fn run_lines(seed: u64, density: f64) -> (f64, usize, usize) {
 }
 
 fn run_lines_with(seed: u64, density: f64, sampler: &Sampler) -> (f64, usize, usize) {
-    let opts = SceneOptions::lines()
-        .seed(seed)
-        .background_per_ellipsoid(density);
+    run_scene(
+        SceneOptions::lines()
+            .seed(seed)
+            .background_per_ellipsoid(density),
+        sampler,
+        false,
+    )
+}
+
+/// Runs the k = 1 loop; with `split`, structures are the straight parts
+/// (10°) of the kept edges instead of their components.
+fn run_scene(opts: SceneOptions, sampler: &Sampler, split: bool) -> (f64, usize, usize) {
     let scene = opts.generate().unwrap();
     let p = opts.paper_params();
     let rotations = orientations(StructureKind::Lines, sampler, false).unwrap();
@@ -190,7 +200,11 @@ fn run_lines_with(seed: u64, density: f64, sampler: &Sampler) -> (f64, usize, us
         .zip(&keep)
         .filter_map(|(e, &k)| k.then_some(*e))
         .collect();
-    let comp = components(&kept).unwrap();
+    let comp = if split {
+        linear_parts(&scene.points, &kept, 10.0).unwrap()
+    } else {
+        components(&kept).unwrap()
+    };
     let n_comp = comp.iter().copied().max().map_or(0, |m| m as usize + 1);
     let mut size = vec![0usize; n_comp];
     for &c in &comp {
@@ -209,7 +223,7 @@ fn run_lines_with(seed: u64, density: f64, sampler: &Sampler) -> (f64, usize, us
     }
     let ev = evaluate(&scene.labels, None, &label, None).unwrap();
     eprintln!(
-        "lines seed {seed} density {density}: {} union edges, {} kept\n{ev}",
+        "lines (split {split}): {} union edges, {} kept\n{ev}",
         union.len(),
         kept.len()
     );
@@ -262,4 +276,20 @@ fn lines_sampler_comparison() {
             );
         }
     }
+}
+
+#[test]
+fn crossing_lines_are_split_into_two() {
+    let opts = SceneOptions::lines().crossing(true).seed(2);
+    let (f1, found, total) = run_scene(opts.clone(), &Sampler::default(), true);
+    assert_eq!(total, 5);
+    assert!(found >= 4, "{found}/{total}");
+    assert!(f1 > 0.8, "{f1}");
+    // The labelling helper agrees with the hand-written one above.
+    let scene = opts.generate().unwrap();
+    let edges = [[0u32, 1], [1, 2]];
+    assert_eq!(
+        label_points(scene.points.len(), &edges, &[0, 0]).unwrap()[..3],
+        [0, 0, 0]
+    );
 }
