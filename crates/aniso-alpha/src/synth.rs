@@ -536,12 +536,17 @@ impl SceneOptions {
             } else {
                 let (lo, hi) = bounds(&rotated);
                 let mut o = [0.0; 3];
+                let mut fits = true;
                 for k in 0..3 {
                     let (a, b) = (margin - lo[k], side - margin - hi[k]);
                     if a > b {
-                        return Err(SynthError::CannotPlace);
+                        fits = false; // too big in this orientation
+                        break;
                     }
                     o[k] = rng.range(a, b);
+                }
+                if !fits {
+                    continue;
                 }
                 o
             };
