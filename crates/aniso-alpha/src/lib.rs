@@ -12,6 +12,12 @@
 //!   queries, `validate()`);
 //! * [`io`]: point file readers (text, PLY, LAS/LAZ, PCD), atomic writers
 //!   (PLY, OBJ, labels) and their typed errors;
+//! * [`aniso`]: the anisotropy Q = diag(e)·R (Euler angles, line and plane
+//!   ellipsoids) and the exact point transform;
+//! * [`detect`]: orientation samplers, the path filter of non-significant
+//!   structures, connected components, least-squares line/plane fits;
+//! * [`synth`]: deterministic benchmark scenes with ground truth;
+//! * [`eval`]: detection scores (precision/recall/F1, structures found).
 //!
 //! ```
 //! use aniso_alpha::delaunay::Triangulation;
@@ -27,6 +33,10 @@
 // iterator chains in the geometry code.
 #![allow(clippy::needless_range_loop)]
 
+pub mod aniso;
 pub mod delaunay;
+pub mod detect;
+pub mod eval;
 pub mod geometry;
 pub mod io;
+pub mod synth;

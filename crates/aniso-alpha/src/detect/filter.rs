@@ -1,0 +1,410 @@
+//! The path filter of non-significant structures (paper §4.2, SPEC §3) and
+//! plain connected components.
+//!
+//! Works on k-simplices given as vertex-index arrays: edges `[u32; 2]`
+//! (k = 1, faces = vertices) or triangles `[u32; 3]` (k = 2, faces =
+//! edges). Vertex ids are arbitrary `u32`; the vertex order inside a simplex
+//! does not matter. The input is a *set*: an entry repeated (in any vertex
+//! order) is one simplex, and every copy gets its verdict.
+//!
+//! * The **degree** of a face is the number of simplices containing it; a
+//!   face of degree ≥ 3 is a *ramification*.
+//! * Two simplices are **joined** when they share a face of degree exactly 2.
+//! * A **path** is a connected component of "joined"; its length is its
+//!   number of simplices.
+//! * [`filter_mask`]`(S, nb_c)`: for l = 1 … nb_c − 1, delete every path of
+//!   length ≤ l, recompute degrees and paths, repeat at the same l until no
+//!   path of length ≤ l remains, then go on to l + 1.
+//!
+//! Deleting a simplex only lowers face degrees, so a join between two
+//! survivors is never broken (their shared face had degree 2 without the
+//! deleted one) and a ramification can turn into a join: paths only merge.
+//! Hence once no path of length ≤ l remains none ever reappears, and the
+//! levels l at which nothing would be deleted can be skipped: the
+//! implementation jumps straight to the shortest remaining path length.
+//! (The naive reading is compared with this one in the tests.)
+//!
+//! Storage is flat: the (face key, simplex) incidences are sorted once
+//! (a face key is the vertex id for k = 1, `(a << 32) | b` with a < b for
+//! k = 2) into a face → simplices adjacency in CSR form; each round is a
+//! union-find pass over the faces of degree 2. No hash map is used.
+//!
+//! ```
+//! use aniso_alpha::detect::filter::{filter, paths};
+//! // A chain 0-1-2-3-4-5 with a one-edge spur 2-9 at vertex 2.
+//! let s = [[0, 1], [1, 2], [2, 3], [3, 4], [4, 5], [2, 9]];
+//! assert_eq!(paths(&s).unwrap(), vec![0, 0, 1, 1, 1, 2]); // cut at vertex 2
+//! let kept = filter(&s, 2).unwrap();
+//! assert_eq!(kept, vec![[0, 1], [1, 2], [2, 3], [3, 4], [4, 5]]);
+//! assert_eq!(paths(&kept).unwrap(), vec![0; 5]); // one path again
+//! ```
+
+use std::fmt;
+
+mod sealed {
+    pub trait Sealed {}
+    impl Sealed for [u32; 2] {}
+    impl Sealed for [u32; 3] {}
+}
+
+/// An edge `[u32; 2]` or a triangle `[u32; 3]`. Sealed.
+pub trait Simplex: Copy + Ord + sealed::Sealed {
+    /// Number of vertices (= number of faces): 2 or 3.
+    const VERTICES: usize;
+    /// The simplex with its vertices sorted ascending, or `None` if a vertex
+    /// is repeated.
+    fn canonical(self) -> Option<Self>;
+    /// Key of face `i` (0 ≤ i < VERTICES) of a canonical simplex: the
+    /// vertex for an edge, `(a << 32) | b` (a < b) for a triangle's edge.
+    fn face_key(&self, i: usize) -> u64;
+}
+
+impl Simplex for [u32; 2] {
+    const VERTICES: usize = 2;
+    fn canonical(self) -> Option<Self> {
+        let [a, b] = self;
+        match a.cmp(&b) {
+            std::cmp::Ordering::Less => Some([a, b]),
+            std::cmp::Ordering::Greater => Some([b, a]),
+            std::cmp::Ordering::Equal => None,
+        }
+    }
+    fn face_key(&self, i: usize) -> u64 {
+        u64::from(self[i])
+    }
+}
+
+impl Simplex for [u32; 3] {
+    const VERTICES: usize = 3;
+    fn canonical(self) -> Option<Self> {
+        let mut s = self;
+        s.sort_unstable();
+        if s[0] == s[1] || s[1] == s[2] {
+            None
+        } else {
+            Some(s)
+        }
+    }
+    fn face_key(&self, i: usize) -> u64 {
+        let (a, b) = match i {
+            0 => (self[1], self[2]),
+            1 => (self[0], self[2]),
+            _ => (self[0], self[1]),
+        };
+        (u64::from(a) << 32) | u64::from(b)
+    }
+}
+
+/// Bad input to the filter.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum FilterError {
+    /// Simplex `index` has a repeated vertex.
+    RepeatedVertex {
+        /// Position in the input.
+        index: usize,
+    },
+    /// More than `u32::MAX − 1` simplices.
+    TooManySimplices(usize),
+}
+
+impl fmt::Display for FilterError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::RepeatedVertex { index } => {
+                write!(f, "simplex {index} has a repeated vertex")
+            }
+            Self::TooManySimplices(n) => write!(f, "{n} simplices: at most 2^32 − 2"),
+        }
+    }
+}
+
+impl std::error::Error for FilterError {}
+
+/// Flat incidence structure of a simplex set.
+pub(crate) struct Incidence {
+    /// Input position → unique simplex.
+    pub(crate) input_to_unique: Vec<u32>,
+    /// Unique simplex → its first input position.
+    pub(crate) unique_to_input: Vec<u32>,
+    /// Number of unique simplices.
+    pub(crate) n: usize,
+    /// Faces of unique simplex s: `simplex_faces[s*K .. s*K+K]`.
+    simplex_faces: Vec<u32>,
+    /// CSR: simplices of face f are `face_simplices[face_start[f]..face_start[f+1]]`.
+    face_start: Vec<u32>,
+    face_simplices: Vec<u32>,
+    k: usize,
+}
+
+impl Incidence {
+    pub(crate) fn new<S: Simplex>(simplices: &[S]) -> Result<Self, FilterError> {
+        // Incidence counts (3 per triangle) must fit u32 as well.
+        if simplices.len() >= (u32::MAX / 3) as usize {
+            return Err(FilterError::TooManySimplices(simplices.len()));
+        }
+        let mut canon = Vec::with_capacity(simplices.len());
+        for (index, &s) in simplices.iter().enumerate() {
+            canon.push(s.canonical().ok_or(FilterError::RepeatedVertex { index })?);
+        }
+        // Merge repeated simplices.
+        let mut order: Vec<u32> = (0..canon.len() as u32).collect();
+        order.sort_unstable_by(|&a, &b| canon[a as usize].cmp(&canon[b as usize]).then(a.cmp(&b)));
+        let mut input_to_unique = vec![0u32; canon.len()];
+        let mut unique: Vec<S> = Vec::with_capacity(canon.len());
+        let mut unique_to_input: Vec<u32> = Vec::with_capacity(canon.len());
+        for &i in &order {
+            let s = canon[i as usize];
+            if unique.last() != Some(&s) {
+                unique.push(s);
+                unique_to_input.push(i);
+            }
+            input_to_unique[i as usize] = (unique.len() - 1) as u32;
+        }
+        let k = S::VERTICES;
+        let n = unique.len();
+        let mut pairs: Vec<(u64, u32)> = Vec::with_capacity(n * k);
+        for (si, s) in unique.iter().enumerate() {
+            for i in 0..k {
+                pairs.push((s.face_key(i), si as u32));
+            }
+        }
+        pairs.sort_unstable();
+        let mut simplex_faces = vec![0u32; n * k];
+        let mut fill = vec![0u8; n];
+        let mut face_start: Vec<u32> = Vec::with_capacity(pairs.len() / 2 + 2);
+        let mut face_simplices: Vec<u32> = Vec::with_capacity(pairs.len());
+        let mut last_key = None;
+        for (idx, &(key, s)) in pairs.iter().enumerate() {
+            if last_key != Some(key) {
+                face_start.push(idx as u32);
+                last_key = Some(key);
+            }
+            let f = (face_start.len() - 1) as u32;
+            face_simplices.push(s);
+            let slot = &mut fill[s as usize];
+            simplex_faces[s as usize * k + *slot as usize] = f;
+            *slot += 1;
+        }
+        face_start.push(pairs.len() as u32);
+        Ok(Self {
+            input_to_unique,
+            unique_to_input,
+            n,
+            simplex_faces,
+            face_start,
+            face_simplices,
+            k,
+        })
+    }
+
+    pub(crate) fn num_faces(&self) -> usize {
+        self.face_start.len() - 1
+    }
+
+    pub(crate) fn face(&self, f: usize) -> &[u32] {
+        &self.face_simplices[self.face_start[f] as usize..self.face_start[f + 1] as usize]
+    }
+
+    pub(crate) fn faces_of(&self, s: usize) -> &[u32] {
+        &self.simplex_faces[s * self.k..(s + 1) * self.k]
+    }
+
+    fn degrees(&self) -> Vec<u32> {
+        (0..self.num_faces())
+            .map(|f| self.face(f).len() as u32)
+            .collect()
+    }
+
+    /// Union-find over alive simplices: joined through faces of degree 2
+    /// (`only_degree_two`) or through any shared face.
+    fn unite(&self, alive: &[bool], degree: &[u32], only_degree_two: bool, uf: &mut UnionFind) {
+        uf.reset(self.n);
+        for (f, w) in self.face_start.windows(2).enumerate() {
+            if only_degree_two && degree[f] != 2 {
+                continue;
+            }
+            let mut first = None;
+            for &s in &self.face_simplices[w[0] as usize..w[1] as usize] {
+                if alive[s as usize] {
+                    match first {
+                        None => first = Some(s),
+                        Some(a) => uf.union(a, s),
+                    }
+                }
+            }
+        }
+    }
+
+    /// Maps input positions to compact component ids (in order of first
+    /// appearance in the input).
+    fn label_input(&self, uf: &mut UnionFind) -> Vec<u32> {
+        let mut id_of_root = vec![u32::MAX; self.n];
+        let mut next = 0u32;
+        self.input_to_unique
+            .iter()
+            .map(|&u| {
+                let r = uf.find(u) as usize;
+                if id_of_root[r] == u32::MAX {
+                    id_of_root[r] = next;
+                    next += 1;
+                }
+                id_of_root[r]
+            })
+            .collect()
+    }
+}
+
+struct UnionFind {
+    parent: Vec<u32>,
+    size: Vec<u32>,
+}
+
+impl UnionFind {
+    fn new() -> Self {
+        Self {
+            parent: Vec::new(),
+            size: Vec::new(),
+        }
+    }
+    fn reset(&mut self, n: usize) {
+        self.parent.clear();
+        self.parent.extend(0..n as u32);
+        self.size.clear();
+        self.size.resize(n, 1);
+    }
+    fn find(&mut self, mut x: u32) -> u32 {
+        while self.parent[x as usize] != x {
+            let p = self.parent[x as usize];
+            self.parent[x as usize] = self.parent[p as usize];
+            x = p;
+        }
+        x
+    }
+    fn union(&mut self, a: u32, b: u32) {
+        let (mut ra, mut rb) = (self.find(a), self.find(b));
+        if ra == rb {
+            return;
+        }
+        if self.size[ra as usize] < self.size[rb as usize] {
+            std::mem::swap(&mut ra, &mut rb);
+        }
+        self.parent[rb as usize] = ra;
+        self.size[ra as usize] += self.size[rb as usize];
+    }
+    /// Size of x's set.
+    fn size_of(&mut self, x: u32) -> u32 {
+        let r = self.find(x) as usize;
+        self.size[r]
+    }
+}
+
+/// The path filter (module docs): `mask[i]` is true when input simplex `i`
+/// survives `filter(S, nb_c)`. `nb_c ≤ 1` keeps everything.
+///
+/// ```
+/// use aniso_alpha::detect::filter::filter_mask;
+/// // A fin (triangle 1-2-9) on the inner edge 1-2 of a 4-triangle patch.
+/// let s = [[0, 1, 2], [1, 2, 3], [1, 3, 4], [0, 2, 5], [1, 2, 9]];
+/// assert_eq!(filter_mask(&s, 2).unwrap(), vec![true, true, true, true, false]);
+/// ```
+pub fn filter_mask<S: Simplex>(simplices: &[S], nb_c: u32) -> Result<Vec<bool>, FilterError> {
+    let inc = Incidence::new(simplices)?;
+    let n = inc.n;
+    let mut alive = vec![true; n];
+    let mut degree = inc.degrees();
+    let mut uf = UnionFind::new();
+    let mut l = 1u32;
+    let mut n_alive = n;
+    while l < nb_c && n_alive > 0 {
+        inc.unite(&alive, &degree, true, &mut uf);
+        // Length of the shortest alive path.
+        let mut shortest = u32::MAX;
+        for (s, _) in alive.iter().enumerate().filter(|(_, &a)| a) {
+            shortest = shortest.min(uf.size_of(s as u32));
+        }
+        if shortest > l {
+            // Levels l .. shortest − 1 delete nothing (paths only merge).
+            l = shortest;
+            continue;
+        }
+        for (s, a) in alive.iter_mut().enumerate() {
+            if *a && uf.size_of(s as u32) <= l {
+                *a = false;
+                n_alive -= 1;
+                for &f in inc.faces_of(s) {
+                    degree[f as usize] -= 1;
+                }
+            }
+        }
+        // Repeat at the same l (the next pass finds shortest > l and moves on).
+    }
+    Ok(inc
+        .input_to_unique
+        .iter()
+        .map(|&u| alive[u as usize])
+        .collect())
+}
+
+/// The simplices kept by [`filter_mask`], in input order.
+pub fn filter<S: Simplex>(simplices: &[S], nb_c: u32) -> Result<Vec<S>, FilterError> {
+    let mask = filter_mask(simplices, nb_c)?;
+    Ok(simplices
+        .iter()
+        .zip(mask)
+        .filter_map(|(&s, keep)| keep.then_some(s))
+        .collect())
+}
+
+/// Path id of each input simplex (components of "joined": sharing a face
+/// of degree exactly 2), ids 0, 1, … in order of first appearance.
+pub fn paths<S: Simplex>(simplices: &[S]) -> Result<Vec<u32>, FilterError> {
+    let inc = Incidence::new(simplices)?;
+    let alive = vec![true; inc.n];
+    let degree = inc.degrees();
+    let mut uf = UnionFind::new();
+    inc.unite(&alive, &degree, true, &mut uf);
+    Ok(inc.label_input(&mut uf))
+}
+
+/// Plain connected components (triangles joined by any shared edge, edges
+/// by any shared vertex), ids 0, 1, … in order of first appearance.
+///
+/// ```
+/// use aniso_alpha::detect::filter::components;
+/// let s = [[0, 1, 2], [5, 6, 7], [1, 2, 3], [1, 2, 4]];
+/// assert_eq!(components(&s).unwrap(), vec![0, 1, 0, 0]);
+/// ```
+pub fn components<S: Simplex>(simplices: &[S]) -> Result<Vec<u32>, FilterError> {
+    let inc = Incidence::new(simplices)?;
+    let alive = vec![true; inc.n];
+    let mut uf = UnionFind::new();
+    inc.unite(&alive, &[], false, &mut uf);
+    Ok(inc.label_input(&mut uf))
+}
+
+/// Keeps the simplices of connected components ([`components`]) holding at
+/// least `min_size` distinct simplices: the final clean-up of the union of
+/// all orientations (SPEC §4), which must not use the path filter.
+///
+/// ```
+/// use aniso_alpha::detect::filter::component_size_mask;
+/// let s = [[0, 1], [1, 2], [5, 6]];
+/// assert_eq!(component_size_mask(&s, 2).unwrap(), vec![true, true, false]);
+/// ```
+pub fn component_size_mask<S: Simplex>(
+    simplices: &[S],
+    min_size: u32,
+) -> Result<Vec<bool>, FilterError> {
+    let inc = Incidence::new(simplices)?;
+    let alive = vec![true; inc.n];
+    let mut uf = UnionFind::new();
+    inc.unite(&alive, &[], false, &mut uf);
+    Ok(inc
+        .input_to_unique
+        .iter()
+        .map(|&u| uf.size_of(u) >= min_size)
+        .collect())
+}
+
+#[cfg(test)]
+mod tests;
