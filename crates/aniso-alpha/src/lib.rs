@@ -10,6 +10,8 @@
 //!   that CGAL uses, and circumsphere constructions;
 //! * [`delaunay`]: the triangulation (flat `u32` arrays, bulk construction,
 //!   queries, `validate()`);
+//! * [`alpha`]: alpha-shape intervals of edges and triangles, `F_α`, the
+//!   α-shape surface, and the anisotropic complex of `Q·P`;
 //!
 //! ```
 //! use aniso_alpha::delaunay::Triangulation;
@@ -25,5 +27,6 @@
 // iterator chains in the geometry code.
 #![allow(clippy::needless_range_loop)]
 
+pub mod alpha;
 pub mod delaunay;
 pub mod geometry;
