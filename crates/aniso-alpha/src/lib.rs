@@ -18,6 +18,8 @@
 //!   structures, connected components, least-squares line/plane fits;
 //! * [`synth`]: deterministic benchmark scenes with ground truth;
 //! * [`eval`]: detection scores (precision/recall/F1, structures found).
+//! * [`alpha`]: alpha-shape intervals of edges and triangles, `F_α`, the
+//!   α-shape surface, and the anisotropic complex of `Q·P`;
 //!
 //! ```
 //! use aniso_alpha::delaunay::Triangulation;
@@ -33,6 +35,7 @@
 // iterator chains in the geometry code.
 #![allow(clippy::needless_range_loop)]
 
+pub mod alpha;
 pub mod aniso;
 pub mod delaunay;
 pub mod detect;

@@ -1,0 +1,441 @@
+//! Exact "strictly inside the smallest circumsphere" predicates for the
+//! Gabriel tests of edges and triangles.
+//!
+//! Both are a floating-point evaluation with a static forward error bound
+//! (the filter), backed by an exact evaluation in Shewchuk's expansion
+//! arithmetic (error-free `two_sum` / `two_product` with Dekker splitting,
+//! no fused multiply-add) when the filter cannot decide. The exact stage
+//! computes every coordinate difference as a two-term expansion, so the
+//! result is the exact sign of the polynomial for any finite `f64` input
+//! (barring overflow or underflow of the intermediate products, i.e.
+//! coordinates beyond about 1e±50, as for [`crate::geometry::predicates`]).
+//!
+//! * Edge `(a, b)`, point `p`: `p` is strictly inside the ball with diameter
+//!   `ab` iff `(p − a)·(p − b) < 0` (Thales).
+//! * Triangle `(a, b, c)`, point `p`: with `u = b − a`, `v = c − a`,
+//!   `w = p − a`, the circumcentre of the triangle is `a + o` with
+//!   `o = (|v|²(|u|² − u·v) u + |u|²(|v|² − u·v) v) / (2|u × v|²)`, and
+//!   `|w − o|² − |o|² = |w|² − 2 w·o`. Multiplying by `|u × v|² > 0`,
+//!   `p` is strictly inside the triangle's diametral sphere iff
+//!   `D = |w|²·|u × v|² − (w·u)|v|²(|u|² − u·v) − (w·v)|u|²(|v|² − u·v) < 0`,
+//!   a polynomial of degree 6 in the coordinate differences, with
+//!   `|u × v|² = |u|²|v|² − (u·v)²` (Lagrange).
+
+use crate::geometry::Point3;
+
+/// Sign of `(p − a)·(p − b)`: `-1` when `p` is strictly inside the ball
+/// with diameter `ab`, `0` on its sphere, `1` outside.
+///
+/// ```
+/// use aniso_alpha::alpha::exact::edge_diametral_side;
+/// let (a, b) = ([0.0, 0.0, 0.0], [2.0, 0.0, 0.0]);
+/// assert_eq!(edge_diametral_side(&a, &b, &[1.0, 0.5, 0.0]), -1);
+/// assert_eq!(edge_diametral_side(&a, &b, &[1.0, 1.0, 0.0]), 0);
+/// assert_eq!(edge_diametral_side(&a, &b, &[1.0, 1.5, 0.0]), 1);
+/// ```
+#[inline]
+pub fn edge_diametral_side(a: &Point3, b: &Point3, p: &Point3) -> i32 {
+    let mut d = 0.0;
+    let mut m = 0.0;
+    for k in 0..3 {
+        let x = p[k] - a[k];
+        let y = p[k] - b[k];
+        d += x * y;
+        m += (x * y).abs();
+    }
+    // Depth 4 (difference, product, two sums): the error is below 4.5ε·m;
+    // 2e-15 ≈ 9ε leaves margin for the rounding of m itself.
+    let eps = 2e-15 * m;
+    if d > eps {
+        return 1;
+    }
+    if -d > eps {
+        return -1;
+    }
+    edge_exact(a, b, p)
+}
+
+/// Sign of `D` (see the module docs): `-1` when `p` is strictly inside the
+/// smallest circumsphere (diametral sphere) of the non-degenerate triangle
+/// `abc`, `0` on it, `1` outside.
+///
+/// ```
+/// use aniso_alpha::alpha::exact::triangle_diametral_side;
+/// let (a, b, c) = ([0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]);
+/// // Circumcentre (1, 1, 0), radius √2.
+/// assert_eq!(triangle_diametral_side(&a, &b, &c, &[1.0, 1.0, 1.0]), -1);
+/// assert_eq!(triangle_diametral_side(&a, &b, &c, &[2.0, 2.0, 0.0]), 0);
+/// assert_eq!(triangle_diametral_side(&a, &b, &c, &[1.0, 1.0, 2.0]), 1);
+/// ```
+#[inline]
+pub fn triangle_diametral_side(a: &Point3, b: &Point3, c: &Point3, p: &Point3) -> i32 {
+    let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+    let w = [p[0] - a[0], p[1] - a[1], p[2] - a[2]];
+    let uu = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
+    let vv = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+    let ww = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+    let uv = u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+    let wu = w[0] * u[0] + w[1] * u[1] + w[2] * u[2];
+    let wv = w[0] * v[0] + w[1] * v[1] + w[2] * v[2];
+    let n = [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ];
+    let nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+    let d = ww * nn - wu * vv * (uu - uv) - wv * uu * (vv - uv);
+    triangle_filter(&u, &v, &w, uu, vv, ww, d).unwrap_or_else(|| triangle_exact(a, b, c, p))
+}
+
+/// The filter of [`triangle_diametral_side`]: `Some(sign)` when the f64
+/// value `d` is certainly of the right sign.
+#[inline]
+pub(crate) fn triangle_filter(
+    u: &Point3,
+    v: &Point3,
+    w: &Point3,
+    uu: f64,
+    vv: f64,
+    ww: f64,
+    d: f64,
+) -> Option<i32> {
+    // Permanents: the same expression with absolute values everywhere.
+    let puv = (u[0] * v[0]).abs() + (u[1] * v[1]).abs() + (u[2] * v[2]).abs();
+    let pwu = (w[0] * u[0]).abs() + (w[1] * u[1]).abs() + (w[2] * u[2]).abs();
+    let pwv = (w[0] * v[0]).abs() + (w[1] * v[1]).abs() + (w[2] * v[2]).abs();
+    let n0 = (u[1] * v[2]).abs() + (u[2] * v[1]).abs();
+    let n1 = (u[2] * v[0]).abs() + (u[0] * v[2]).abs();
+    let n2 = (u[0] * v[1]).abs() + (u[1] * v[0]).abs();
+    let pnn = n0 * n0 + n1 * n1 + n2 * n2;
+    let m = ww * pnn + pwu * vv * (uu + puv) + pwv * uu * (vv + puv);
+    // At most 10 rounded operations on any path from the inputs to `d`:
+    // the error is below about 10ε·m. 4e-15 ≈ 18ε leaves ample margin.
+    let eps = 4e-15 * m;
+    if d > eps && eps >= f64::MIN_POSITIVE {
+        Some(1)
+    } else if -d > eps && eps >= f64::MIN_POSITIVE {
+        Some(-1)
+    } else {
+        None
+    }
+}
+
+#[cold]
+#[inline(never)]
+fn edge_exact(a: &Point3, b: &Point3, p: &Point3) -> i32 {
+    let mut sum = Expansion::zero();
+    for k in 0..3 {
+        let x = Expansion::diff(p[k], a[k]);
+        let y = Expansion::diff(p[k], b[k]);
+        sum = sum.add(&x.mul(&y));
+    }
+    sum.sign()
+}
+
+#[cold]
+#[inline(never)]
+fn triangle_exact(a: &Point3, b: &Point3, c: &Point3, p: &Point3) -> i32 {
+    let u: [Expansion; 3] = std::array::from_fn(|k| Expansion::diff(b[k], a[k]));
+    let v: [Expansion; 3] = std::array::from_fn(|k| Expansion::diff(c[k], a[k]));
+    let w: [Expansion; 3] = std::array::from_fn(|k| Expansion::diff(p[k], a[k]));
+    let dot = |x: &[Expansion; 3], y: &[Expansion; 3]| {
+        x[0].mul(&y[0]).add(&x[1].mul(&y[1])).add(&x[2].mul(&y[2]))
+    };
+    let uu = dot(&u, &u);
+    let vv = dot(&v, &v);
+    let ww = dot(&w, &w);
+    let uv = dot(&u, &v);
+    let wu = dot(&w, &u);
+    let wv = dot(&w, &v);
+    let nn = uu.mul(&vv).sub(&uv.mul(&uv));
+    let t1 = ww.mul(&nn);
+    let t2 = wu.mul(&vv).mul(&uu.sub(&uv));
+    let t3 = wv.mul(&uu).mul(&vv.sub(&uv));
+    t1.sub(&t2).sub(&t3).sign()
+}
+
+/// Squared circumradius of the tetrahedron `abcd`, accurate to a few ulps
+/// even for slivers: `r² = |N|² / (4 det²)` with `det = u·(v × w)` and
+/// `N = |u|²(v × w) + |v|²(w × u) + |w|²(u × v)` (`u, v, w` the edges from
+/// `a`). Both are evaluated in f64 with a forward error bound; when either
+/// may have lost more than about 10 bits to cancellation (a flat or
+/// nearly cospherical-and-flat tet), they are recomputed exactly and only
+/// then rounded. `+∞` for a flat tet.
+#[inline]
+pub(crate) fn tet_radius2(a: &Point3, b: &Point3, c: &Point3, d: &Point3) -> f64 {
+    let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+    let w = [d[0] - a[0], d[1] - a[1], d[2] - a[2]];
+    let uu = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
+    let vv = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+    let ww = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+    let cr = |x: &Point3, y: &Point3| {
+        [
+            x[1] * y[2] - x[2] * y[1],
+            x[2] * y[0] - x[0] * y[2],
+            x[0] * y[1] - x[1] * y[0],
+        ]
+    };
+    let pc = |x: &Point3, y: &Point3| {
+        [
+            (x[1] * y[2]).abs() + (x[2] * y[1]).abs(),
+            (x[2] * y[0]).abs() + (x[0] * y[2]).abs(),
+            (x[0] * y[1]).abs() + (x[1] * y[0]).abs(),
+        ]
+    };
+    let (vw, wu, uv) = (cr(&v, &w), cr(&w, &u), cr(&u, &v));
+    let (pvw, pwu, puv) = (pc(&v, &w), pc(&w, &u), pc(&u, &v));
+    let det = u[0] * vw[0] + u[1] * vw[1] + u[2] * vw[2];
+    let pdet = u[0].abs() * pvw[0] + u[1].abs() * pvw[1] + u[2].abs() * pvw[2];
+    let n: [f64; 3] = std::array::from_fn(|k| uu * vw[k] + vv * wu[k] + ww * uv[k]);
+    let pn: [f64; 3] = std::array::from_fn(|k| uu * pvw[k] + vv * pwu[k] + ww * puv[k]);
+    let nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+    let pnn = pn[0] * pn[0] + pn[1] * pn[1] + pn[2] * pn[2];
+    // Relative errors below ~8ε·p/|x|: keep the float result while that is
+    // under ~2e-12 (|x| ≥ 1e-3·p).
+    if det.abs() >= 1e-3 * pdet && nn >= 1e-6 * pnn && pdet > 0.0 {
+        return nn / (4.0 * det * det);
+    }
+    tet_radius2_exact(a, b, c, d)
+}
+
+#[cold]
+#[inline(never)]
+fn tet_radius2_exact(a: &Point3, b: &Point3, c: &Point3, d: &Point3) -> f64 {
+    let u: [Expansion; 3] = std::array::from_fn(|k| Expansion::diff(b[k], a[k]));
+    let v: [Expansion; 3] = std::array::from_fn(|k| Expansion::diff(c[k], a[k]));
+    let w: [Expansion; 3] = std::array::from_fn(|k| Expansion::diff(d[k], a[k]));
+    let dot = |x: &[Expansion; 3], y: &[Expansion; 3]| {
+        x[0].mul(&y[0]).add(&x[1].mul(&y[1])).add(&x[2].mul(&y[2]))
+    };
+    let cross = |x: &[Expansion; 3], y: &[Expansion; 3]| -> [Expansion; 3] {
+        std::array::from_fn(|k| {
+            let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+            x[i].mul(&y[j]).sub(&x[j].mul(&y[i]))
+        })
+    };
+    let (uu, vv, ww) = (dot(&u, &u), dot(&v, &v), dot(&w, &w));
+    let (vw, wu, uv) = (cross(&v, &w), cross(&w, &u), cross(&u, &v));
+    let det = dot(&u, &vw).estimate();
+    if det == 0.0 {
+        return f64::INFINITY;
+    }
+    let n: [f64; 3] = std::array::from_fn(|k| {
+        uu.mul(&vw[k])
+            .add(&vv.mul(&wu[k]))
+            .add(&ww.mul(&uv[k]))
+            .estimate()
+    });
+    (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) / (4.0 * det * det)
+}
+
+/// `|u × v|²` for `u = b − a`, `v = c − a`, accurate to a few ulps: the
+/// cross product's components are recomputed exactly when cancellation may
+/// have cost more than about 10 bits.
+#[inline]
+pub(crate) fn cross_norm2(a: &Point3, b: &Point3, c: &Point3, u: &Point3, v: &Point3) -> f64 {
+    let n = [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ];
+    let p = [
+        (u[1] * v[2]).abs() + (u[2] * v[1]).abs(),
+        (u[2] * v[0]).abs() + (u[0] * v[2]).abs(),
+        (u[0] * v[1]).abs() + (u[1] * v[0]).abs(),
+    ];
+    let nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+    let pp = p[0] * p[0] + p[1] * p[1] + p[2] * p[2];
+    if nn >= 1e-6 * pp && pp > 0.0 {
+        return nn;
+    }
+    cross_norm2_exact(a, b, c)
+}
+
+#[cold]
+#[inline(never)]
+fn cross_norm2_exact(a: &Point3, b: &Point3, c: &Point3) -> f64 {
+    let u: [Expansion; 3] = std::array::from_fn(|k| Expansion::diff(b[k], a[k]));
+    let v: [Expansion; 3] = std::array::from_fn(|k| Expansion::diff(c[k], a[k]));
+    let n: [f64; 3] = std::array::from_fn(|k| {
+        let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+        u[i].mul(&v[j]).sub(&u[j].mul(&v[i])).estimate()
+    });
+    n[0] * n[0] + n[1] * n[1] + n[2] * n[2]
+}
+
+// ---------------------------------------------------------------------------
+// Shewchuk's expansion arithmetic (nonoverlapping, increasing magnitude,
+// zero-eliminated). Only used on the rare exact path, so plain `Vec`s.
+
+#[inline]
+fn two_sum(a: f64, b: f64) -> (f64, f64) {
+    let x = a + b;
+    let bv = x - a;
+    let av = x - bv;
+    let br = b - bv;
+    let ar = a - av;
+    (x, ar + br)
+}
+
+#[inline]
+fn split(a: f64) -> (f64, f64) {
+    // 2^27 + 1
+    let c = 134_217_729.0 * a;
+    let abig = c - a;
+    let hi = c - abig;
+    (hi, a - hi)
+}
+
+#[inline]
+fn two_product(a: f64, b: f64) -> (f64, f64) {
+    let x = a * b;
+    let (ahi, alo) = split(a);
+    let (bhi, blo) = split(b);
+    let err1 = x - ahi * bhi;
+    let err2 = err1 - alo * bhi;
+    let err3 = err2 - ahi * blo;
+    (x, alo * blo - err3)
+}
+
+/// An exact sum of `f64` components (Shewchuk's expansions).
+#[derive(Clone, Debug)]
+pub(crate) struct Expansion(Vec<f64>);
+
+impl Expansion {
+    fn zero() -> Self {
+        Expansion(Vec::new())
+    }
+
+    /// The exact difference `a − b`.
+    pub(crate) fn diff(a: f64, b: f64) -> Self {
+        let (x, y) = two_sum(a, -b);
+        let mut e = Vec::with_capacity(2);
+        if y != 0.0 {
+            e.push(y);
+        }
+        if x != 0.0 {
+            e.push(x);
+        }
+        Expansion(e)
+    }
+
+    /// Exact sum (Shewchuk's `linear_expansion_sum_zeroelim` by repeated
+    /// `grow_expansion`, which is simple and exact).
+    pub(crate) fn add(&self, f: &Expansion) -> Expansion {
+        let mut h = self.0.clone();
+        for &b in &f.0 {
+            h = grow(&h, b);
+        }
+        Expansion(h)
+    }
+
+    pub(crate) fn neg(&self) -> Expansion {
+        Expansion(self.0.iter().map(|x| -x).collect())
+    }
+
+    pub(crate) fn sub(&self, f: &Expansion) -> Expansion {
+        self.add(&f.neg())
+    }
+
+    /// Exact product.
+    pub(crate) fn mul(&self, f: &Expansion) -> Expansion {
+        let mut acc = Expansion::zero();
+        for &b in &f.0 {
+            acc = acc.add(&self.scale(b));
+        }
+        acc
+    }
+
+    /// Exact product by a double (`scale_expansion_zeroelim`).
+    fn scale(&self, b: f64) -> Expansion {
+        let e = &self.0;
+        let mut h = Vec::with_capacity(2 * e.len());
+        if e.is_empty() || b == 0.0 {
+            return Expansion(h);
+        }
+        let (mut q, hh) = two_product(e[0], b);
+        if hh != 0.0 {
+            h.push(hh);
+        }
+        for &x in &e[1..] {
+            let (p1, p0) = two_product(x, b);
+            let (sum, hh) = two_sum(q, p0);
+            if hh != 0.0 {
+                h.push(hh);
+            }
+            let (nq, hh) = two_sum(p1, sum);
+            // p1 + sum is exact as fast_two_sum in Shewchuk; two_sum is safe.
+            q = nq;
+            if hh != 0.0 {
+                h.push(hh);
+            }
+        }
+        if q != 0.0 {
+            h.push(q);
+        }
+        Expansion(h)
+    }
+
+    /// Sign of the exact value: that of the most significant component.
+    pub(crate) fn sign(&self) -> i32 {
+        match self.0.last() {
+            None => 0,
+            Some(&x) if x > 0.0 => 1,
+            Some(_) => -1,
+        }
+    }
+
+    /// The value rounded to a double (approximately: sum of components
+    /// from the smallest up, accurate to a few ulps).
+    pub(crate) fn estimate(&self) -> f64 {
+        self.0.iter().sum()
+    }
+}
+
+/// `grow_expansion_zeroelim`: the exact sum of the expansion `e` and `b`.
+fn grow(e: &[f64], b: f64) -> Vec<f64> {
+    let mut h = Vec::with_capacity(e.len() + 1);
+    let mut q = b;
+    for &x in e {
+        let (s, hh) = two_sum(q, x);
+        q = s;
+        if hh != 0.0 {
+            h.push(hh);
+        }
+    }
+    if q != 0.0 {
+        h.push(q);
+    }
+    h
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn expansion_exact_small() {
+        // (1 + 2^-60) * (1 - 2^-60) - 1 = -2^-120
+        let a = Expansion::zero().add(&Expansion(vec![2f64.powi(-60), 1.0]));
+        let b = Expansion::diff(1.0, 2f64.powi(-60));
+        let one = Expansion(vec![1.0]);
+        let r = a.mul(&b).sub(&one);
+        assert_eq!(r.sign(), -1);
+        assert_eq!(r.estimate(), -(2f64.powi(-120)));
+    }
+
+    #[test]
+    fn ties_are_zero() {
+        // Cospherical: a point on the diametral sphere of a skewed triangle
+        // with non-representable differences.
+        let a = [0.1, 0.2, 0.3];
+        let b = [0.1 + 4.0, 0.2, 0.3];
+        assert_eq!(edge_exact(&a, &b, &a), 0);
+        assert_eq!(edge_diametral_side(&a, &b, &b), 0);
+        let c = [0.1, 0.2 + 3.0, 0.3];
+        assert_eq!(triangle_exact(&a, &b, &c, &a), 0);
+        assert_eq!(triangle_diametral_side(&a, &b, &c, &c), 0);
+    }
+}

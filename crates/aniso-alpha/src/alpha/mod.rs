@@ -1,0 +1,735 @@
+//! Alpha-shape intervals, Euclidean and anisotropic alpha-shapes
+//! (SPEC §1–§2).
+//!
+//! [`AlphaComplex`] takes a Delaunay [`Triangulation`] and computes, for
+//! every finite edge and triangle σ, the interval `[α_min(σ), α_max(σ)]` of
+//! radii of the empty open balls whose boundary passes through σ's vertices
+//! (the values CGAL's `Alpha_shape_3` in GENERAL mode and GUDHI report), and
+//! the circumradius of every tetrahedron. The α-shape of the paper,
+//! `F_α = {σ : α_min(σ) ≤ α ≤ α_max(σ)}` (a *closed* interval: on
+//! degenerate sets many simplices have `α_min = α_max`), is then a scan.
+//!
+//! # Definitions
+//!
+//! * `α_max(σ)`: the largest circumradius of σ's incident tetrahedra, `+∞`
+//!   when σ is on the convex hull (incident to an infinite tetrahedron).
+//! * `α_min(σ)`: `ρ(σ)` (half the edge length; the triangle's circumradius)
+//!   if σ is *Gabriel*, i.e. no vertex of a simplex incident to σ lies
+//!   strictly inside σ's smallest circumsphere (decided exactly, see
+//!   [`exact`]); otherwise the smallest `α_min` of the simplices one
+//!   dimension up (for a triangle: the smallest circumradius of its finite
+//!   incident tets; for an edge: the smallest `α_min` of its triangles).
+//!
+//! # Algorithm and storage
+//!
+//! Everything is flat (`Vec`s indexed by `u32`), linear in the number of
+//! simplices, without hashing:
+//!
+//! 1. circumradius of every cell (`+∞` for infinite cells), computed
+//!    relative to a vertex of the tet;
+//! 2. edges: every finite tet emits its 6 edges `(a, b)`, `a < b`, bucketed
+//!    by `a` with a counting sort; each vertex's bucket is sorted and
+//!    deduplicated. The edges are then numbered by `(a, b)` and the
+//!    per-vertex offsets (CSR) give an `O(degree)` lookup;
+//! 3. triangles: each finite face once, from the cell with the smaller id;
+//!    its Gabriel test looks at the (one or two) opposite vertices, and it
+//!    then pushes its values to its three edges (α_max: max, α_min of the
+//!    cofaces: min, Gabriel test of the edge against the triangle's third
+//!    vertex; the third vertices of an edge's triangles are exactly the
+//!    vertices of its incident tets);
+//! 4. each edge's `α_min` is its half length if Gabriel, else the minimum
+//!    over its triangles.
+//!
+//! The struct owns the triangulation (get it back with
+//! [`AlphaComplex::into_triangulation`]).
+//!
+//! ```
+//! use aniso_alpha::alpha::AlphaComplex;
+//! let pts = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+//! let ac = AlphaComplex::from_points(&pts)?;
+//! assert_eq!((ac.num_edges(), ac.num_triangles()), (6, 4));
+//! // The tet's circumradius is √3/2 ≈ 0.866. The hull triangle (1, 2, 3)
+//! // (circumradius √(2/3)) is not Gabriel: the origin is inside its
+//! // diametral sphere, so it appears only with the tet's ball.
+//! let t = ac.triangles().find(|t| t.vertices == [1, 2, 3]).unwrap();
+//! assert!((t.alpha_min - 3f64.sqrt() / 2.0).abs() < 1e-15);
+//! assert_eq!(t.alpha_max, f64::INFINITY);
+//! // The three triangles through the origin are Gabriel, radius √2/2.
+//! assert_eq!(ac.triangles_at(0.85).count(), 3);
+//! assert_eq!(ac.regular_surface(0.85).len(), 0);
+//! assert_eq!(ac.regular_surface(0.9).len(), 4);
+//! # Ok::<(), aniso_alpha::delaunay::DelaunayError>(())
+//! ```
+
+pub mod exact;
+
+use crate::delaunay::{DelaunayError, Triangulation, INFINITE};
+use crate::geometry::Point3;
+
+/// Faces: for local vertex `i`, the other three local indices in an order
+/// that makes `(f[0], f[1], f[2], i)` an even permutation of `(0, 1, 2, 3)`,
+/// so that face `i` of a positively oriented tet has its normal (right-hand
+/// rule) pointing towards vertex `i`, i.e. into the tet.
+const FACE: [[usize; 3]; 4] = [[1, 3, 2], [0, 2, 3], [0, 3, 1], [0, 1, 2]];
+/// The 6 edges of a tet as local index pairs.
+const PAIRS: [[usize; 2]; 6] = [[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]];
+
+/// An edge of the triangulation with its alpha interval, vertices given as
+/// input indices (ascending).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EdgeInterval {
+    /// Input indices of the endpoints, ascending (the smallest input index
+    /// of a duplicated point).
+    pub vertices: [u32; 2],
+    /// `α_min` (see the [module docs](self)).
+    pub alpha_min: f64,
+    /// `α_max`, `+∞` on the convex hull.
+    pub alpha_max: f64,
+}
+
+/// A triangle of the triangulation with its alpha interval, vertices given
+/// as input indices (ascending).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TriangleInterval {
+    /// Input indices of the corners, ascending.
+    pub vertices: [u32; 3],
+    /// `α_min` (see the [module docs](self)).
+    pub alpha_min: f64,
+    /// `α_max`, `+∞` on the convex hull.
+    pub alpha_max: f64,
+}
+
+/// The alpha intervals of every edge and triangle of a 3D Delaunay
+/// triangulation, and the circumradii of its tetrahedra.
+///
+/// Ids: edges are numbered `0..num_edges()` in `(a, b)` order of their
+/// vertex ids, triangles `0..num_triangles()`; cells (tets) use the
+/// triangulation's ids. Vertex ids are the triangulation's (insertion
+/// order); every query that says *input* maps them to input indices.
+///
+/// ```
+/// use aniso_alpha::alpha::AlphaComplex;
+/// // The unit cube's corners: 6 tets, all with circumradius √3/2.
+/// let pts: Vec<[f64; 3]> = (0..8)
+///     .map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64])
+///     .collect();
+/// let ac = AlphaComplex::from_points(&pts)?;
+/// // The 12 square edges are Gabriel (radius 1/2).
+/// assert_eq!(ac.edges().filter(|e| e.alpha_min == 0.5).count(), 12);
+/// // The solid appears at once, at α = √3/2.
+/// let r = ac.optimal_alpha().unwrap();
+/// assert!((r - 3f64.sqrt() / 2.0).abs() < 1e-15);
+/// assert_eq!(ac.regular_surface(r).len(), 12);
+/// # Ok::<(), aniso_alpha::delaunay::DelaunayError>(())
+/// ```
+#[derive(Clone, Debug)]
+pub struct AlphaComplex {
+    tri: Triangulation,
+    /// Cell id -> circumradius (`+∞` for infinite cells).
+    cell_r: Vec<f64>,
+    /// Edge id -> vertex ids `(a, b)`, `a < b`, sorted.
+    edge_v: Vec<[u32; 2]>,
+    /// Vertex id `a` -> first edge `(a, _)`; `num_vertices + 1` entries.
+    edge_start: Vec<u32>,
+    edge_min: Vec<f64>,
+    edge_max: Vec<f64>,
+    /// Triangle id -> owning face, packed `4 * cell + local face`, with
+    /// `cell` smaller than the neighbour across the face.
+    tri_face: Vec<u32>,
+    tri_min: Vec<f64>,
+    tri_max: Vec<f64>,
+}
+
+impl AlphaComplex {
+    /// Computes the intervals of `tri` (which the complex then owns).
+    ///
+    /// When the triangulation's dimension is below 3 there are no
+    /// tetrahedra, and (like CGAL's `Alpha_shape_3`) no edges or triangles
+    /// are reported.
+    pub fn new(tri: Triangulation) -> Self {
+        if tri.dimension() < 3 || tri.num_finite_tets() == 0 {
+            let nv = tri.num_vertices();
+            return AlphaComplex {
+                tri,
+                cell_r: Vec::new(),
+                edge_v: Vec::new(),
+                edge_start: vec![0; nv + 1],
+                edge_min: Vec::new(),
+                edge_max: Vec::new(),
+                tri_face: Vec::new(),
+                tri_min: Vec::new(),
+                tri_max: Vec::new(),
+            };
+        }
+        let cell_r = cell_radii(&tri);
+        let (edge_v, edge_start) = number_edges(&tri);
+        let ne = edge_v.len();
+        let mut ac = AlphaComplex {
+            tri,
+            cell_r,
+            edge_v,
+            edge_start,
+            edge_min: vec![f64::INFINITY; ne],
+            edge_max: vec![0.0; ne],
+            tri_face: Vec::new(),
+            tri_min: Vec::new(),
+            tri_max: Vec::new(),
+        };
+        ac.compute_triangles_and_edges();
+        ac
+    }
+
+    /// Triangulates `points` and computes the intervals.
+    ///
+    /// # Errors
+    /// As [`Triangulation::new`].
+    pub fn from_points(points: &[[f64; 3]]) -> Result<Self, DelaunayError> {
+        Ok(Self::new(Triangulation::new(points)?))
+    }
+
+    /// The anisotropic complex of SPEC §2: transforms every point by the
+    /// matrix `Q` given by its rows `q_rows` (`Q = diag(e)·R`, see
+    /// [`q_matrix`]), triangulates `Q·P` and computes its intervals. Since
+    /// `d_Q(p, q) = |Qp − Qq|`, the result's `F_α` is the anisotropic
+    /// `F_{α,Q}(P)`; every query reports indices into `points` (the
+    /// triangulation's [`Triangulation::points`] are the transformed ones).
+    ///
+    /// Each coordinate is computed as `(Q_i1·x + Q_i2·y) + Q_i3·z`, each
+    /// operation rounded to double in that order, without fused
+    /// multiply-add (numpy's and the project's convention, reproducible bit
+    /// for bit).
+    ///
+    /// ```
+    /// use aniso_alpha::alpha::{q_matrix, AlphaComplex};
+    /// let pts = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0, 1.0]];
+    /// let id = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// // E = (1, 1, 1/8): distances along z count 8 times less.
+    /// let q = q_matrix(&id, &[1.0, 1.0, 0.125]);
+    /// let ac = AlphaComplex::anisotropic(&pts, &q)?;
+    /// assert_eq!(ac.triangulation().point(ac.triangulation().vertex_of_input(3)), &[0.0, 0.0, 0.125]);
+    /// let e = ac.edges().find(|e| e.vertices == [0, 3]).unwrap();
+    /// assert_eq!(e.alpha_min, 0.0625);
+    /// # Ok::<(), aniso_alpha::delaunay::DelaunayError>(())
+    /// ```
+    ///
+    /// # Errors
+    /// As [`Triangulation::new`] (a non-finite coordinate after the
+    /// transform is reported at its input index).
+    pub fn anisotropic(points: &[[f64; 3]], q_rows: &[[f64; 3]; 3]) -> Result<Self, DelaunayError> {
+        Self::from_points(&transform_points(points, q_rows))
+    }
+
+    /// The triangulation the intervals refer to.
+    pub fn triangulation(&self) -> &Triangulation {
+        &self.tri
+    }
+
+    /// Gives the triangulation back.
+    pub fn into_triangulation(self) -> Triangulation {
+        self.tri
+    }
+
+    /// Number of finite edges.
+    pub fn num_edges(&self) -> usize {
+        self.edge_v.len()
+    }
+
+    /// Number of finite triangles.
+    pub fn num_triangles(&self) -> usize {
+        self.tri_face.len()
+    }
+
+    /// Vertex ids `(a, b)`, `a < b`, of edge `e`.
+    #[inline]
+    pub fn edge_vertices(&self, e: usize) -> [u32; 2] {
+        self.edge_v[e]
+    }
+
+    /// `(α_min, α_max)` of edge `e`.
+    #[inline]
+    pub fn edge_interval(&self, e: usize) -> (f64, f64) {
+        (self.edge_min[e], self.edge_max[e])
+    }
+
+    /// The id of the edge between vertex ids `a` and `b`, if it exists.
+    pub fn find_edge(&self, a: u32, b: u32) -> Option<usize> {
+        let (a, b) = if a < b { (a, b) } else { (b, a) };
+        let s = *self.edge_start.get(a as usize)? as usize;
+        let e = *self.edge_start.get(a as usize + 1)? as usize;
+        self.edge_v[s..e]
+            .iter()
+            .position(|x| x[1] == b)
+            .map(|k| s + k)
+    }
+
+    /// Vertex ids of triangle `f`, ordered so that its normal (right-hand
+    /// rule) points into the first of its two cells ([`Self::triangle_cells`]).
+    #[inline]
+    pub fn triangle_vertices(&self, f: usize) -> [u32; 3] {
+        let p = self.tri_face[f];
+        let (t, i) = (p >> 2, (p & 3) as usize);
+        let v = self.tri.tet(t);
+        let fi = FACE[i];
+        [v[fi[0]], v[fi[1]], v[fi[2]]]
+    }
+
+    /// The two cells on the sides of triangle `f` (the first has the
+    /// smaller id; either may be infinite).
+    #[inline]
+    pub fn triangle_cells(&self, f: usize) -> [u32; 2] {
+        let p = self.tri_face[f];
+        let (t, i) = (p >> 2, (p & 3) as usize);
+        [t, self.tri.neighbor(t, i).0]
+    }
+
+    /// `(α_min, α_max)` of triangle `f`.
+    #[inline]
+    pub fn triangle_interval(&self, f: usize) -> (f64, f64) {
+        (self.tri_min[f], self.tri_max[f])
+    }
+
+    /// Circumradius of cell `t` (`+∞` for an infinite cell).
+    #[inline]
+    pub fn tet_radius(&self, t: u32) -> f64 {
+        self.cell_r[t as usize]
+    }
+
+    /// Circumradii of all cells, indexed by cell id (`+∞` for infinite
+    /// cells); empty when the dimension is below 3.
+    pub fn tet_radii(&self) -> &[f64] {
+        &self.cell_r
+    }
+
+    /// The `α_min` values of all edges, indexed by edge id.
+    pub fn edge_alpha_min(&self) -> &[f64] {
+        &self.edge_min
+    }
+
+    /// The `α_max` values of all edges, indexed by edge id.
+    pub fn edge_alpha_max(&self) -> &[f64] {
+        &self.edge_max
+    }
+
+    /// The `α_min` values of all triangles, indexed by triangle id.
+    pub fn triangle_alpha_min(&self) -> &[f64] {
+        &self.tri_min
+    }
+
+    /// The `α_max` values of all triangles, indexed by triangle id.
+    pub fn triangle_alpha_max(&self) -> &[f64] {
+        &self.tri_max
+    }
+
+    fn input3(&self, v: [u32; 3]) -> [u32; 3] {
+        let mut w = v.map(|x| self.tri.input_index(x));
+        w.sort_unstable();
+        w
+    }
+
+    /// Every edge with its interval, vertices as ascending input indices.
+    pub fn edges(&self) -> impl Iterator<Item = EdgeInterval> + '_ {
+        (0..self.num_edges()).map(move |e| {
+            let [a, b] = self.edge_v[e].map(|x| self.tri.input_index(x));
+            EdgeInterval {
+                vertices: if a < b { [a, b] } else { [b, a] },
+                alpha_min: self.edge_min[e],
+                alpha_max: self.edge_max[e],
+            }
+        })
+    }
+
+    /// Every triangle with its interval, vertices as ascending input
+    /// indices.
+    pub fn triangles(&self) -> impl Iterator<Item = TriangleInterval> + '_ {
+        (0..self.num_triangles()).map(move |f| TriangleInterval {
+            vertices: self.input3(self.triangle_vertices(f)),
+            alpha_min: self.tri_min[f],
+            alpha_max: self.tri_max[f],
+        })
+    }
+
+    /// Ids of the edges of `F_{1,α}`: `α_min ≤ α ≤ α_max`.
+    pub fn edge_ids_at(&self, alpha: f64) -> impl Iterator<Item = usize> + '_ {
+        (0..self.num_edges())
+            .filter(move |&e| self.edge_min[e] <= alpha && alpha <= self.edge_max[e])
+    }
+
+    /// Ids of the triangles of `F_{2,α}`: `α_min ≤ α ≤ α_max`.
+    pub fn triangle_ids_at(&self, alpha: f64) -> impl Iterator<Item = usize> + '_ {
+        (0..self.num_triangles())
+            .filter(move |&f| self.tri_min[f] <= alpha && alpha <= self.tri_max[f])
+    }
+
+    /// `F_{1,α}` as ascending input-index pairs.
+    pub fn edges_at(&self, alpha: f64) -> impl Iterator<Item = [u32; 2]> + '_ {
+        self.edge_ids_at(alpha).map(move |e| {
+            let [a, b] = self.edge_v[e].map(|x| self.tri.input_index(x));
+            if a < b {
+                [a, b]
+            } else {
+                [b, a]
+            }
+        })
+    }
+
+    /// `F_{2,α}` as ascending input-index triples.
+    pub fn triangles_at(&self, alpha: f64) -> impl Iterator<Item = [u32; 3]> + '_ {
+        self.triangle_ids_at(alpha)
+            .map(move |f| self.input3(self.triangle_vertices(f)))
+    }
+
+    /// The α spectrum: every distinct finite critical value, ascending —
+    /// the `α_min` and finite `α_max` of all edges and triangles and the
+    /// circumradii of all finite tetrahedra (the values at which the
+    /// α-complex or `F_α` changes).
+    pub fn spectrum(&self) -> Vec<f64> {
+        let mut v: Vec<f64> = self
+            .edge_min
+            .iter()
+            .chain(&self.edge_max)
+            .chain(&self.tri_min)
+            .chain(&self.tri_max)
+            .chain(&self.cell_r)
+            .copied()
+            .filter(|x| x.is_finite())
+            .collect();
+        v.sort_unstable_by(f64::total_cmp);
+        v.dedup();
+        v
+    }
+
+    /// The boundary of the α-complex's solid part as an oriented triangle
+    /// mesh (input indices): the *regular* triangles at `α`, those with
+    /// exactly one side a finite tet of circumradius ≤ α (the other side
+    /// is a larger tet or outside the hull). Each is oriented so that its
+    /// normal (right-hand rule, `(b − a) × (c − a)`) points away from that
+    /// interior tet, like the surfaces CGAL and Open3D produce. Singular
+    /// triangles (in `F_α` with no solid on either side) are not included;
+    /// see [`Self::triangles_at`].
+    pub fn regular_surface(&self, alpha: f64) -> Vec<[u32; 3]> {
+        let mut out = Vec::new();
+        for f in 0..self.num_triangles() {
+            if !(self.tri_min[f] <= alpha && alpha < self.tri_max[f]) {
+                continue;
+            }
+            let [t, n] = self.triangle_cells(f);
+            let in_t = self.cell_r[t as usize] <= alpha;
+            let in_n = self.cell_r[n as usize] <= alpha;
+            if in_t == in_n {
+                continue;
+            }
+            let [a, b, c] = self.triangle_vertices(f).map(|x| self.tri.input_index(x));
+            // The normal of (a, b, c) points into t.
+            out.push(if in_t { [a, c, b] } else { [a, b, c] });
+        }
+        out
+    }
+
+    /// The smallest α at which the α-complex is one solid holding every
+    /// point, or `None` when there are no tetrahedra.
+    ///
+    /// Precisely: the smallest α such that the finite tetrahedra of
+    /// circumradius ≤ α (a) have every vertex among their corners and (b)
+    /// form a single component when two tets sharing a triangle are joined.
+    /// This is CGAL's `find_optimal_alpha(1)` reading of "one solid
+    /// component containing all the points". It is always at most the
+    /// largest circumradius (at that value every finite tet is in).
+    ///
+    /// Computed by a union-find over the tets sorted by radius, checking
+    /// the two conditions after each group of equal radii.
+    pub fn optimal_alpha(&self) -> Option<f64> {
+        let nf = self.tri.num_finite_tets();
+        if nf == 0 || self.cell_r.is_empty() {
+            return None;
+        }
+        let mut order: Vec<u32> = (0..self.cell_r.len() as u32)
+            .filter(|&t| !self.tri.is_infinite(t))
+            .collect();
+        order
+            .sort_unstable_by(|&a, &b| self.cell_r[a as usize].total_cmp(&self.cell_r[b as usize]));
+        let mut parent: Vec<u32> = (0..self.cell_r.len() as u32).collect();
+        let mut added = vec![false; self.cell_r.len()];
+        let mut covered = vec![false; self.tri.num_vertices()];
+        let mut n_covered = 0usize;
+        let mut components = 0usize;
+        let nv = self.tri.num_vertices();
+        let mut k = 0;
+        while k < order.len() {
+            let r = self.cell_r[order[k] as usize];
+            while k < order.len() && self.cell_r[order[k] as usize] == r {
+                let t = order[k];
+                k += 1;
+                added[t as usize] = true;
+                components += 1;
+                for &v in &self.tri.tet(t) {
+                    if !covered[v as usize] {
+                        covered[v as usize] = true;
+                        n_covered += 1;
+                    }
+                }
+                for i in 0..4 {
+                    let (n, _) = self.tri.neighbor(t, i);
+                    if added[n as usize] {
+                        let (ra, rb) = (find(&mut parent, t), find(&mut parent, n));
+                        if ra != rb {
+                            parent[ra as usize] = rb;
+                            components -= 1;
+                        }
+                    }
+                }
+            }
+            if components == 1 && n_covered == nv {
+                return Some(r);
+            }
+        }
+        // Unreachable for a valid triangulation (all finite tets form one
+        // face-connected solid), kept total.
+        order.last().map(|&t| self.cell_r[t as usize])
+    }
+
+    /// Steps 3–4 of the algorithm (module docs).
+    fn compute_triangles_and_edges(&mut self) {
+        let tri = &self.tri;
+        let pts = tri.points();
+        let nt = tri.num_triangles();
+        let mut tri_face = Vec::with_capacity(nt);
+        let mut tri_min = Vec::with_capacity(nt);
+        let mut tri_max = Vec::with_capacity(nt);
+        let mut non_gabriel = vec![false; self.edge_v.len()];
+        let edge_v = &self.edge_v;
+        let edge_start = &self.edge_start;
+        let edge_min = &mut self.edge_min;
+        let edge_max = &mut self.edge_max;
+        let cell_r = &self.cell_r;
+        let lookup = |a: u32, b: u32| -> usize {
+            let (a, b) = if a < b { (a, b) } else { (b, a) };
+            let s = edge_start[a as usize] as usize;
+            let mut e = s;
+            while edge_v[e][1] != b {
+                e += 1;
+            }
+            e
+        };
+        for t in 0..tri.num_tets() as u32 {
+            let v = tri.tet(t);
+            let finite = v[3] != INFINITE;
+            for i in 0..4 {
+                if !finite && i != 3 {
+                    continue;
+                }
+                let (n, j) = tri.neighbor(t, i);
+                if n < t {
+                    continue;
+                }
+                let f = FACE[i];
+                let (ia, ib, ic) = (v[f[0]], v[f[1]], v[f[2]]);
+                let (a, b, c) = (&pts[ia as usize], &pts[ib as usize], &pts[ic as usize]);
+                let apex_t = v[i];
+                let apex_n = tri.tet(n)[j];
+                let (rho, gabriel) = triangle_rho_gabriel(a, b, c, apex_t, apex_n, pts);
+                let rt = cell_r[t as usize];
+                let rn = cell_r[n as usize];
+                let amax = rt.max(rn);
+                let amin = if gabriel { rho } else { rt.min(rn) };
+                tri_face.push((t << 2) | i as u32);
+                tri_min.push(amin);
+                tri_max.push(amax);
+                // Push to the three edges.
+                for (x, y, z) in [(ia, ib, ic), (ib, ic, ia), (ic, ia, ib)] {
+                    let e = lookup(x, y);
+                    if amax > edge_max[e] {
+                        edge_max[e] = amax;
+                    }
+                    if amin < edge_min[e] {
+                        edge_min[e] = amin;
+                    }
+                    if !non_gabriel[e]
+                        && exact::edge_diametral_side(
+                            &pts[x as usize],
+                            &pts[y as usize],
+                            &pts[z as usize],
+                        ) < 0
+                    {
+                        non_gabriel[e] = true;
+                    }
+                }
+            }
+        }
+        for (e, &[a, b]) in edge_v.iter().enumerate() {
+            if !non_gabriel[e] {
+                let (p, q) = (&pts[a as usize], &pts[b as usize]);
+                let d = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
+                edge_min[e] = 0.5 * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            }
+        }
+        self.tri_face = tri_face;
+        self.tri_min = tri_min;
+        self.tri_max = tri_max;
+    }
+}
+
+/// Union-find root with path halving.
+fn find(parent: &mut [u32], mut x: u32) -> u32 {
+    while parent[x as usize] != x {
+        let p = parent[parent[x as usize] as usize];
+        parent[x as usize] = p;
+        x = p;
+    }
+    x
+}
+
+/// Circumradius of every cell (`+∞` for infinite cells).
+fn cell_radii(tri: &Triangulation) -> Vec<f64> {
+    let pts = tri.points();
+    (0..tri.num_tets() as u32)
+        .map(|t| {
+            let v = tri.tet(t);
+            if v[3] == INFINITE {
+                f64::INFINITY
+            } else {
+                let p = |k: usize| &pts[v[k] as usize];
+                exact::tet_radius2(p(0), p(1), p(2), p(3)).sqrt()
+            }
+        })
+        .collect()
+}
+
+/// Numbers the finite edges by `(a, b)`, `a < b` (vertex ids), with a
+/// counting sort of the 6 edges of every finite tet on `a` and a per-vertex
+/// sort + dedup. Returns the edges and the per-vertex offsets.
+fn number_edges(tri: &Triangulation) -> (Vec<[u32; 2]>, Vec<u32>) {
+    let nv = tri.num_vertices();
+    let nc = tri.num_tets() as u32;
+    let mut start = vec![0u32; nv + 1];
+    for t in 0..nc {
+        let v = tri.tet(t);
+        if v[3] == INFINITE {
+            continue;
+        }
+        for [i, j] in PAIRS {
+            start[v[i].min(v[j]) as usize + 1] += 1;
+        }
+    }
+    for k in 0..nv {
+        start[k + 1] += start[k];
+    }
+    let mut fill: Vec<u32> = start[..nv].to_vec();
+    let mut buf = vec![0u32; start[nv] as usize];
+    for t in 0..nc {
+        let v = tri.tet(t);
+        if v[3] == INFINITE {
+            continue;
+        }
+        for [i, j] in PAIRS {
+            let (a, b) = if v[i] < v[j] {
+                (v[i], v[j])
+            } else {
+                (v[j], v[i])
+            };
+            let slot = &mut fill[a as usize];
+            buf[*slot as usize] = b;
+            *slot += 1;
+        }
+    }
+    drop(fill);
+    // Euler: V − E + F − T = 1 for the (ball-shaped) finite complex.
+    let nf = tri.num_triangles();
+    let ne_guess = (nv + nf).saturating_sub(tri.num_finite_tets() + 1);
+    let mut edges: Vec<[u32; 2]> = Vec::with_capacity(ne_guess);
+    let mut estart = vec![0u32; nv + 1];
+    for a in 0..nv {
+        let s = &mut buf[start[a] as usize..start[a + 1] as usize];
+        insertion_sort(s);
+        let mut last = u32::MAX;
+        for &b in s.iter() {
+            if b != last {
+                edges.push([a as u32, b]);
+                last = b;
+            }
+        }
+        estart[a + 1] = edges.len() as u32;
+    }
+    (edges, estart)
+}
+
+/// Sorts a short slice (a vertex's bucket holds a few dozen entries).
+fn insertion_sort(s: &mut [u32]) {
+    if s.len() > 64 {
+        s.sort_unstable();
+        return;
+    }
+    for i in 1..s.len() {
+        let x = s[i];
+        let mut j = i;
+        while j > 0 && s[j - 1] > x {
+            s[j] = s[j - 1];
+            j -= 1;
+        }
+        s[j] = x;
+    }
+}
+
+/// Circumradius of the triangle `abc` and whether it is Gabriel with
+/// respect to the apexes of its two cells (vertex ids, [`INFINITE`] for
+/// none).
+#[inline]
+fn triangle_rho_gabriel(
+    a: &Point3,
+    b: &Point3,
+    c: &Point3,
+    apex_t: u32,
+    apex_n: u32,
+    pts: &[Point3],
+) -> (f64, bool) {
+    let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+    let d = [c[0] - b[0], c[1] - b[1], c[2] - b[2]];
+    let uu = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
+    let vv = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+    let dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    let uv = u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+    let nn = exact::cross_norm2(a, b, c, &u, &v);
+    // R = |u| |v| |c − b| / (2 |u × v|): no cancellation in the numerator.
+    let rho = 0.5 * ((uu * vv * dd) / nn).sqrt();
+    let mut gabriel = true;
+    for apex in [apex_t, apex_n] {
+        if apex == INFINITE || !gabriel {
+            continue;
+        }
+        let p = &pts[apex as usize];
+        let w = [p[0] - a[0], p[1] - a[1], p[2] - a[2]];
+        let ww = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+        let wu = w[0] * u[0] + w[1] * u[1] + w[2] * u[2];
+        let wv = w[0] * v[0] + w[1] * v[1] + w[2] * v[2];
+        let dv = ww * nn - wu * vv * (uu - uv) - wv * uu * (vv - uv);
+        let s = match exact::triangle_filter(&u, &v, &w, uu, vv, ww, dv) {
+            Some(s) => s,
+            None => exact::triangle_diametral_side(a, b, c, p),
+        };
+        if s < 0 {
+            gabriel = false;
+        }
+    }
+    (rho, gabriel)
+}
+
+/// `Q = diag(e)·R`: row `i` of the rotation `r` scaled by `e[i]`
+/// (`Q_ij = e_i·R_ij`, one rounding each).
+///
+/// ```
+/// use aniso_alpha::alpha::q_matrix;
+/// let r = [[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]];
+/// assert_eq!(q_matrix(&r, &[2.0, 1.0, 0.5]), [[0.0, 2.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 0.5]]);
+/// ```
+pub fn q_matrix(rotation: &[[f64; 3]; 3], elongation: &[f64; 3]) -> [[f64; 3]; 3] {
+    std::array::from_fn(|i| rotation[i].map(|x| elongation[i] * x))
+}
+
+/// `q_i = (Q_i1·x + Q_i2·y) + Q_i3·z` for every point, each operation
+/// rounded in that order (no fused multiply-add).
+fn transform_points(points: &[[f64; 3]], q: &[[f64; 3]; 3]) -> Vec<[f64; 3]> {
+    points
+        .iter()
+        .map(|p| std::array::from_fn(|i| (q[i][0] * p[0] + q[i][1] * p[1]) + q[i][2] * p[2]))
+        .collect()
+}
