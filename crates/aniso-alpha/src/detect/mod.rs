@@ -6,12 +6,16 @@
 //! * [`filter`]: the path filter (SPEC §3) and connected components;
 //! * [`fit`]: least-squares lines and planes;
 //! * [`parts`]: splitting structures into straight/flat parts, and point
-//!   labelling.
+//!   labelling;
+//! * [`prune`]: exact removal of points isolated at distance 2α;
+//! * [`detector`]: the whole §4 pipeline over many orientations.
 
+pub mod detector;
 pub mod filter;
 pub mod fit;
 pub mod orientations;
 pub mod parts;
+pub mod prune;
 
 /// Which structures are sought: k = 1 (lines, edges) or k = 2 (planes,
 /// triangles).

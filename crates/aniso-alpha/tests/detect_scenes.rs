@@ -1,0 +1,179 @@
+//! End-to-end detection on the synthetic scenes with the paper's
+//! parameters (SPEC §5), scored as in SPEC §6.
+
+use aniso_alpha::detect::detector::{Detection, Detector};
+use aniso_alpha::eval::{evaluate, Evaluation};
+use aniso_alpha::synth::{Scene, SceneOptions};
+
+fn score(scene: &Scene, det: &Detection) -> Evaluation {
+    evaluate(
+        &scene.labels,
+        Some(&scene.parts),
+        &det.labels,
+        Some(&det.part_labels()),
+    )
+    .unwrap()
+}
+
+#[test]
+fn fig12_lines() {
+    for seed in 1..=3 {
+        let scene = SceneOptions::lines().seed(seed).generate().unwrap();
+        let det = Detector::lines(1.0, 10.0, 4).run(&scene.points).unwrap();
+        let ev = score(&scene, &det);
+        eprintln!(
+            "lines seed {seed}: {} structures\n{ev}",
+            det.structures.len()
+        );
+        assert_eq!(det.stats.orientations, 162);
+        assert!(ev.f1 >= 0.85, "lines seed {seed}: F1 {}", ev.f1);
+        assert!(ev.structures_found >= 4, "lines seed {seed}: {ev}");
+    }
+}
+
+#[test]
+fn fig10_polyhedron() {
+    for seed in 1..=2 {
+        let scene = SceneOptions::polyhedron().seed(seed).generate().unwrap();
+        let det = Detector::planes(1.0, 4.0, 8.0, 20)
+            .run(&scene.points)
+            .unwrap();
+        let ev = score(&scene, &det);
+        eprintln!(
+            "polyhedron seed {seed}: {} structures\n{ev}",
+            det.structures.len()
+        );
+        assert_eq!(det.stats.orientations, 1944);
+        assert!(ev.f1 >= 0.9, "polyhedron seed {seed}: F1 {}", ev.f1);
+        // One polyhedral surface, found as one structure with its facets.
+        assert_eq!(ev.structures_found, 1, "{ev}");
+        assert!(ev.parts_found >= 4, "{ev}");
+    }
+}
+
+#[test]
+fn fig5_planes() {
+    for seed in 1..=2 {
+        let scene = SceneOptions::planes().seed(seed).generate().unwrap();
+        let det = Detector::planes(1.0, 4.0, 8.0, 20)
+            .run(&scene.points)
+            .unwrap();
+        let ev = score(&scene, &det);
+        eprintln!(
+            "planes seed {seed}: {} structures\n{ev}",
+            det.structures.len()
+        );
+        assert!(ev.f1 >= 0.9, "planes seed {seed}: F1 {}", ev.f1);
+        assert_eq!(ev.structures_found, scene.num_structures(), "{ev}");
+    }
+}
+
+#[test]
+fn crossing_planes_are_two_structures() {
+    let scene = SceneOptions::planes()
+        .seed(3)
+        .structures(2)
+        .crossing(true)
+        .generate()
+        .unwrap();
+    let det = Detector::planes(1.0, 4.0, 8.0, 20)
+        .run(&scene.points)
+        .unwrap();
+    let ev = score(&scene, &det);
+    eprintln!("crossing planes: {} structures\n{ev}", det.structures.len());
+    assert_eq!(ev.structures_found, 2, "{ev}");
+    assert!(ev.f1 >= 0.9, "{ev}");
+}
+
+#[test]
+fn crossing_lines_are_separate_structures() {
+    let scene = SceneOptions::lines()
+        .seed(4)
+        .crossing(true)
+        .generate()
+        .unwrap();
+    let det = Detector::lines(1.0, 10.0, 4).run(&scene.points).unwrap();
+    let ev = score(&scene, &det);
+    eprintln!("crossing lines: {} structures\n{ev}", det.structures.len());
+    assert!(ev.structures_found + 1 >= scene.num_structures(), "{ev}");
+    assert!(ev.f1 >= 0.85, "{ev}");
+}
+
+#[test]
+fn euclidean_alpha_shape_does_clearly_worse_on_lines() {
+    // The paper's own comparison: E = (1, 1, 1), one orientation, at its
+    // best α over a scan.
+    let scene = SceneOptions::lines().seed(1).generate().unwrap();
+    let aniso = score(
+        &scene,
+        &Detector::lines(1.0, 10.0, 4).run(&scene.points).unwrap(),
+    );
+    let id = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    let mut best = (0.0, 0.0);
+    for k in 1..=40 {
+        let alpha = 0.5 * k as f64;
+        let det = Detector::lines(alpha, 1.0, 4)
+            .rotations(vec![id])
+            .run(&scene.points)
+            .unwrap();
+        let f1 = score(&scene, &det).f1;
+        if f1 > best.0 {
+            best = (f1, alpha);
+        }
+    }
+    eprintln!(
+        "lines: anisotropic F1 {:.3}, Euclidean best F1 {:.3} at alpha {}",
+        aniso.f1, best.0, best.1
+    );
+    assert!(best.0 + 0.2 < aniso.f1, "{} vs {}", best.0, aniso.f1);
+}
+
+#[test]
+fn output_does_not_depend_on_thread_count() {
+    let scene = SceneOptions::polyhedron().seed(5).generate().unwrap();
+    let d = Detector::planes(1.0, 4.0, 8.0, 20);
+    let many = d.run(&scene.points).unwrap();
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap()
+        .install(|| d.run(&scene.points).unwrap());
+    assert_eq!(many, one);
+}
+
+#[test]
+fn pruning_is_exact() {
+    // Same union with and without pruning, on a smaller orientation set.
+    use aniso_alpha::detect::orientations::Sampler;
+    let scene = SceneOptions::lines().seed(2).generate().unwrap();
+    let d = Detector::lines(1.0, 10.0, 4).sampler(Sampler::Fibonacci { step_degrees: 20.0 });
+    let with = d.clone().run(&scene.points).unwrap();
+    let without = d.prune(false).run(&scene.points).unwrap();
+    assert_eq!(with.simplices, without.simplices);
+    assert_eq!(with.stats.union_simplices, without.stats.union_simplices);
+    assert!(with.stats.triangulated_points * 3 < without.stats.triangulated_points);
+}
+
+#[test]
+fn progress_and_cancellation() {
+    let scene = SceneOptions::lines().seed(1).generate().unwrap();
+    let calls = std::sync::atomic::AtomicUsize::new(0);
+    let cb = |done: usize, total: usize| {
+        assert!(done <= total);
+        calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        true
+    };
+    Detector::lines(1.0, 10.0, 4)
+        .progress(&cb)
+        .run(&scene.points)
+        .unwrap();
+    assert_eq!(calls.load(std::sync::atomic::Ordering::Relaxed), 162);
+    let stop = |done: usize, _| done < 5;
+    let r = Detector::lines(1.0, 10.0, 4)
+        .progress(&stop)
+        .run(&scene.points);
+    assert_eq!(
+        r,
+        Err(aniso_alpha::detect::detector::DetectError::Cancelled)
+    );
+}
