@@ -98,7 +98,7 @@ pub(crate) fn read_text(
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
     let n = bytes.len();
     let needed = match label_column {
-        Some(c) => c.max(2) + 1,
+        Some(c) => c.max(2).saturating_add(1),
         None => 3,
     };
     let mut points: Vec<[f64; 3]> = Vec::with_capacity(n / 32 + 1);
@@ -282,6 +282,16 @@ mod tests {
         assert_eq!(
             e.to_string(),
             "s.xyz:1: invalid label 'a' in column 4 (expected an integer)"
+        );
+    }
+
+    #[test]
+    fn huge_label_column_is_an_error_not_an_overflow() {
+        let e = read_text(Path::new("s.xyz"), b"0 0 0 1\n", Some(usize::MAX)).unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("s.xyz:1: expected a label in column"),
+            "{e}"
         );
     }
 
