@@ -96,6 +96,17 @@ pub(crate) fn read_text(
     label_column: Option<usize>,
 ) -> Result<PointCloud, IoError> {
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    // Classic Mac line ends (CR only) would otherwise read as one line.
+    let converted: Vec<u8>;
+    let bytes = if !bytes.contains(&b'\n') && bytes.contains(&b'\r') {
+        converted = bytes
+            .iter()
+            .map(|&b| if b == b'\r' { b'\n' } else { b })
+            .collect();
+        &converted[..]
+    } else {
+        bytes
+    };
     let n = bytes.len();
     let needed = match label_column {
         Some(c) => c.max(2).saturating_add(1),
@@ -259,6 +270,13 @@ mod tests {
             vec![[1.0, 2.0, 3.0], [4.0, 5.0, 6.0], [7.0, 8.0, 9.0]]
         );
         assert_eq!(c.labels, None);
+        // CR-only line ends.
+        let c = read("x y z\r1 2 3\r4 5 6\r").unwrap();
+        assert_eq!(c.points, vec![[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]]);
+        assert_eq!(
+            err("1 2 3\r4 5\r"),
+            "t.xyz:2: expected 3 numeric columns, found 2"
+        );
         // No trailing newline; exponent and signs.
         let c = read("1e3 -2.5E-1 +0").unwrap();
         assert_eq!(c.points, vec![[1000.0, -0.25, 0.0]]);
