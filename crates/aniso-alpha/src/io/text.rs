@@ -5,7 +5,8 @@
 //! that runs to the end of the line. Blank lines are skipped. The first
 //! non-blank, non-comment line is a header, and skipped, when its first
 //! column is not a number; no other line may be a header. Columns past x, y,
-//! z (and the label column) are ignored.
+//! z (and the label column) are ignored. A first line holding a single
+//! number (the point count that `.pts` files start with) is skipped too.
 
 use std::path::Path;
 
@@ -181,6 +182,11 @@ pub(crate) fn read_text(
         if col == 0 {
             continue; // blank or comment line
         }
+        if col == 1 && !seen_content {
+            // A lone number first: the point count line of `.pts` files.
+            seen_content = true;
+            continue;
+        }
         seen_content = true;
         if col < 3 {
             return Err(IoError::parse(
@@ -270,6 +276,13 @@ mod tests {
             vec![[1.0, 2.0, 3.0], [4.0, 5.0, 6.0], [7.0, 8.0, 9.0]]
         );
         assert_eq!(c.labels, None);
+        // Leica PTS: a count line, then x y z intensity r g b.
+        let c = read("2\n1 2 3 -1200 10 20 30\n4 5 6 0 1 2 3\n").unwrap();
+        assert_eq!(c.points, vec![[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]]);
+        assert_eq!(
+            err("1 2 3\n2\n"),
+            "t.xyz:2: expected 3 numeric columns, found 1"
+        );
         // CR-only line ends.
         let c = read("x y z\r1 2 3\r4 5 6\r").unwrap();
         assert_eq!(c.points, vec![[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]]);
