@@ -48,6 +48,16 @@ fn bench(c: &mut Criterion) {
     g.bench_function("xyz", |b| {
         b.iter(|| read_xyz_bytes(Path::new("b.xyz"), black_box(&text), &opts).unwrap())
     });
+    // Shortest round-trip output (~17 digits): the standard parser's path.
+    let full: Vec<u8> = pts
+        .iter()
+        .map(|p| format!("{} {} {}\n", p[0], p[1], p[2]))
+        .collect::<String>()
+        .into_bytes();
+    g.throughput(Throughput::Bytes(full.len() as u64));
+    g.bench_function("xyz_full_precision", |b| {
+        b.iter(|| read_xyz_bytes(Path::new("b.xyz"), black_box(&full), &opts).unwrap())
+    });
     g.throughput(Throughput::Bytes(csv.len() as u64));
     g.bench_function("csv", |b| {
         b.iter(|| read_xyz_bytes(Path::new("b.csv"), black_box(&csv), &opts).unwrap())

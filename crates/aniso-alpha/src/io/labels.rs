@@ -61,15 +61,50 @@ pub fn read_labels_bytes(name: &Path, bytes: &[u8]) -> Result<Vec<i64>, IoError>
 /// ```
 pub fn write_labels(path: &Path, labels: &[i64]) -> Result<(), IoError> {
     atomic_write(path, |w| {
-        let mut buf = String::with_capacity(1 << 16);
+        let mut buf = Vec::with_capacity(4096 * 21);
         for chunk in labels.chunks(4096) {
             buf.clear();
-            for v in chunk {
-                buf.push_str(&v.to_string());
-                buf.push('\n');
+            for &v in chunk {
+                push_i64(&mut buf, v);
+                buf.push(b'\n');
             }
-            w.write_all(buf.as_bytes())?;
+            w.write_all(&buf)?;
         }
         Ok(())
     })
+}
+
+/// Appends the decimal form of `v` (no allocation).
+fn push_i64(buf: &mut Vec<u8>, v: i64) {
+    if v < 0 {
+        buf.push(b'-');
+    }
+    let mut m = v.unsigned_abs();
+    let mut tmp = [0u8; 20];
+    let mut i = tmp.len();
+    loop {
+        i -= 1;
+        tmp[i] = b'0' + (m % 10) as u8;
+        m /= 10;
+        if m == 0 {
+            break;
+        }
+    }
+    buf.extend_from_slice(&tmp[i..]);
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn integers() {
+        let mut b = Vec::new();
+        for v in [0, -1, 42, i64::MIN, i64::MAX] {
+            super::push_i64(&mut b, v);
+            b.push(b' ');
+        }
+        assert_eq!(
+            String::from_utf8(b).unwrap(),
+            "0 -1 42 -9223372036854775808 9223372036854775807 "
+        );
+    }
 }

@@ -4,7 +4,7 @@
 //!
 //! | extension | format |
 //! |---|---|
-//! | `.xyz` `.txt` `.csv` `.pts` | text: x y z in the first three columns, whitespace or commas, `#` comments, one optional header line |
+//! | `.xyz` `.txt` `.csv` `.pts` | text: x y z in the first three columns, whitespace or commas, `#` comments, one optional header line (or the point count line of `.pts`) |
 //! | `.ply` | PLY ascii, binary little- or big-endian; x/y/z of any scalar type |
 //! | `.las` `.laz` | LAS/LAZ with scale and offset applied (cargo feature `las`) |
 //! | `.pcd` | PCD ascii, binary and binary_compressed |

@@ -5,7 +5,8 @@
 //! that runs to the end of the line. Blank lines are skipped. The first
 //! non-blank, non-comment line is a header, and skipped, when its first
 //! column is not a number; no other line may be a header. Columns past x, y,
-//! z (and the label column) are ignored.
+//! z (and the label column) are ignored. A first line holding a single
+//! number (the point count that `.pts` files start with) is skipped too.
 
 use std::path::Path;
 
@@ -96,9 +97,20 @@ pub(crate) fn read_text(
     label_column: Option<usize>,
 ) -> Result<PointCloud, IoError> {
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    // Classic Mac line ends (CR only) would otherwise read as one line.
+    let converted: Vec<u8>;
+    let bytes = if !bytes.contains(&b'\n') && bytes.contains(&b'\r') {
+        converted = bytes
+            .iter()
+            .map(|&b| if b == b'\r' { b'\n' } else { b })
+            .collect();
+        &converted[..]
+    } else {
+        bytes
+    };
     let n = bytes.len();
     let needed = match label_column {
-        Some(c) => c.max(2) + 1,
+        Some(c) => c.max(2).saturating_add(1),
         None => 3,
     };
     let mut points: Vec<[f64; 3]> = Vec::with_capacity(n / 32 + 1);
@@ -169,6 +181,11 @@ pub(crate) fn read_text(
         }
         if col == 0 {
             continue; // blank or comment line
+        }
+        if col == 1 && !seen_content {
+            // A lone number first: the point count line of `.pts` files.
+            seen_content = true;
+            continue;
         }
         seen_content = true;
         if col < 3 {
@@ -259,6 +276,20 @@ mod tests {
             vec![[1.0, 2.0, 3.0], [4.0, 5.0, 6.0], [7.0, 8.0, 9.0]]
         );
         assert_eq!(c.labels, None);
+        // Leica PTS: a count line, then x y z intensity r g b.
+        let c = read("2\n1 2 3 -1200 10 20 30\n4 5 6 0 1 2 3\n").unwrap();
+        assert_eq!(c.points, vec![[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]]);
+        assert_eq!(
+            err("1 2 3\n2\n"),
+            "t.xyz:2: expected 3 numeric columns, found 1"
+        );
+        // CR-only line ends.
+        let c = read("x y z\r1 2 3\r4 5 6\r").unwrap();
+        assert_eq!(c.points, vec![[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]]);
+        assert_eq!(
+            err("1 2 3\r4 5\r"),
+            "t.xyz:2: expected 3 numeric columns, found 2"
+        );
         // No trailing newline; exponent and signs.
         let c = read("1e3 -2.5E-1 +0").unwrap();
         assert_eq!(c.points, vec![[1000.0, -0.25, 0.0]]);
@@ -282,6 +313,16 @@ mod tests {
         assert_eq!(
             e.to_string(),
             "s.xyz:1: invalid label 'a' in column 4 (expected an integer)"
+        );
+    }
+
+    #[test]
+    fn huge_label_column_is_an_error_not_an_overflow() {
+        let e = read_text(Path::new("s.xyz"), b"0 0 0 1\n", Some(usize::MAX)).unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("s.xyz:1: expected a label in column"),
+            "{e}"
         );
     }
 
