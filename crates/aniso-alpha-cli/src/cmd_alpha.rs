@@ -1,11 +1,17 @@
 //! `aniso-alpha alpha`: alpha-shape intervals, or the shape at one alpha.
 
+use std::io::Write;
 use std::path::PathBuf;
 
-use aniso_alpha::io::ReadOptions;
+use aniso_alpha::alpha::AlphaComplex;
+use aniso_alpha::aniso::Anisotropy;
+use aniso_alpha::delaunay::Triangulation;
+use aniso_alpha::io::{Mesh, ReadOptions};
 use clap::Args;
 
-use crate::common::{self, parse_positive, parse_positive_triple, parse_triple, CliError, Timings};
+use crate::common::{
+    self, parse_positive, parse_positive_triple, parse_triple, push_u32, CliError, Timings,
+};
 
 /// Arguments of `alpha`.
 #[derive(Debug, Args)]
@@ -46,6 +52,117 @@ pub fn run(args: &AlphaArgs, timings: &mut Timings) -> Result<(), CliError> {
         common::check_mesh_output(out)?;
     }
     let cloud = common::read_input(&args.input, &ReadOptions::default(), timings)?;
-    let _ = cloud;
-    Err(CliError::not_available("alpha"))
+    let e = args.elongation.unwrap_or([1.0, 1.0, 1.0]);
+    let [theta, psi, phi] = args.euler.unwrap_or([0.0, 0.0, 0.0]);
+    let aniso = Anisotropy::from_euler(theta, psi, phi, e)?;
+    let euclidean = args.elongation.is_none() && args.euler.is_none();
+    let bar = common::spinner("triangulating");
+    let tri = timings
+        .phase("triangulate", || {
+            if euclidean {
+                Triangulation::new(&cloud.points)
+            } else {
+                Triangulation::new(&aniso.transform(&cloud.points))
+            }
+        })
+        .map_err(|err| CliError::in_file(&args.input, err))?;
+    bar.set_message("alpha intervals");
+    let ac = timings.phase("intervals", || AlphaComplex::new(tri));
+    bar.finish_and_clear();
+    if ac.triangulation().dimension() < 3 {
+        common::info(format_args!(
+            "{}: the points span {} dimension(s): no tetrahedra, so no alpha intervals",
+            args.input.display(),
+            ac.triangulation().dimension()
+        ));
+    }
+    if let Some(path) = &args.intervals {
+        common::write_output(path, timings, |w| write_intervals(w, &ac))?;
+        common::info(format_args!(
+            "{} edges, {} triangles -> {}",
+            ac.num_edges(),
+            ac.num_triangles(),
+            path.display()
+        ));
+    }
+    if let (Some(alpha), Some(path)) = (args.alpha, &args.output) {
+        let faces: Vec<[u32; 3]> = ac.triangles_at(alpha).collect();
+        // Edges of F_alpha that bound no triangle of F_alpha.
+        let mut in_tri: Vec<[u32; 2]> = faces
+            .iter()
+            .flat_map(|t| [[t[0], t[1]], [t[0], t[2]], [t[1], t[2]]])
+            .collect();
+        in_tri.sort_unstable();
+        in_tri.dedup();
+        let edges: Vec<[u32; 2]> = ac
+            .edges_at(alpha)
+            .filter(|e| in_tri.binary_search(e).is_err())
+            .collect();
+        let mesh = Mesh {
+            points: &cloud.points,
+            labels: None,
+            edges: &edges,
+            faces: &faces,
+        };
+        common::write_mesh(path, &mesh, timings)?;
+        common::info(format_args!(
+            "alpha {alpha}: {} triangles, {} dangling edges -> {}",
+            faces.len(),
+            edges.len(),
+            path.display()
+        ));
+    }
+    Ok(())
+}
+
+/// `dim,v0,v1,v2,alpha_min,alpha_max`, edges then triangles, each sorted
+/// by vertices; values in Rust's shortest round-trip form, `inf` unbounded.
+fn write_intervals(w: &mut dyn Write, ac: &AlphaComplex) -> std::io::Result<()> {
+    let mut edges: Vec<_> = ac.edges().collect();
+    edges.sort_unstable_by_key(|e| e.vertices);
+    let mut tris: Vec<_> = ac.triangles().collect();
+    tris.sort_unstable_by_key(|t| t.vertices);
+    let mut buf = Vec::with_capacity(1 << 20);
+    buf.extend_from_slice(b"dim,v0,v1,v2,alpha_min,alpha_max\n");
+    let num = |buf: &mut Vec<u8>, x: f64| {
+        if x.is_infinite() {
+            buf.extend_from_slice(b"inf");
+        } else {
+            buf.extend_from_slice(format!("{x:?}").as_bytes());
+        }
+    };
+    for e in &edges {
+        buf.extend_from_slice(b"1,");
+        push_u32(&mut buf, e.vertices[0]);
+        buf.push(b',');
+        push_u32(&mut buf, e.vertices[1]);
+        buf.extend_from_slice(b",,");
+        num(&mut buf, e.alpha_min);
+        buf.push(b',');
+        num(&mut buf, e.alpha_max);
+        buf.push(b'\n');
+        if buf.len() > 1 << 20 {
+            w.write_all(&buf)?;
+            buf.clear();
+        }
+    }
+    for t in &tris {
+        buf.extend_from_slice(b"2,");
+        for (i, v) in t.vertices.iter().enumerate() {
+            if i > 0 {
+                buf.push(b',');
+            }
+            push_u32(&mut buf, *v);
+        }
+        buf.push(b',');
+        num(&mut buf, t.alpha_min);
+        buf.push(b',');
+        num(&mut buf, t.alpha_max);
+        buf.push(b'\n');
+        if buf.len() > 1 << 20 {
+            w.write_all(&buf)?;
+            buf.clear();
+        }
+    }
+    w.write_all(&buf)
 }

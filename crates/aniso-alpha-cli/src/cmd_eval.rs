@@ -4,6 +4,9 @@ use std::path::PathBuf;
 
 use clap::Args;
 
+use aniso_alpha::eval::evaluate;
+use serde_json::json;
+
 use crate::common::{self, CliError, Timings};
 
 /// Arguments of `eval`.
@@ -12,7 +15,11 @@ use crate::common::{self, CliError, Timings};
     after_help = "TRUTH is a point file with labels: text `x y z label` (label column set by \
 --label-column), PLY with a `structure` vertex property, PCD with a `label` field, LAS \
 classification. LABELS has one integer per line, as written by `detect --labels`.\n\n\
-Example:\n  aniso-alpha eval --truth scene.xyz --labels labels.txt --json"
+Scores (SPEC §6): per-point precision, recall and F1 of structure vs background, and \
+structures found (one detected structure holds at least half of a true structure's points, \
+and most of its own points are that structure's).\n\n\
+Examples:\n  aniso-alpha eval --truth scene.xyz --labels labels.txt --json\n  \
+aniso-alpha eval --truth poly.xyz --labels labels.txt --part-column 4 --part-labels parts.txt"
 )]
 pub struct EvalArgs {
     /// Ground-truth scene
@@ -27,6 +34,13 @@ pub struct EvalArgs {
     /// 0-based column of the label in a text truth file
     #[arg(long, value_name = "N", default_value_t = 3)]
     pub label_column: usize,
+    /// 0-based column of the true facet (part) id, to score parts too
+    /// (`synth polyhedron` writes it in column 4)
+    #[arg(long, value_name = "N")]
+    pub part_column: Option<usize>,
+    /// Detected part labels, one per line (`detect --part-labels`)
+    #[arg(long, value_name = "PARTS.txt", requires = "part_column")]
+    pub part_labels: Option<PathBuf>,
 }
 
 /// Runs `eval`.
@@ -42,5 +56,40 @@ pub fn run(args: &EvalArgs, timings: &mut Timings) -> Result<(), CliError> {
             args.truth.display()
         )));
     }
-    Err(CliError::not_available("eval"))
+    let truth_parts = match args.part_column {
+        Some(col) => Some(common::read_truth(&args.truth, col, timings)?.1),
+        None => None,
+    };
+    let predicted_parts = match &args.part_labels {
+        Some(p) => Some(timings.phase("read", || aniso_alpha::io::read_labels(p))?),
+        None => None,
+    };
+    let ev = timings.phase("eval", || {
+        evaluate(
+            &truth,
+            truth_parts.as_deref(),
+            &labels,
+            predicted_parts.as_deref(),
+        )
+    })?;
+    if args.json {
+        let v = json!({
+            "points": ev.points,
+            "true_positives": ev.true_positives,
+            "false_positives": ev.false_positives,
+            "false_negatives": ev.false_negatives,
+            "true_negatives": ev.true_negatives,
+            "precision": ev.precision,
+            "recall": ev.recall,
+            "f1": ev.f1,
+            "structures_total": ev.structures_total,
+            "structures_found": ev.structures_found,
+            "detected_structures": ev.detected_structures,
+            "parts_total": ev.parts_total,
+            "parts_found": ev.parts_found,
+        });
+        common::print_stdout(&format!("{v}\n"))
+    } else {
+        common::print_stdout(&format!("{ev}\n"))
+    }
 }

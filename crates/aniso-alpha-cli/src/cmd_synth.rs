@@ -4,7 +4,9 @@ use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
 
-use crate::common::{self, CliError, Timings};
+use aniso_alpha::synth::{write_xyz_labels, write_xyz_labels_parts, SceneOptions};
+
+use crate::common::{self, parse_positive, CliError, Timings};
 
 /// A benchmark scene kind.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -20,8 +22,13 @@ pub enum Scene {
 /// Arguments of `synth`.
 #[derive(Debug, Args)]
 #[command(
-    after_help = "Output: text `x y z label`, one point per line, label -1 for background.\n\n\
-Example:\n  aniso-alpha synth lines --seed 7 --output lines.xyz"
+    after_help = "Output: text `x y z label`, one point per line, label -1 for background \
+(plus a 5th column `part`, the facet id, for the polyhedron or with --parts). The scales \
+follow the paper's Observations 3 and 4 so that the paper's parameters work (lines: alpha 1, \
+lambda3 10, min-size 4; planes and polyhedron: alpha 1, lambda2 4, lambda3 8, min-size 20); \
+the command prints the matching detect line.\n\n\
+Examples:\n  aniso-alpha synth lines --seed 7 --output lines.xyz\n  \
+aniso-alpha synth planes --structures 2 --crossing --jitter 0.1 --output crossing.xyz"
 )]
 pub struct SynthArgs {
     /// Scene kind
@@ -33,10 +40,80 @@ pub struct SynthArgs {
     /// Output scene file
     #[arg(long, value_name = "OUT.xyz")]
     pub output: PathBuf,
+    /// Number of uniform background points (default: the paper's count)
+    #[arg(long, value_name = "N")]
+    pub background: Option<usize>,
+    /// Background density in points per alpha-ellipsoid (default 0.01);
+    /// sets the box size
+    #[arg(long, value_name = "X", value_parser = parse_positive)]
+    pub density: Option<f64>,
+    /// Gaussian jitter (standard deviation) of the structure points
+    #[arg(long, value_name = "SIGMA", default_value_t = 0.0)]
+    pub jitter: f64,
+    /// Sample the structures at random positions instead of on a grid
+    #[arg(long)]
+    pub random_sampling: bool,
+    /// Number of structures (lines or planes; not for the polyhedron)
+    #[arg(long, value_name = "N")]
+    pub structures: Option<usize>,
+    /// Make the structures cross (two lines through one point, planes
+    /// cutting each other)
+    #[arg(long)]
+    pub crossing: bool,
+    /// Also write the facet id of each point as a 5th column (polyhedron)
+    #[arg(long)]
+    pub parts: bool,
 }
 
 /// Runs `synth`.
-pub fn run(args: &SynthArgs, _timings: &mut Timings) -> Result<(), CliError> {
+pub fn run(args: &SynthArgs, timings: &mut Timings) -> Result<(), CliError> {
     common::check_output(&args.output)?;
-    Err(CliError::not_available("synth"))
+    let mut opts = match args.scene {
+        Scene::Lines => SceneOptions::lines(),
+        Scene::Planes => SceneOptions::planes(),
+        Scene::Polyhedron => SceneOptions::polyhedron(),
+    }
+    .seed(args.seed)
+    .jitter(args.jitter)
+    .random_sampling(args.random_sampling)
+    .crossing(args.crossing);
+    if let Some(n) = args.background {
+        opts = opts.background(n);
+    }
+    if let Some(x) = args.density {
+        opts = opts.background_per_ellipsoid(x);
+    }
+    if let Some(n) = args.structures {
+        opts = opts.structures(n);
+    }
+    let scene = timings.phase("synth", || opts.generate())?;
+    let with_parts = args.parts || args.scene == Scene::Polyhedron;
+    common::write_output(&args.output, timings, |w| {
+        let mut w = std::io::BufWriter::new(w);
+        if with_parts {
+            write_xyz_labels_parts(&scene, &mut w)?;
+        } else {
+            write_xyz_labels(&scene, &mut w)?;
+        }
+        std::io::Write::flush(&mut w)
+    })?;
+    let p = opts.paper_params();
+    let structure = if p.k == 1 { "lines" } else { "planes" };
+    let lambda2 = if p.k == 2 {
+        format!(" --lambda2 {}", p.lambda2)
+    } else {
+        String::new()
+    };
+    common::info(format_args!(
+        "{} points ({} structures) -> {}\ndetect with: aniso-alpha detect {} --structure {structure} \
+--alpha {}{lambda2} --lambda3 {} --min-size {}",
+        scene.points.len(),
+        scene.num_structures(),
+        args.output.display(),
+        args.output.display(),
+        p.alpha,
+        p.lambda3,
+        p.nb_c
+    ));
+    Ok(())
 }

@@ -25,14 +25,8 @@ impl CliError {
 
     /// An error about a file whose message does not name it (e.g. an
     /// engine error on the points of `path`): `<path>: <error>`.
-    #[allow(dead_code)] // used by the subcommands once the library layers are wired
     pub fn in_file(path: &Path, err: impl fmt::Display) -> Self {
         CliError(format!("{}: {err}", path.display()))
-    }
-
-    /// The error of a subcommand whose library layer is not in this build.
-    pub fn not_available(subcommand: &str) -> Self {
-        CliError(format!("{subcommand}: not available in this build yet"))
     }
 
     /// The message on one line (newlines folded).
@@ -72,7 +66,6 @@ pub fn quiet() -> bool {
 }
 
 /// Prints an informational line on stderr, unless `--quiet`.
-#[allow(dead_code)] // used by detect/synth once wired
 pub fn info(message: impl fmt::Display) {
     if !quiet() {
         eprintln!("{message}");
@@ -80,7 +73,6 @@ pub fn info(message: impl fmt::Display) {
 }
 
 /// Writes `text` to stdout; a closed pipe (`| head`) is not an error.
-#[allow(dead_code)] // used by eval once wired
 pub fn print_stdout(text: &str) -> Result<(), CliError> {
     let mut out = std::io::stdout().lock();
     match out.write_all(text.as_bytes()).and_then(|_| out.flush()) {
@@ -104,7 +96,6 @@ fn draw_target() -> ProgressDrawTarget {
 /// A progress bar of `len` steps on stderr, hidden with `--quiet` or when
 /// stderr is not a terminal. Call `inc`/`set_position`, then
 /// `finish_and_clear`.
-#[allow(dead_code)] // used by the subcommands once wired
 pub fn progress(len: u64, msg: &str) -> ProgressBar {
     let style = ProgressStyle::with_template(
         "{msg:>14} [{bar:40}] {pos}/{len} ({percent}%, {elapsed} elapsed, eta {eta})",
@@ -129,7 +120,6 @@ pub fn progress_bytes(len: u64, msg: &str) -> ProgressBar {
 }
 
 /// A spinner for a phase of unknown length (hidden like [`progress`]).
-#[allow(dead_code)] // used by the subcommands once wired
 pub fn spinner(msg: &str) -> ProgressBar {
     let bar = ProgressBar::with_draw_target(None, draw_target())
         .with_style(
@@ -224,7 +214,6 @@ pub fn read_input(
 
 /// Reads a point file that must carry labels (ground truth): text column
 /// `label_column`, PLY `structure`/`label`, PCD `label`, LAS classification.
-#[allow(dead_code)] // used by eval once wired
 pub fn read_truth(
     path: &Path,
     label_column: usize,
@@ -289,7 +278,6 @@ pub fn check_mesh_output(path: &Path) -> Result<(), CliError> {
 
 /// Writes simplices as PLY (binary) or OBJ by extension, atomically, as
 /// phase `write`.
-#[allow(dead_code)] // used by alpha/detect once wired
 pub fn write_mesh(path: &Path, mesh: &Mesh<'_>, timings: &mut Timings) -> Result<(), CliError> {
     let format = mesh_format(path)?;
     timings.phase("write", || match format {
@@ -300,7 +288,6 @@ pub fn write_mesh(path: &Path, mesh: &Mesh<'_>, timings: &mut Timings) -> Result
 }
 
 /// Writes an output atomically (complete or absent), as phase `write`.
-#[allow(dead_code)] // used by the subcommands once wired
 pub fn write_output(
     path: &Path,
     timings: &mut Timings,
@@ -310,7 +297,6 @@ pub fn write_output(
 }
 
 /// Writes `value` as pretty JSON (plus a newline), atomically.
-#[allow(dead_code)] // used by detect/eval once wired
 pub fn write_json(
     path: &Path,
     value: &impl serde::Serialize,

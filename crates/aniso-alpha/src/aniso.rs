@@ -113,8 +113,16 @@ pub struct Anisotropy {
     elongation: [f64; 3],
 }
 
-/// R(θ, ψ, φ) = R_z(θ) · R_x(ψ) · R_y(φ) (module docs), written out entry by
-/// entry as in the paper (§4.3).
+/// R(θ, ψ, φ) = R_z(θ) · R_x(ψ) · R_y(φ) (module docs), computed as the
+/// product of the three explicit matrices, `(R_z · R_x) · R_y`, each entry
+/// as `fma(a₂, b₂, fma(a₁, b₁, a₀·b₀))`. That is what numpy's
+/// `rz @ rx @ ry` computes (its BLAS uses fused multiply-adds), so with the
+/// same sin/cos (glibc's, which Rust uses on Linux) the result is bit for
+/// bit the R of the project's reference fixtures
+/// (`grid_6_aniso.transform.txt`, made with numpy). It matters because the
+/// triangulation of a transformed grid depends on the last bit. (Only R is
+/// built this way; the point transform itself uses no FMA, see
+/// [`Anisotropy::transform`].)
 ///
 /// ```
 /// use aniso_alpha::aniso::rotation_from_euler;
@@ -125,14 +133,22 @@ pub fn rotation_from_euler(theta: f64, psi: f64, phi: f64) -> Mat3 {
     let (st, ct) = theta.sin_cos();
     let (sp, cp) = psi.sin_cos();
     let (sf, cf) = phi.sin_cos();
-    [
-        [cf * ct - sf * st * sp, -st * cp, ct * sf + cf * st * sp],
-        [cf * st + ct * sf * sp, ct * cp, sf * st - cf * ct * sp],
-        [-sf * cp, sp, cf * cp],
-    ]
+    let rz = [[ct, -st, 0.0], [st, ct, 0.0], [0.0, 0.0, 1.0]];
+    let rx = [[1.0, 0.0, 0.0], [0.0, cp, -sp], [0.0, sp, cp]];
+    let ry = [[cf, 0.0, sf], [0.0, 1.0, 0.0], [-sf, 0.0, cf]];
+    let fma_mul = |a: &Mat3, b: &Mat3| -> Mat3 {
+        let mut c = [[0.0; 3]; 3];
+        for i in 0..3 {
+            for j in 0..3 {
+                c[i][j] = a[i][2].mul_add(b[2][j], a[i][1].mul_add(b[1][j], a[i][0] * b[0][j]));
+            }
+        }
+        c
+    };
+    fma_mul(&fma_mul(&rz, &rx), &ry)
 }
 
-/// Matrix product a · b.
+/// Matrix product a · b, each entry `(a_i0·b_0j + a_i1·b_1j) + a_i2·b_2j`.
 pub fn mat_mul(a: &Mat3, b: &Mat3) -> Mat3 {
     let mut c = [[0.0; 3]; 3];
     for i in 0..3 {

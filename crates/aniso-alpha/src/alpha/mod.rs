@@ -579,7 +579,7 @@ fn find(parent: &mut [u32], mut x: u32) -> u32 {
 }
 
 /// Circumradius of every cell (`+∞` for infinite cells).
-fn cell_radii(tri: &Triangulation) -> Vec<f64> {
+pub(crate) fn cell_radii(tri: &Triangulation) -> Vec<f64> {
     let pts = tri.points();
     (0..tri.num_tets() as u32)
         .map(|t| {
@@ -673,7 +673,7 @@ fn insertion_sort(s: &mut [u32]) {
 /// respect to the apexes of its two cells (vertex ids, [`INFINITE`] for
 /// none).
 #[inline]
-fn triangle_rho_gabriel(
+pub(crate) fn triangle_rho_gabriel(
     a: &Point3,
     b: &Point3,
     c: &Point3,

@@ -4,8 +4,7 @@
 //!
 //! For every orientation R of the sampler: Q = diag(E)·R, transform the
 //! points, drop the points that are isolated at distance 2α (exact, see
-//! [`super::prune`]), triangulate, select `F_{k,α,Q}` from the α
-//! intervals, and apply the path filter with `nb_c`. The orientations are
+//! [`super::prune`]), triangulate, select `F_{k,α,Q}` ([`super::faces`]), and apply the path filter with `nb_c`. The orientations are
 //! independent and run in parallel (feature `parallel`, on by default); the
 //! result does not depend on the thread count because each orientation's
 //! output is collected in orientation order before the union is sorted.
@@ -39,11 +38,10 @@ use super::filter::{component_size_mask, components, filter, FilterError, Simple
 use super::fit::{fit_line_indices, fit_plane_indices, LineFit, PlaneFit};
 use super::orientations::{orientations, OrientationError, Sampler};
 use super::parts::{linear_parts, planar_parts, PartsError};
-use super::prune::non_isolated;
+use super::prune::{non_isolated, CandidatePairs};
 use super::StructureKind;
-use crate::alpha::AlphaComplex;
 use crate::aniso::{Anisotropy, AnisotropyError};
-use crate::delaunay::DelaunayError;
+use crate::delaunay::Triangulation;
 use std::fmt;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
@@ -268,6 +266,21 @@ impl<'a> Detector<'a> {
             .iter()
             .map(|r| Anisotropy::from_matrix_rows(*r, e))
             .collect::<Result<Vec<_>, _>>()?;
+        // Candidate pairs for the pruning, once for all orientations (unless
+        // there are too many: then each orientation grids its own points).
+        // The radii are inflated by 1e-9 so that rounding in the two ways of
+        // computing a distance never drops a point at exactly 2α.
+        let lmax = e.iter().map(|&x| 1.0 / x).fold(1.0, f64::max);
+        let radius = 2.0 * self.alpha * (1.0 + 1e-9);
+        let cands = if self.prune {
+            CandidatePairs::new(
+                points,
+                radius * lmax * (1.0 + 1e-9),
+                32 * points.len() + 1024,
+            )
+        } else {
+            None
+        };
         let done = AtomicUsize::new(0);
         let cancelled = AtomicBool::new(false);
         let total = anisotropies.len();
@@ -275,7 +288,7 @@ impl<'a> Detector<'a> {
             if cancelled.load(Ordering::Relaxed) {
                 return Err(DetectError::Cancelled);
             }
-            let r = self.one_orientation::<S>(points, a);
+            let r = self.one_orientation::<S>(points, a, cands.as_ref(), radius);
             let d = done.fetch_add(1, Ordering::Relaxed) + 1;
             if let Some(cb) = self.progress {
                 if !cb(d, total) {
@@ -326,22 +339,31 @@ impl<'a> Detector<'a> {
         &self,
         points: &[[f64; 3]],
         a: &Anisotropy,
+        cands: Option<&CandidatePairs>,
+        radius: f64,
     ) -> OrientationResult<S> {
-        let q = a.transform(points);
         let alpha = self.alpha;
-        let keep = if self.prune {
-            non_isolated(&q, 2.0 * alpha)
-        } else {
-            vec![true; q.len()]
-        };
-        let mut map: Vec<u32> = Vec::new();
-        let mut reduced: Vec<[f64; 3]> = Vec::new();
-        for (i, (p, &k)) in q.iter().zip(&keep).enumerate() {
-            if k {
-                map.push(i as u32);
-                reduced.push(*p);
+        let (map, mut reduced): (Vec<u32>, Vec<[f64; 3]>) = match cands {
+            Some(c) => {
+                let keep = c.non_isolated_under(points, &a.q(), radius);
+                let map: Vec<u32> = (0..points.len() as u32)
+                    .filter(|&i| keep[i as usize])
+                    .collect();
+                let kept: Vec<[f64; 3]> = map.iter().map(|&i| points[i as usize]).collect();
+                (map, a.transform(&kept))
             }
-        }
+            None => {
+                let q = a.transform(points);
+                let keep = if self.prune {
+                    non_isolated(&q, radius)
+                } else {
+                    vec![true; q.len()]
+                };
+                let map: Vec<u32> = (0..q.len() as u32).filter(|&i| keep[i as usize]).collect();
+                let reduced = map.iter().map(|&i| q[i as usize]).collect();
+                (map, reduced)
+            }
+        };
         let triangulated = reduced.len();
         if reduced.len() < 2 {
             return OrientationResult {
@@ -350,37 +372,42 @@ impl<'a> Detector<'a> {
                 raw: 0,
             };
         }
-        // Four far sentinels around the box make the set 3-dimensional even
-        // when what is left is one clean plane or line; they are isolated
-        // (farther than 2α from everything), so F_α is unchanged.
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        for p in &reduced {
-            for k in 0..3 {
-                lo[k] = lo[k].min(p[k]);
-                hi[k] = hi[k].max(p[k]);
-            }
-        }
-        let ext = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max) + 4.0 * alpha + 1.0;
-        let c = [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]));
-        let d = 16.0 * ext;
-        for s in [
-            [1.0, 1.0, 1.0],
-            [1.0, -1.0, -1.0],
-            [-1.0, 1.0, -1.0],
-            [-1.0, -1.0, 1.0],
-        ] {
-            reduced.push([c[0] + d * s[0], c[1] + d * s[1], c[2] + d * s[2]]);
-        }
         let n_real = map.len() as u32;
-        let faces: Vec<S> = match AlphaComplex::from_points(&reduced) {
-            Ok(ac) => S::at(&ac, alpha)
+        let mut tri = Triangulation::new(&reduced).ok();
+        if tri.as_ref().is_none_or(|t| t.dimension() < 3) {
+            // What is left is one clean plane or line (or a few points):
+            // four far sentinels around it make the set 3-dimensional. They
+            // are isolated (farther than 2α from everything), so F_α is
+            // unchanged.
+            let mut lo = [f64::INFINITY; 3];
+            let mut hi = [f64::NEG_INFINITY; 3];
+            for p in &reduced {
+                for k in 0..3 {
+                    lo[k] = lo[k].min(p[k]);
+                    hi[k] = hi[k].max(p[k]);
+                }
+            }
+            let ext = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max) + 4.0 * alpha + 1.0;
+            let c = [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]));
+            let d = 16.0 * ext;
+            for s in [
+                [1.0, 1.0, 1.0],
+                [1.0, -1.0, -1.0],
+                [-1.0, 1.0, -1.0],
+                [-1.0, -1.0, 1.0],
+            ] {
+                reduced.push([c[0] + d * s[0], c[1] + d * s[1], c[2] + d * s[2]]);
+            }
+            tri = Triangulation::new(&reduced).ok();
+        }
+        // (Triangulation errors are unreachable: the points are finite.)
+        let faces: Vec<S> = match &tri {
+            Some(tri) => S::at(tri, alpha)
+                .into_iter()
                 .filter(|f| f.as_ref().iter().all(|&v| v < n_real))
                 .map(|f| S::sorted(f.as_ref().iter().map(|&v| map[v as usize])))
                 .collect(),
-            // Unreachable: the points are finite and non-empty.
-            Err(DelaunayError::Empty | DelaunayError::NonFinite { .. }) => Vec::new(),
-            Err(DelaunayError::TooManyPoints(_)) => Vec::new(),
+            None => Vec::new(),
         };
         let raw = faces.len();
         let faces = filter(&faces, self.nb_c).unwrap_or_default();
@@ -814,7 +841,7 @@ struct OrientationResult<S> {
 trait Face: Simplex + AsRef<[u32]> + Send + Sync + 'static {
     /// The simplex dimension.
     const K: usize;
-    fn at(ac: &AlphaComplex, alpha: f64) -> Box<dyn Iterator<Item = Self> + '_>;
+    fn at(tri: &Triangulation, alpha: f64) -> Vec<Self>;
     fn sorted(v: impl Iterator<Item = u32>) -> Self;
     fn parts(points: &[[f64; 3]], s: &[Self], angle: f64) -> Result<Vec<u32>, PartsError>;
     fn fit(points: &[[f64; 3]], vertices: &[u32]) -> Primitive;
@@ -822,8 +849,8 @@ trait Face: Simplex + AsRef<[u32]> + Send + Sync + 'static {
 
 impl Face for [u32; 2] {
     const K: usize = 1;
-    fn at(ac: &AlphaComplex, alpha: f64) -> Box<dyn Iterator<Item = Self> + '_> {
-        Box::new(ac.edges_at(alpha))
+    fn at(tri: &Triangulation, alpha: f64) -> Vec<Self> {
+        super::faces::edges_at(tri, alpha)
     }
     fn sorted(mut v: impl Iterator<Item = u32>) -> Self {
         let mut s = [v.next().unwrap_or(0), v.next().unwrap_or(0)];
@@ -840,8 +867,8 @@ impl Face for [u32; 2] {
 
 impl Face for [u32; 3] {
     const K: usize = 2;
-    fn at(ac: &AlphaComplex, alpha: f64) -> Box<dyn Iterator<Item = Self> + '_> {
-        Box::new(ac.triangles_at(alpha))
+    fn at(tri: &Triangulation, alpha: f64) -> Vec<Self> {
+        super::faces::triangles_at(tri, alpha)
     }
     fn sorted(mut v: impl Iterator<Item = u32>) -> Self {
         let mut s = [

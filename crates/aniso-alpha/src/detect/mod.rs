@@ -7,10 +7,12 @@
 //! * [`fit`]: least-squares lines and planes;
 //! * [`parts`]: splitting structures into straight/flat parts, and point
 //!   labelling;
+//! * [`faces`]: `F_{k,α}` at one α straight from a triangulation;
 //! * [`prune`]: exact removal of points isolated at distance 2α;
 //! * [`detector`]: the whole §4 pipeline over many orientations.
 
 pub mod detector;
+pub mod faces;
 pub mod filter;
 pub mod fit;
 pub mod orientations;

@@ -10,9 +10,11 @@
 //! while the triangulation shrinks to the neighbourhood of the structures
 //! (a sparse background is mostly isolated at the scale α).
 //!
-//! The neighbour search uses a uniform grid of cell side `2α` stored as
-//! flat sorted arrays (no hash map): points sorted by cell key, and each
-//! occupied cell's 27 neighbours found by binary search.
+//! The neighbour search uses a uniform grid of cell side at least `2α`,
+//! stored as flat arrays (a counting sort of the points into cells, no hash
+//! map); each point looks at its own and the 26 adjacent cells. Across the
+//! orientations of one run, [`CandidatePairs`] finds the pairs within
+//! `2α·λ_max` once, and each orientation only tests those under its Q.
 
 /// Marks the points that have another point within distance `radius`
 /// (inclusive). Points are `[f64; 3]` in the metric of interest.
@@ -31,85 +33,205 @@ pub fn non_isolated(points: &[[f64; 3]], radius: f64) -> Vec<bool> {
     if !radius.is_finite() {
         return vec![true; n];
     }
-    let mut lo = [f64::INFINITY; 3];
-    for p in points {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-        }
-    }
-    let cell = if radius > 0.0 {
-        radius
-    } else {
-        f64::MIN_POSITIVE
-    };
-    // Cell coordinates, clamped to 21 bits per axis (beyond that, cells
-    // merge, which only costs distance checks, never correctness: the
-    // distance test below is exact on the coordinates).
-    const MAXC: i64 = (1 << 21) - 1;
-    let cell_of = |p: &[f64; 3]| -> [i64; 3] {
-        let mut c = [0i64; 3];
-        for k in 0..3 {
-            let x = ((p[k] - lo[k]) / cell).floor();
-            c[k] = if x.is_finite() {
-                (x as i64).clamp(0, MAXC)
-            } else {
-                MAXC
-            };
-        }
-        c
-    };
-    let key_of = |c: [i64; 3]| ((c[0] as u64) << 42) | ((c[1] as u64) << 21) | c[2] as u64;
-    let mut order: Vec<(u64, u32)> = points
-        .iter()
-        .enumerate()
-        .map(|(i, p)| (key_of(cell_of(p)), i as u32))
-        .collect();
-    order.sort_unstable();
     let r2 = radius * radius;
-    let close = |a: &[f64; 3], b: &[f64; 3]| {
-        let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-        d[0] * d[0] + d[1] * d[1] + d[2] * d[2] <= r2
-    };
-    let mut start = 0;
-    let mut ranges: Vec<(usize, usize)> = Vec::with_capacity(27);
-    while start < n {
-        let key = order[start].0;
-        let mut end = start + 1;
-        while end < n && order[end].0 == key {
-            end += 1;
+    let grid = Grid::new(points, radius);
+    for (i, p) in points.iter().enumerate() {
+        if keep[i] {
+            continue;
         }
-        let c = cell_of(&points[order[start].1 as usize]);
-        ranges.clear();
-        for dx in -1..=1i64 {
-            for dy in -1..=1i64 {
-                for dz in -1..=1i64 {
-                    let nc = [c[0] + dx, c[1] + dy, c[2] + dz];
-                    if nc.iter().any(|&x| !(0..=MAXC).contains(&x)) {
-                        continue;
-                    }
-                    let k = key_of(nc);
-                    let a = order.partition_point(|e| e.0 < k);
-                    let b = order[a..].partition_point(|e| e.0 == k) + a;
-                    if a < b {
-                        ranges.push((a, b));
-                    }
-                }
+        grid.for_near(points, p, |j| {
+            if j as usize == i {
+                return true;
             }
-        }
-        for &(_, i) in &order[start..end] {
-            let p = &points[i as usize];
-            'search: for &(a, b) in &ranges {
-                for &(_, j) in &order[a..b] {
-                    if j != i && close(p, &points[j as usize]) {
-                        keep[i as usize] = true;
-                        break 'search;
-                    }
-                }
+            let q = &points[j as usize];
+            let d = [p[0] - q[0], p[1] - q[1], p[2] - q[2]];
+            if d[0] * d[0] + d[1] * d[1] + d[2] * d[2] <= r2 {
+                keep[i] = true;
+                keep[j as usize] = true;
+                return false;
             }
-        }
-        start = end;
+            true
+        });
     }
     keep
+}
+
+/// A uniform grid over a point set, stored as a counting sort of the
+/// points into cells (CSR): cell side at least `radius` (so points within
+/// `radius` are in adjacent cells), enlarged until there are at most about
+/// 4n cells (a larger side only costs distance checks).
+struct Grid {
+    lo: [f64; 3],
+    side: f64,
+    dims: [usize; 3],
+    start: Vec<u32>,
+    sorted: Vec<u32>,
+}
+
+impl Grid {
+    fn new(points: &[[f64; 3]], radius: f64) -> Grid {
+        let n = points.len();
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for p in points {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+        let mut side = radius.max(f64::MIN_POSITIVE);
+        let cells_for = |side: f64| -> [usize; 3] {
+            [0, 1, 2].map(|k| (((hi[k] - lo[k]) / side).floor() as usize).saturating_add(1))
+        };
+        let budget = 4 * n + 64;
+        loop {
+            let d = cells_for(side);
+            let total = d[0].saturating_mul(d[1]).saturating_mul(d[2]);
+            if total <= budget {
+                break;
+            }
+            side *= ((total as f64) / (budget as f64)).cbrt().max(1.01);
+        }
+        let dims = cells_for(side);
+        let mut g = Grid {
+            lo,
+            side,
+            dims,
+            start: Vec::new(),
+            sorted: Vec::new(),
+        };
+        let total = dims[0] * dims[1] * dims[2];
+        let mut start = vec![0u32; total + 1];
+        let cell: Vec<u32> = points
+            .iter()
+            .map(|p| g.index(g.cell_of(p)) as u32)
+            .collect();
+        for &c in &cell {
+            start[c as usize + 1] += 1;
+        }
+        for i in 0..total {
+            start[i + 1] += start[i];
+        }
+        let mut fill = start.clone();
+        let mut sorted = vec![0u32; n];
+        for (i, &c) in cell.iter().enumerate() {
+            sorted[fill[c as usize] as usize] = i as u32;
+            fill[c as usize] += 1;
+        }
+        g.start = start;
+        g.sorted = sorted;
+        g
+    }
+
+    fn cell_of(&self, p: &[f64; 3]) -> [usize; 3] {
+        [0, 1, 2].map(|k| (((p[k] - self.lo[k]) / self.side) as usize).min(self.dims[k] - 1))
+    }
+
+    fn index(&self, c: [usize; 3]) -> usize {
+        (c[0] * self.dims[1] + c[1]) * self.dims[2] + c[2]
+    }
+
+    /// Calls `f` on every point of the 27 cells around `p` until it
+    /// returns false.
+    fn for_near(&self, _points: &[[f64; 3]], p: &[f64; 3], mut f: impl FnMut(u32) -> bool) {
+        let c = self.cell_of(p);
+        let range = |k: usize| c[k].saturating_sub(1)..=(c[k] + 1).min(self.dims[k] - 1);
+        for x in range(0) {
+            for y in range(1) {
+                for z in range(2) {
+                    let ci = self.index([x, y, z]);
+                    for &j in &self.sorted[self.start[ci] as usize..self.start[ci + 1] as usize] {
+                        if !f(j) {
+                            return;
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The pairs of points within a Euclidean distance, found once and then
+/// tested under many linear maps: since `|Q·d| ≥ |d| / λ_max` for
+/// `Q = diag(e)·R` with `min(e) = 1/λ_max`, every pair within `2α` in a
+/// Q-metric is within `2α·λ_max` in Euclidean distance.
+#[derive(Debug, Clone)]
+pub struct CandidatePairs {
+    /// Pairs `(i, j)`, `i < j`.
+    pairs: Vec<[u32; 2]>,
+    n: usize,
+}
+
+impl CandidatePairs {
+    /// All pairs within `radius` (inclusive), or `None` if there are more
+    /// than `max_pairs` of them.
+    pub fn new(points: &[[f64; 3]], radius: f64, max_pairs: usize) -> Option<CandidatePairs> {
+        let n = points.len();
+        let mut pairs = Vec::new();
+        if n >= 2 && radius.is_finite() && radius >= 0.0 {
+            let r2 = radius * radius;
+            let grid = Grid::new(points, radius);
+            for (i, p) in points.iter().enumerate() {
+                let mut over = false;
+                grid.for_near(points, p, |j| {
+                    if j as usize > i {
+                        let q = &points[j as usize];
+                        let d = [p[0] - q[0], p[1] - q[1], p[2] - q[2]];
+                        if d[0] * d[0] + d[1] * d[1] + d[2] * d[2] <= r2 {
+                            pairs.push([i as u32, j]);
+                            over = pairs.len() > max_pairs;
+                        }
+                    }
+                    !over
+                });
+                if over {
+                    return None;
+                }
+            }
+        }
+        Some(CandidatePairs { pairs, n })
+    }
+
+    /// Number of candidate pairs.
+    pub fn len(&self) -> usize {
+        self.pairs.len()
+    }
+
+    /// Whether there is no candidate pair.
+    pub fn is_empty(&self) -> bool {
+        self.pairs.is_empty()
+    }
+
+    /// [`non_isolated`] in the metric `|Q·(p − q)|` (Q given by its rows),
+    /// restricted to the candidate pairs: exact as long as every pair
+    /// within `radius` under Q is a candidate.
+    pub fn non_isolated_under(
+        &self,
+        points: &[[f64; 3]],
+        q: &[[f64; 3]; 3],
+        radius: f64,
+    ) -> Vec<bool> {
+        let mut keep = vec![false; self.n];
+        let r2 = radius * radius;
+        for &[i, j] in &self.pairs {
+            let (i, j) = (i as usize, j as usize);
+            if keep[i] && keep[j] {
+                continue;
+            }
+            let (a, b) = (&points[i], &points[j]);
+            let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+            let mut s = 0.0;
+            for row in q {
+                let x = row[0] * d[0] + row[1] * d[1] + row[2] * d[2];
+                s += x * x;
+            }
+            if s <= r2 {
+                keep[i] = true;
+                keep[j] = true;
+            }
+        }
+        keep
+    }
 }
 
 #[cfg(test)]
@@ -144,6 +266,43 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn candidate_pairs_under_a_map_match_brute_force() {
+        let mut s = 3u64;
+        let mut rnd = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for round in 0..20 {
+            let pts: Vec<[f64; 3]> = (0..200)
+                .map(|_| [rnd() * 60.0, rnd() * 60.0, rnd() * 60.0])
+                .collect();
+            let (t, p, f) = (rnd() * 6.0, rnd() * 3.0 - 1.5, rnd() * 6.0);
+            let r = crate::aniso::rotation_from_euler(t, p, f);
+            let e = [1.0, 0.25, 0.125];
+            let q = [0, 1, 2].map(|i| r[i].map(|x| x * e[i]));
+            let radius = 1.0 + round as f64 * 0.3;
+            let cand = CandidatePairs::new(&pts, radius * 8.0 * (1.0 + 1e-9), usize::MAX).unwrap();
+            let fast = cand.non_isolated_under(&pts, &q, radius);
+            for i in 0..pts.len() {
+                let brute = (0..pts.len()).any(|j| {
+                    j != i && {
+                        let d = [0, 1, 2].map(|k| pts[i][k] - pts[j][k]);
+                        let s: f64 = q
+                            .iter()
+                            .map(|row| (row[0] * d[0] + row[1] * d[1] + row[2] * d[2]).powi(2))
+                            .sum();
+                        s <= radius * radius
+                    }
+                });
+                assert_eq!(fast[i], brute, "round {round} point {i}");
+            }
+        }
+        assert!(CandidatePairs::new(&[[0.0; 3]; 10], 1.0, 5).is_none());
     }
 
     #[test]
