@@ -71,13 +71,9 @@ fn grid_6_aniso_transform_is_bit_exact() {
     // product as numpy's rz @ rx @ ry, same sin/cos), hence the same points.
     let [t, p, f] = euler.expect("euler line");
     let b = Anisotropy::from_euler(t, p, f, e).unwrap();
-    for i in 0..3 {
-        for j in 0..3 {
-            assert_eq!(
-                b.rotation()[i][j].to_bits(),
-                r[i][j].to_bits(),
-                "R[{i}][{j}]"
-            );
+    for (i, (got, want)) in b.rotation().iter().zip(&r).enumerate() {
+        for (j, (g, w)) in got.iter().zip(want).enumerate() {
+            assert_eq!(g.to_bits(), w.to_bits(), "R[{i}][{j}]");
         }
     }
     let from_angles = b.transform(&input);
