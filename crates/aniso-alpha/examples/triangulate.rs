@@ -46,13 +46,14 @@ fn main() {
     let tri = Triangulation::new(&pts).expect("triangulation");
     let dt = t0.elapsed().as_secs_f64();
     println!(
-        "{kind} n={} tets={} time={dt:.3}s",
+        "{{\"tool\":\"aniso_alpha\",\"input\":\"{kind}\",\"n\":{},\"vertices\":{},\"finite_tets\":{},\"time_s\":{dt:.6}}}",
         pts.len(),
+        tri.num_vertices(),
         tri.num_finite_tets()
     );
     if args.iter().any(|a| a == "--validate") {
         let t1 = Instant::now();
         tri.validate_with_input(&pts).expect("valid");
-        println!("valid ({:.3}s)", t1.elapsed().as_secs_f64());
+        eprintln!("valid ({:.3}s)", t1.elapsed().as_secs_f64());
     }
 }
