@@ -85,6 +85,26 @@ pub fn triangle_diametral_side(a: &Point3, b: &Point3, c: &Point3, p: &Point3) -
     ];
     let nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
     let d = ww * nn - wu * vv * (uu - uv) - wv * uu * (vv - uv);
+    // Semi-static stage: with M the largest |coordinate difference| in u, v,
+    // w, the permanent below is at most 144·M⁶ (ww ≤ 3M², its |u × v|²
+    // permanent ≤ 12M⁴, the other two terms ≤ 54M⁶ each), so 4e-15·144 =
+    // 5.8e-13 times M⁶ bounds the error.
+    let m = u[0]
+        .abs()
+        .max(u[1].abs())
+        .max(u[2].abs())
+        .max(v[0].abs().max(v[1].abs()).max(v[2].abs()))
+        .max(w[0].abs().max(w[1].abs()).max(w[2].abs()));
+    let m2 = m * m;
+    let eps = 5.8e-13 * (m2 * m2 * m2);
+    if eps >= f64::MIN_POSITIVE && eps < f64::MAX {
+        if d > eps {
+            return 1;
+        }
+        if -d > eps {
+            return -1;
+        }
+    }
     triangle_filter(&u, &v, &w, uu, vv, ww, d).unwrap_or_else(|| triangle_exact(a, b, c, p))
 }
 

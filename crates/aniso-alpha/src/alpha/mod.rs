@@ -28,9 +28,11 @@
 //! 1. circumradius of every cell (`+∞` for infinite cells), computed
 //!    relative to a vertex of the tet;
 //! 2. edges: every finite tet emits its 6 edges `(a, b)`, `a < b`, bucketed
-//!    by `a` with a counting sort; each vertex's bucket is sorted and
-//!    deduplicated. The edges are then numbered by `(a, b)` and the
-//!    per-vertex offsets (CSR) give an `O(degree)` lookup;
+//!    by `a` with a counting sort (the tets visited grouped by their
+//!    smallest vertex, which keeps the accesses local); each vertex's bucket
+//!    is deduplicated with a per-vertex stamp. The edges are numbered
+//!    grouped by `a` and the per-vertex offsets (CSR) give an `O(degree)`
+//!    lookup;
 //! 3. triangles: each finite face once, from the cell with the smaller id;
 //!    its Gabriel test looks at the (one or two) opposite vertices, and it
 //!    then pushes its values to its three edges (α_max: max, α_min of the
@@ -71,6 +73,8 @@ use crate::geometry::Point3;
 /// so that face `i` of a positively oriented tet has its normal (right-hand
 /// rule) pointing towards vertex `i`, i.e. into the tet.
 const FACE: [[usize; 3]; 4] = [[1, 3, 2], [0, 2, 3], [0, 3, 1], [0, 1, 2]];
+/// Mark of an infinite cell in the per-cell Gabriel masks.
+const INFINITE_CELL: u8 = 0x80;
 /// The 6 edges of a tet as local index pairs.
 const PAIRS: [[usize; 2]; 6] = [[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]];
 
@@ -102,8 +106,8 @@ pub struct TriangleInterval {
 /// The alpha intervals of every edge and triangle of a 3D Delaunay
 /// triangulation, and the circumradii of its tetrahedra.
 ///
-/// Ids: edges are numbered `0..num_edges()` in `(a, b)` order of their
-/// vertex ids, triangles `0..num_triangles()`; cells (tets) use the
+/// Ids: edges are numbered `0..num_edges()` grouped by their smaller
+/// vertex id, triangles `0..num_triangles()`; cells (tets) use the
 /// triangulation's ids. Vertex ids are the triangulation's (insertion
 /// order); every query that says *input* maps them to input indices.
 ///
@@ -127,7 +131,7 @@ pub struct AlphaComplex {
     tri: Triangulation,
     /// Cell id -> circumradius (`+∞` for infinite cells).
     cell_r: Vec<f64>,
-    /// Edge id -> vertex ids `(a, b)`, `a < b`, sorted.
+    /// Edge id -> vertex ids `(a, b)`, `a < b`, grouped by `a`.
     edge_v: Vec<[u32; 2]>,
     /// Vertex id `a` -> first edge `(a, _)`; `num_vertices + 1` entries.
     edge_start: Vec<u32>,
@@ -161,8 +165,9 @@ impl AlphaComplex {
                 tri_max: Vec::new(),
             };
         }
-        let cell_r = cell_radii(&tri);
-        let (edge_v, edge_start) = number_edges(&tri);
+        let (cell_r, bits) = cell_pass(&tri);
+        let order = cells_by_min_vertex(&tri);
+        let (edge_v, edge_start) = number_edges(&tri, &order);
         let ne = edge_v.len();
         let mut ac = AlphaComplex {
             tri,
@@ -175,7 +180,7 @@ impl AlphaComplex {
             tri_min: Vec::new(),
             tri_max: Vec::new(),
         };
-        ac.compute_triangles_and_edges();
+        ac.compute_triangles_and_edges(&order, &bits);
         ac
     }
 
@@ -488,7 +493,7 @@ impl AlphaComplex {
     }
 
     /// Steps 3–4 of the algorithm (module docs).
-    fn compute_triangles_and_edges(&mut self) {
+    fn compute_triangles_and_edges(&mut self, order: &[u32], bits: &[u8]) {
         let tri = &self.tri;
         let pts = tri.points();
         let nt = tri.num_triangles();
@@ -510,27 +515,27 @@ impl AlphaComplex {
             }
             e
         };
-        for t in 0..tri.num_tets() as u32 {
+        for &t in order {
             let v = tri.tet(t);
-            let finite = v[3] != INFINITE;
             for i in 0..4 {
-                if !finite && i != 3 {
-                    continue;
-                }
                 let (n, j) = tri.neighbor(t, i);
-                if n < t {
+                // Owner: the finite side, the smaller id if both are.
+                let bn = bits[n as usize];
+                if n < t && bn & INFINITE_CELL == 0 {
                     continue;
                 }
                 let f = FACE[i];
                 let (ia, ib, ic) = (v[f[0]], v[f[1]], v[f[2]]);
                 let (a, b, c) = (&pts[ia as usize], &pts[ib as usize], &pts[ic as usize]);
-                let apex_t = v[i];
-                let apex_n = tri.tet(n)[j];
-                let (rho, gabriel) = triangle_rho_gabriel(a, b, c, apex_t, apex_n, pts);
+                let gabriel = (bits[t as usize] >> i) & 1 == 0 && (bn >> j) & 1 == 0;
                 let rt = cell_r[t as usize];
                 let rn = cell_r[n as usize];
                 let amax = rt.max(rn);
-                let amin = if gabriel { rho } else { rt.min(rn) };
+                let amin = if gabriel {
+                    triangle_rho(a, b, c)
+                } else {
+                    rt.min(rn)
+                };
                 tri_face.push((t << 2) | i as u32);
                 tri_min.push(amin);
                 tri_max.push(amax);
@@ -578,34 +583,44 @@ fn find(parent: &mut [u32], mut x: u32) -> u32 {
     x
 }
 
-/// Circumradius of every cell (`+∞` for infinite cells).
-fn cell_radii(tri: &Triangulation) -> Vec<f64> {
+/// Circumradius of every cell (`+∞` for infinite cells), and for each
+/// finite cell a 4-bit mask: bit `i` is set when vertex `i` lies strictly
+/// inside the diametral sphere of the opposite face (so that face is not
+/// Gabriel); infinite cells get [`INFINITE_CELL`] instead. Visits the cells in id order (sequential), touching only the
+/// cell's own vertices.
+fn cell_pass(tri: &Triangulation) -> (Vec<f64>, Vec<u8>) {
     let pts = tri.points();
-    (0..tri.num_tets() as u32)
-        .map(|t| {
-            let v = tri.tet(t);
-            if v[3] == INFINITE {
-                f64::INFINITY
-            } else {
-                let p = |k: usize| &pts[v[k] as usize];
-                exact::tet_radius2(p(0), p(1), p(2), p(3)).sqrt()
-            }
-        })
-        .collect()
-}
-
-/// Numbers the finite edges by `(a, b)`, `a < b` (vertex ids), with a
-/// counting sort of the 6 edges of every finite tet on `a` and a per-vertex
-/// sort + dedup. Returns the edges and the per-vertex offsets.
-fn number_edges(tri: &Triangulation) -> (Vec<[u32; 2]>, Vec<u32>) {
-    let nv = tri.num_vertices();
-    let nc = tri.num_tets() as u32;
-    let mut start = vec![0u32; nv + 1];
-    for t in 0..nc {
+    let nc = tri.num_tets();
+    let mut radii = Vec::with_capacity(nc);
+    let mut bits = Vec::with_capacity(nc);
+    for t in 0..nc as u32 {
         let v = tri.tet(t);
         if v[3] == INFINITE {
+            radii.push(f64::INFINITY);
+            bits.push(INFINITE_CELL);
             continue;
         }
+        let p = |k: usize| &pts[v[k] as usize];
+        radii.push(exact::tet_radius2(p(0), p(1), p(2), p(3)).sqrt());
+        let mut m = 0u8;
+        for (i, f) in FACE.iter().enumerate() {
+            if exact::triangle_diametral_side(p(f[0]), p(f[1]), p(f[2]), p(i)) < 0 {
+                m |= 1 << i;
+            }
+        }
+        bits.push(m);
+    }
+    (radii, bits)
+}
+
+/// Numbers the finite edges `(a, b)`, `a < b` (vertex ids), grouped by
+/// `a`: a counting sort of the 6 edges of every finite tet on `a`, then a
+/// per-vertex deduplication. Returns the edges and the per-vertex offsets.
+fn number_edges(tri: &Triangulation, order: &[u32]) -> (Vec<[u32; 2]>, Vec<u32>) {
+    let nv = tri.num_vertices();
+    let mut start = vec![0u32; nv + 1];
+    for &t in order {
+        let v = tri.tet(t);
         for [i, j] in PAIRS {
             start[v[i].min(v[j]) as usize + 1] += 1;
         }
@@ -615,11 +630,8 @@ fn number_edges(tri: &Triangulation) -> (Vec<[u32; 2]>, Vec<u32>) {
     }
     let mut fill: Vec<u32> = start[..nv].to_vec();
     let mut buf = vec![0u32; start[nv] as usize];
-    for t in 0..nc {
+    for &t in order {
         let v = tri.tet(t);
-        if v[3] == INFINITE {
-            continue;
-        }
         for [i, j] in PAIRS {
             let (a, b) = if v[i] < v[j] {
                 (v[i], v[j])
@@ -637,14 +649,14 @@ fn number_edges(tri: &Triangulation) -> (Vec<[u32; 2]>, Vec<u32>) {
     let ne_guess = (nv + nf).saturating_sub(tri.num_finite_tets() + 1);
     let mut edges: Vec<[u32; 2]> = Vec::with_capacity(ne_guess);
     let mut estart = vec![0u32; nv + 1];
+    // Deduplicate each bucket with a stamp per vertex (no sort: within a
+    // vertex the edges stay in first-seen order, lookups scan the bucket).
+    let mut stamp = vec![u32::MAX; nv];
     for a in 0..nv {
-        let s = &mut buf[start[a] as usize..start[a + 1] as usize];
-        insertion_sort(s);
-        let mut last = u32::MAX;
-        for &b in s.iter() {
-            if b != last {
+        for &b in &buf[start[a] as usize..start[a + 1] as usize] {
+            if stamp[b as usize] != a as u32 {
+                stamp[b as usize] = a as u32;
                 edges.push([a as u32, b]);
-                last = b;
             }
         }
         estart[a + 1] = edges.len() as u32;
@@ -652,65 +664,49 @@ fn number_edges(tri: &Triangulation) -> (Vec<[u32; 2]>, Vec<u32>) {
     (edges, estart)
 }
 
-/// Sorts a short slice (a vertex's bucket holds a few dozen entries).
-fn insertion_sort(s: &mut [u32]) {
-    if s.len() > 64 {
-        s.sort_unstable();
-        return;
-    }
-    for i in 1..s.len() {
-        let x = s[i];
-        let mut j = i;
-        while j > 0 && s[j - 1] > x {
-            s[j] = s[j - 1];
-            j -= 1;
+/// The finite cells grouped by their smallest vertex id (a counting sort).
+/// Vertex ids follow the spatially coherent insertion order while cell ids
+/// do not, so visiting cells in this order keeps the accesses to points
+/// and edges local.
+fn cells_by_min_vertex(tri: &Triangulation) -> Vec<u32> {
+    let nv = tri.num_vertices();
+    let nc = tri.num_tets() as u32;
+    let mut start = vec![0u32; nv + 1];
+    for t in 0..nc {
+        let v = tri.tet(t);
+        if v[3] != INFINITE {
+            start[v[0].min(v[1]).min(v[2].min(v[3])) as usize + 1] += 1;
         }
-        s[j] = x;
     }
+    for k in 0..nv {
+        start[k + 1] += start[k];
+    }
+    let mut order = vec![0u32; start[nv] as usize];
+    for t in 0..nc {
+        let v = tri.tet(t);
+        if v[3] != INFINITE {
+            let slot = &mut start[v[0].min(v[1]).min(v[2].min(v[3])) as usize];
+            order[*slot as usize] = t;
+            *slot += 1;
+        }
+    }
+    order
 }
 
-/// Circumradius of the triangle `abc` and whether it is Gabriel with
-/// respect to the apexes of its two cells (vertex ids, [`INFINITE`] for
-/// none).
+/// Circumradius of the triangle `abc` (radius of its smallest
+/// circumsphere), as `|b − a| |c − a| |c − b| / (2 |(b − a) × (c − a)|)`:
+/// no cancellation in the numerator, and the cross product is made
+/// accurate for nearly collinear triangles.
 #[inline]
-fn triangle_rho_gabriel(
-    a: &Point3,
-    b: &Point3,
-    c: &Point3,
-    apex_t: u32,
-    apex_n: u32,
-    pts: &[Point3],
-) -> (f64, bool) {
+fn triangle_rho(a: &Point3, b: &Point3, c: &Point3) -> f64 {
     let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
     let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
     let d = [c[0] - b[0], c[1] - b[1], c[2] - b[2]];
     let uu = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
     let vv = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
     let dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-    let uv = u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
     let nn = exact::cross_norm2(a, b, c, &u, &v);
-    // R = |u| |v| |c − b| / (2 |u × v|): no cancellation in the numerator.
-    let rho = 0.5 * ((uu * vv * dd) / nn).sqrt();
-    let mut gabriel = true;
-    for apex in [apex_t, apex_n] {
-        if apex == INFINITE || !gabriel {
-            continue;
-        }
-        let p = &pts[apex as usize];
-        let w = [p[0] - a[0], p[1] - a[1], p[2] - a[2]];
-        let ww = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
-        let wu = w[0] * u[0] + w[1] * u[1] + w[2] * u[2];
-        let wv = w[0] * v[0] + w[1] * v[1] + w[2] * v[2];
-        let dv = ww * nn - wu * vv * (uu - uv) - wv * uu * (vv - uv);
-        let s = match exact::triangle_filter(&u, &v, &w, uu, vv, ww, dv) {
-            Some(s) => s,
-            None => exact::triangle_diametral_side(a, b, c, p),
-        };
-        if s < 0 {
-            gabriel = false;
-        }
-    }
-    (rho, gabriel)
+    0.5 * ((uu * vv * dd) / nn).sqrt()
 }
 
 /// `Q = diag(e)·R`: row `i` of the rotation `r` scaled by `e[i]`
