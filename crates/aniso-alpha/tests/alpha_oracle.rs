@@ -139,6 +139,7 @@ fn brute_force_empty_balls() {
                             got, want,
                             "seed {seed} alpha {alpha}: triangle ({i}, {j}, {k})"
                         );
+                        pos_t += got as usize;
                     }
                 }
             }
