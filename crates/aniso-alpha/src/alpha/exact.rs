@@ -97,7 +97,7 @@ pub fn triangle_diametral_side(a: &Point3, b: &Point3, c: &Point3, p: &Point3) -
         .max(w[0].abs().max(w[1].abs()).max(w[2].abs()));
     let m2 = m * m;
     let eps = 5.8e-13 * (m2 * m2 * m2);
-    if eps >= f64::MIN_POSITIVE && eps < f64::MAX {
+    if (f64::MIN_POSITIVE..f64::MAX).contains(&eps) {
         if d > eps {
             return 1;
         }

@@ -1,6 +1,6 @@
 //! Helpers for the alpha-shape tests: an exact integer oracle for the
 //! Gabriel predicates, brute-force empty-ball oracles, random points.
-#![allow(dead_code)]
+#![allow(dead_code, clippy::needless_range_loop)]
 
 use std::cmp::Ordering;
 
