@@ -25,22 +25,32 @@
 //! Everything is flat (`Vec`s indexed by `u32`), linear in the number of
 //! simplices, without hashing:
 //!
-//! 1. circumradius of every cell (`+∞` for infinite cells), computed
-//!    relative to a vertex of the tet;
+//! 1. the finite cells are bucketed by their smallest vertex id (counting
+//!    sort). Vertex ids follow the engine's spatially coherent insertion
+//!    order while cell ids do not, so every later pass visits the cells in
+//!    this order and its accesses to points and edges stay local;
 //! 2. edges: every finite tet emits its 6 edges `(a, b)`, `a < b`, bucketed
-//!    by `a` with a counting sort (the tets visited grouped by their
-//!    smallest vertex, which keeps the accesses local); each vertex's bucket
-//!    is deduplicated with a per-vertex stamp. The edges are numbered
-//!    grouped by `a` and the per-vertex offsets (CSR) give an `O(degree)`
-//!    lookup;
-//! 3. triangles: each finite face once, from the cell with the smaller id;
-//!    its Gabriel test looks at the (one or two) opposite vertices, and it
-//!    then pushes its values to its three edges (α_max: max, α_min of the
-//!    cofaces: min, Gabriel test of the edge against the triangle's third
-//!    vertex; the third vertices of an edge's triangles are exactly the
-//!    vertices of its incident tets);
+//!    by `a` (counting sort); each bucket is deduplicated with a per-vertex
+//!    stamp. The edges are numbered grouped by `a`, and the per-vertex
+//!    offsets (CSR) give an `O(degree)` lookup;
+//! 3. one pass over the cells: each computes its circumradius (relative to
+//!    a vertex; recomputed exactly and rounded once for slivers, see
+//!    [`exact`]) and, for each of its faces, whether its opposite vertex is
+//!    strictly inside the face's diametral sphere (exact). A triangle is
+//!    emitted by the second of its two cells to be visited (or its finite
+//!    cell on the hull), when both sides are known: Gabriel iff neither
+//!    apex is inside. It then pushes its values to its three edges (max of
+//!    `α_max`, min of the cofaces' `α_min`, and the edge's own Gabriel test
+//!    against the triangle's third vertex: the third vertices of an edge's
+//!    triangles are exactly the vertices of its incident tets);
 //! 4. each edge's `α_min` is its half length if Gabriel, else the minimum
 //!    over its triangles.
+//!
+//! Memory: the complex adds about 8 bytes per cell, 20 per triangle and 24
+//! per edge to the triangulation (≈ 0.5 GB for 1M uniform points), plus
+//! transient buckets of 4 bytes per (tet, edge) incidence during step 2.
+//! The computation is sequential; the detector runs one complex per
+//! orientation, which is where parallelism belongs.
 //!
 //! The struct owns the triangulation (get it back with
 //! [`AlphaComplex::into_triangulation`]).
@@ -73,8 +83,11 @@ use crate::geometry::Point3;
 /// so that face `i` of a positively oriented tet has its normal (right-hand
 /// rule) pointing towards vertex `i`, i.e. into the tet.
 const FACE: [[usize; 3]; 4] = [[1, 3, 2], [0, 2, 3], [0, 3, 1], [0, 1, 2]];
-/// Mark of an infinite cell in the per-cell Gabriel masks.
+/// Mark of an infinite cell in the per-cell flag bytes (whose low 4 bits
+/// are the Gabriel mask of [`cell_masks`]).
 const INFINITE_CELL: u8 = 0x80;
+/// Mark of a finite cell already visited by the main pass.
+const DONE_CELL: u8 = 0x40;
 /// The 6 edges of a tet as local index pairs.
 const PAIRS: [[usize; 2]; 6] = [[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]];
 
@@ -165,13 +178,13 @@ impl AlphaComplex {
                 tri_max: Vec::new(),
             };
         }
-        let (cell_r, bits) = cell_pass(&tri);
-        let order = cells_by_min_vertex(&tri);
+        let (order, mut bits) = cells_by_min_vertex(&tri);
         let (edge_v, edge_start) = number_edges(&tri, &order);
         let ne = edge_v.len();
+        let nc = tri.num_tets();
         let mut ac = AlphaComplex {
             tri,
-            cell_r,
+            cell_r: vec![f64::INFINITY; nc],
             edge_v,
             edge_start,
             edge_min: vec![f64::INFINITY; ne],
@@ -180,7 +193,7 @@ impl AlphaComplex {
             tri_min: Vec::new(),
             tri_max: Vec::new(),
         };
-        ac.compute_triangles_and_edges(&order, &bits);
+        ac.compute_cells_triangles_edges(&order, &mut bits);
         ac
     }
 
@@ -278,8 +291,8 @@ impl AlphaComplex {
         [v[fi[0]], v[fi[1]], v[fi[2]]]
     }
 
-    /// The two cells on the sides of triangle `f` (the first has the
-    /// smaller id; either may be infinite).
+    /// The two cells on the sides of triangle `f`; the first is always
+    /// finite, the second is infinite for a hull triangle.
     #[inline]
     pub fn triangle_cells(&self, f: usize) -> [u32; 2] {
         let p = self.tri_face[f];
@@ -492,8 +505,14 @@ impl AlphaComplex {
         order.last().map(|&t| self.cell_r[t as usize])
     }
 
-    /// Steps 3–4 of the algorithm (module docs).
-    fn compute_triangles_and_edges(&mut self, order: &[u32], bits: &[u8]) {
+    /// Steps 1, 3 and 4 of the algorithm (module docs), fused in one pass
+    /// over the finite cells in `order`: each cell gets its circumradius and
+    /// Gabriel mask (see [`cell_masks`]) and marks itself [`DONE_CELL`] in
+    /// `bits`; a triangle is created by the second of its two cells to be
+    /// visited (or by its finite cell on the hull), when both sides' data
+    /// are known.
+    #[inline(never)]
+    fn compute_cells_triangles_edges(&mut self, order: &[u32], bits: &mut [u8]) {
         let tri = &self.tri;
         let pts = tri.points();
         let nt = tri.num_triangles();
@@ -505,7 +524,7 @@ impl AlphaComplex {
         let edge_start = &self.edge_start;
         let edge_min = &mut self.edge_min;
         let edge_max = &mut self.edge_max;
-        let cell_r = &self.cell_r;
+        let cell_r = &mut self.cell_r;
         let lookup = |a: u32, b: u32| -> usize {
             let (a, b) = if a < b { (a, b) } else { (b, a) };
             let s = edge_start[a as usize] as usize;
@@ -515,47 +534,62 @@ impl AlphaComplex {
             }
             e
         };
-        for &t in order {
-            let v = tri.tet(t);
-            for i in 0..4 {
-                let (n, j) = tri.neighbor(t, i);
-                // Owner: the finite side, the smaller id if both are.
-                let bn = bits[n as usize];
-                if n < t && bn & INFINITE_CELL == 0 {
-                    continue;
-                }
-                let f = FACE[i];
-                let (ia, ib, ic) = (v[f[0]], v[f[1]], v[f[2]]);
-                let (a, b, c) = (&pts[ia as usize], &pts[ib as usize], &pts[ic as usize]);
-                let gabriel = (bits[t as usize] >> i) & 1 == 0 && (bn >> j) & 1 == 0;
-                let rt = cell_r[t as usize];
-                let rn = cell_r[n as usize];
-                let amax = rt.max(rn);
-                let amin = if gabriel {
-                    triangle_rho(a, b, c)
-                } else {
-                    rt.min(rn)
-                };
-                tri_face.push((t << 2) | i as u32);
-                tri_min.push(amin);
-                tri_max.push(amax);
-                // Push to the three edges.
-                for (x, y, z) in [(ia, ib, ic), (ib, ic, ia), (ic, ia, ib)] {
-                    let e = lookup(x, y);
-                    if amax > edge_max[e] {
-                        edge_max[e] = amax;
+        // Cell ids in `order` are scattered in memory: gather each block's
+        // cells first (independent loads, so many misses are in flight at
+        // once), then work on the gathered copy.
+        const BLOCK: usize = 1024;
+        let mut block: Vec<([u32; 4], [(u32, usize); 4])> = Vec::with_capacity(BLOCK);
+        for chunk in order.chunks(BLOCK) {
+            block.clear();
+            block.extend(
+                chunk
+                    .iter()
+                    .map(|&t| (tri.tet(t), [0, 1, 2, 3].map(|i| tri.neighbor(t, i)))),
+            );
+            for (&t, (v, nbr)) in chunk.iter().zip(&block) {
+                let v = *v;
+                let (rt, mt) = cell_masks(pts, &v);
+                cell_r[t as usize] = rt;
+                bits[t as usize] = mt | DONE_CELL;
+                for i in 0..4 {
+                    let (n, j) = nbr[i];
+                    // Owner: the second cell visited, or the finite one.
+                    let bn = bits[n as usize];
+                    if bn & (INFINITE_CELL | DONE_CELL) == 0 {
+                        continue;
                     }
-                    if amin < edge_min[e] {
-                        edge_min[e] = amin;
-                    }
-                    if !non_gabriel[e]
-                        && exact::edge_diametral_side(
-                            &pts[x as usize],
-                            &pts[y as usize],
-                            &pts[z as usize],
-                        ) < 0
-                    {
-                        non_gabriel[e] = true;
+                    let f = FACE[i];
+                    let (ia, ib, ic) = (v[f[0]], v[f[1]], v[f[2]]);
+                    let (a, b, c) = (&pts[ia as usize], &pts[ib as usize], &pts[ic as usize]);
+                    let gabriel = (mt >> i) & 1 == 0 && (bn >> j) & 1 == 0;
+                    let rn = cell_r[n as usize];
+                    let amax = rt.max(rn);
+                    let amin = if gabriel {
+                        triangle_rho(a, b, c)
+                    } else {
+                        rt.min(rn)
+                    };
+                    tri_face.push((t << 2) | i as u32);
+                    tri_min.push(amin);
+                    tri_max.push(amax);
+                    // Push to the three edges.
+                    for (x, y, z) in [(ia, ib, ic), (ib, ic, ia), (ic, ia, ib)] {
+                        let e = lookup(x, y);
+                        if amax > edge_max[e] {
+                            edge_max[e] = amax;
+                        }
+                        if amin < edge_min[e] {
+                            edge_min[e] = amin;
+                        }
+                        if !non_gabriel[e]
+                            && exact::edge_diametral_side(
+                                &pts[x as usize],
+                                &pts[y as usize],
+                                &pts[z as usize],
+                            ) < 0
+                        {
+                            non_gabriel[e] = true;
+                        }
                     }
                 }
             }
@@ -583,34 +617,20 @@ fn find(parent: &mut [u32], mut x: u32) -> u32 {
     x
 }
 
-/// Circumradius of every cell (`+∞` for infinite cells), and for each
-/// finite cell a 4-bit mask: bit `i` is set when vertex `i` lies strictly
-/// inside the diametral sphere of the opposite face (so that face is not
-/// Gabriel); infinite cells get [`INFINITE_CELL`] instead. Visits the cells in id order (sequential), touching only the
-/// cell's own vertices.
-fn cell_pass(tri: &Triangulation) -> (Vec<f64>, Vec<u8>) {
-    let pts = tri.points();
-    let nc = tri.num_tets();
-    let mut radii = Vec::with_capacity(nc);
-    let mut bits = Vec::with_capacity(nc);
-    for t in 0..nc as u32 {
-        let v = tri.tet(t);
-        if v[3] == INFINITE {
-            radii.push(f64::INFINITY);
-            bits.push(INFINITE_CELL);
-            continue;
+/// Circumradius of the finite cell with vertices `v`, and its 4-bit
+/// Gabriel mask: bit `i` is set when vertex `i` lies strictly inside the
+/// diametral sphere of the opposite face (so that face is not Gabriel).
+#[inline]
+fn cell_masks(pts: &[Point3], v: &[u32; 4]) -> (f64, u8) {
+    let p = |k: usize| &pts[v[k] as usize];
+    let r = exact::tet_radius2(p(0), p(1), p(2), p(3)).sqrt();
+    let mut m = 0u8;
+    for (i, f) in FACE.iter().enumerate() {
+        if exact::triangle_diametral_side(p(f[0]), p(f[1]), p(f[2]), p(i)) < 0 {
+            m |= 1 << i;
         }
-        let p = |k: usize| &pts[v[k] as usize];
-        radii.push(exact::tet_radius2(p(0), p(1), p(2), p(3)).sqrt());
-        let mut m = 0u8;
-        for (i, f) in FACE.iter().enumerate() {
-            if exact::triangle_diametral_side(p(f[0]), p(f[1]), p(f[2]), p(i)) < 0 {
-                m |= 1 << i;
-            }
-        }
-        bits.push(m);
     }
-    (radii, bits)
+    (r, m)
 }
 
 /// Numbers the finite edges `(a, b)`, `a < b` (vertex ids), grouped by
@@ -664,18 +684,22 @@ fn number_edges(tri: &Triangulation, order: &[u32]) -> (Vec<[u32; 2]>, Vec<u32>)
     (edges, estart)
 }
 
-/// The finite cells grouped by their smallest vertex id (a counting sort).
-/// Vertex ids follow the spatially coherent insertion order while cell ids
-/// do not, so visiting cells in this order keeps the accesses to points
-/// and edges local.
-fn cells_by_min_vertex(tri: &Triangulation) -> Vec<u32> {
+/// The finite cells grouped by their smallest vertex id (a counting sort),
+/// and the per-cell flag bytes with [`INFINITE_CELL`] set on infinite
+/// cells. Vertex ids follow the spatially coherent insertion order while
+/// cell ids do not, so visiting cells in this order keeps the accesses to
+/// points and edges local.
+fn cells_by_min_vertex(tri: &Triangulation) -> (Vec<u32>, Vec<u8>) {
     let nv = tri.num_vertices();
     let nc = tri.num_tets() as u32;
     let mut start = vec![0u32; nv + 1];
+    let mut flags = vec![0u8; nc as usize];
     for t in 0..nc {
         let v = tri.tet(t);
         if v[3] != INFINITE {
             start[v[0].min(v[1]).min(v[2].min(v[3])) as usize + 1] += 1;
+        } else {
+            flags[t as usize] = INFINITE_CELL;
         }
     }
     for k in 0..nv {
@@ -690,7 +714,7 @@ fn cells_by_min_vertex(tri: &Triangulation) -> Vec<u32> {
             *slot += 1;
         }
     }
-    order
+    (order, flags)
 }
 
 /// Circumradius of the triangle `abc` (radius of its smallest
