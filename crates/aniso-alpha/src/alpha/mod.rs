@@ -86,6 +86,8 @@ const FACE: [[usize; 3]; 4] = [[1, 3, 2], [0, 2, 3], [0, 3, 1], [0, 1, 2]];
 /// Mark of an infinite cell in the per-cell flag bytes (whose low 4 bits
 /// are the Gabriel mask of [`cell_masks`]).
 const INFINITE_CELL: u8 = 0x80;
+/// A cell's vertices and `(neighbour, mirror index)` per face.
+type GatheredCell = ([u32; 4], [(u32, usize); 4]);
 /// Mark of a finite cell already visited by the main pass.
 const DONE_CELL: u8 = 0x40;
 /// The 6 edges of a tet as local index pairs.
@@ -538,7 +540,7 @@ impl AlphaComplex {
         // cells first (independent loads, so many misses are in flight at
         // once), then work on the gathered copy.
         const BLOCK: usize = 1024;
-        let mut block: Vec<([u32; 4], [(u32, usize); 4])> = Vec::with_capacity(BLOCK);
+        let mut block: Vec<GatheredCell> = Vec::with_capacity(BLOCK);
         for chunk in order.chunks(BLOCK) {
             block.clear();
             block.extend(
