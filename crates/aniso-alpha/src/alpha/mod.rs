@@ -181,7 +181,7 @@ impl AlphaComplex {
             };
         }
         let (order, mut bits) = cells_by_min_vertex(&tri);
-        let (edge_v, edge_start) = number_edges(&tri, &order);
+        let (edge_v, edge_start) = number_edges(&tri);
         let ne = edge_v.len();
         let nc = tri.num_tets();
         let mut ac = AlphaComplex {
@@ -638,11 +638,14 @@ fn cell_masks(pts: &[Point3], v: &[u32; 4]) -> (f64, u8) {
 /// Numbers the finite edges `(a, b)`, `a < b` (vertex ids), grouped by
 /// `a`: a counting sort of the 6 edges of every finite tet on `a`, then a
 /// per-vertex deduplication. Returns the edges and the per-vertex offsets.
-fn number_edges(tri: &Triangulation, order: &[u32]) -> (Vec<[u32; 2]>, Vec<u32>) {
+fn number_edges(tri: &Triangulation) -> (Vec<[u32; 2]>, Vec<u32>) {
     let nv = tri.num_vertices();
     let mut start = vec![0u32; nv + 1];
-    for &t in order {
+    for t in 0..tri.num_tets() as u32 {
         let v = tri.tet(t);
+        if v[3] == INFINITE {
+            continue;
+        }
         for [i, j] in PAIRS {
             start[v[i].min(v[j]) as usize + 1] += 1;
         }
@@ -652,8 +655,11 @@ fn number_edges(tri: &Triangulation, order: &[u32]) -> (Vec<[u32; 2]>, Vec<u32>)
     }
     let mut fill: Vec<u32> = start[..nv].to_vec();
     let mut buf = vec![0u32; start[nv] as usize];
-    for &t in order {
+    for t in 0..tri.num_tets() as u32 {
         let v = tri.tet(t);
+        if v[3] == INFINITE {
+            continue;
+        }
         for [i, j] in PAIRS {
             let (a, b) = if v[i] < v[j] {
                 (v[i], v[j])
