@@ -27,12 +27,13 @@
 //!
 //! 1. the finite cells are bucketed by their smallest vertex id (counting
 //!    sort). Vertex ids follow the engine's spatially coherent insertion
-//!    order while cell ids do not, so every later pass visits the cells in
-//!    this order and its accesses to points and edges stay local;
-//! 2. edges: every finite tet emits its 6 edges `(a, b)`, `a < b`, bucketed
-//!    by `a` (counting sort); each bucket is deduplicated with a per-vertex
-//!    stamp. The edges are numbered grouped by `a`, and the per-vertex
-//!    offsets (CSR) give an `O(degree)` lookup;
+//!    order while cell ids do not, so the main pass (3) visits the cells in
+//!    this order (gathering each block of 1024 cells first) and its
+//!    accesses to points and edges stay local;
+//! 2. edges: every finite tet (read in id order) emits its 6 edges
+//!    `(a, b)`, `a < b`, bucketed by `a` (counting sort); each bucket is
+//!    deduplicated with a per-vertex stamp. The edges are numbered grouped
+//!    by `a`, and the per-vertex offsets (CSR) give an `O(degree)` lookup;
 //! 3. one pass over the cells: each computes its circumradius (relative to
 //!    a vertex; recomputed exactly and rounded once for slivers, see
 //!    [`exact`]) and, for each of its faces, whether its opposite vertex is
@@ -624,15 +625,8 @@ fn find(parent: &mut [u32], mut x: u32) -> u32 {
 /// diametral sphere of the opposite face (so that face is not Gabriel).
 #[inline]
 fn cell_masks(pts: &[Point3], v: &[u32; 4]) -> (f64, u8) {
-    let p = |k: usize| &pts[v[k] as usize];
-    let r = exact::tet_radius2(p(0), p(1), p(2), p(3)).sqrt();
-    let mut m = 0u8;
-    for (i, f) in FACE.iter().enumerate() {
-        if exact::triangle_diametral_side(p(f[0]), p(f[1]), p(f[2]), p(i)) < 0 {
-            m |= 1 << i;
-        }
-    }
-    (r, m)
+    let (r2, m) = exact::cell_radius2_and_mask(v.map(|k| &pts[k as usize]));
+    (r2.sqrt(), m)
 }
 
 /// Numbers the finite edges `(a, b)`, `a < b` (vertex ids), grouped by
