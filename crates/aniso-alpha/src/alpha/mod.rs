@@ -151,13 +151,13 @@ pub struct AlphaComplex {
     edge_v: Vec<[u32; 2]>,
     /// Vertex id `a` -> first edge `(a, _)`; `num_vertices + 1` entries.
     edge_start: Vec<u32>,
-    edge_min: Vec<f64>,
-    edge_max: Vec<f64>,
+    /// Edge id -> `[α_min, α_max]`.
+    edge_iv: Vec<[f64; 2]>,
     /// Triangle id -> owning face, packed `4 * cell + local face`, with
     /// `cell` smaller than the neighbour across the face.
     tri_face: Vec<u32>,
-    tri_min: Vec<f64>,
-    tri_max: Vec<f64>,
+    /// Triangle id -> `[α_min, α_max]`.
+    tri_iv: Vec<[f64; 2]>,
 }
 
 impl AlphaComplex {
@@ -174,11 +174,9 @@ impl AlphaComplex {
                 cell_r: Vec::new(),
                 edge_v: Vec::new(),
                 edge_start: vec![0; nv + 1],
-                edge_min: Vec::new(),
-                edge_max: Vec::new(),
+                edge_iv: Vec::new(),
                 tri_face: Vec::new(),
-                tri_min: Vec::new(),
-                tri_max: Vec::new(),
+                tri_iv: Vec::new(),
             };
         }
         let (order, mut bits) = cells_by_min_vertex(&tri);
@@ -190,11 +188,9 @@ impl AlphaComplex {
             cell_r: vec![f64::INFINITY; nc],
             edge_v,
             edge_start,
-            edge_min: vec![f64::INFINITY; ne],
-            edge_max: vec![0.0; ne],
+            edge_iv: vec![[f64::INFINITY, 0.0]; ne],
             tri_face: Vec::new(),
-            tri_min: Vec::new(),
-            tri_max: Vec::new(),
+            tri_iv: Vec::new(),
         };
         ac.compute_cells_triangles_edges(&order, &mut bits);
         ac
@@ -269,7 +265,7 @@ impl AlphaComplex {
     /// `(α_min, α_max)` of edge `e`.
     #[inline]
     pub fn edge_interval(&self, e: usize) -> (f64, f64) {
-        (self.edge_min[e], self.edge_max[e])
+        (self.edge_iv[e][0], self.edge_iv[e][1])
     }
 
     /// The id of the edge between vertex ids `a` and `b`, if it exists.
@@ -306,7 +302,7 @@ impl AlphaComplex {
     /// `(α_min, α_max)` of triangle `f`.
     #[inline]
     pub fn triangle_interval(&self, f: usize) -> (f64, f64) {
-        (self.tri_min[f], self.tri_max[f])
+        (self.tri_iv[f][0], self.tri_iv[f][1])
     }
 
     /// Circumradius of cell `t` (`+∞` for an infinite cell).
@@ -321,24 +317,14 @@ impl AlphaComplex {
         &self.cell_r
     }
 
-    /// The `α_min` values of all edges, indexed by edge id.
-    pub fn edge_alpha_min(&self) -> &[f64] {
-        &self.edge_min
+    /// `[α_min, α_max]` of every edge, indexed by edge id.
+    pub fn edge_intervals(&self) -> &[[f64; 2]] {
+        &self.edge_iv
     }
 
-    /// The `α_max` values of all edges, indexed by edge id.
-    pub fn edge_alpha_max(&self) -> &[f64] {
-        &self.edge_max
-    }
-
-    /// The `α_min` values of all triangles, indexed by triangle id.
-    pub fn triangle_alpha_min(&self) -> &[f64] {
-        &self.tri_min
-    }
-
-    /// The `α_max` values of all triangles, indexed by triangle id.
-    pub fn triangle_alpha_max(&self) -> &[f64] {
-        &self.tri_max
+    /// `[α_min, α_max]` of every triangle, indexed by triangle id.
+    pub fn triangle_intervals(&self) -> &[[f64; 2]] {
+        &self.tri_iv
     }
 
     fn input3(&self, v: [u32; 3]) -> [u32; 3] {
@@ -353,8 +339,8 @@ impl AlphaComplex {
             let [a, b] = self.edge_v[e].map(|x| self.tri.input_index(x));
             EdgeInterval {
                 vertices: if a < b { [a, b] } else { [b, a] },
-                alpha_min: self.edge_min[e],
-                alpha_max: self.edge_max[e],
+                alpha_min: self.edge_iv[e][0],
+                alpha_max: self.edge_iv[e][1],
             }
         })
     }
@@ -364,21 +350,21 @@ impl AlphaComplex {
     pub fn triangles(&self) -> impl Iterator<Item = TriangleInterval> + '_ {
         (0..self.num_triangles()).map(move |f| TriangleInterval {
             vertices: self.input3(self.triangle_vertices(f)),
-            alpha_min: self.tri_min[f],
-            alpha_max: self.tri_max[f],
+            alpha_min: self.tri_iv[f][0],
+            alpha_max: self.tri_iv[f][1],
         })
     }
 
     /// Ids of the edges of `F_{1,α}`: `α_min ≤ α ≤ α_max`.
     pub fn edge_ids_at(&self, alpha: f64) -> impl Iterator<Item = usize> + '_ {
         (0..self.num_edges())
-            .filter(move |&e| self.edge_min[e] <= alpha && alpha <= self.edge_max[e])
+            .filter(move |&e| self.edge_iv[e][0] <= alpha && alpha <= self.edge_iv[e][1])
     }
 
     /// Ids of the triangles of `F_{2,α}`: `α_min ≤ α ≤ α_max`.
     pub fn triangle_ids_at(&self, alpha: f64) -> impl Iterator<Item = usize> + '_ {
         (0..self.num_triangles())
-            .filter(move |&f| self.tri_min[f] <= alpha && alpha <= self.tri_max[f])
+            .filter(move |&f| self.tri_iv[f][0] <= alpha && alpha <= self.tri_iv[f][1])
     }
 
     /// `F_{1,α}` as ascending input-index pairs.
@@ -405,11 +391,10 @@ impl AlphaComplex {
     /// α-complex or `F_α` changes).
     pub fn spectrum(&self) -> Vec<f64> {
         let mut v: Vec<f64> = self
-            .edge_min
+            .edge_iv
             .iter()
-            .chain(&self.edge_max)
-            .chain(&self.tri_min)
-            .chain(&self.tri_max)
+            .chain(&self.tri_iv)
+            .flatten()
             .chain(&self.cell_r)
             .copied()
             .filter(|x| x.is_finite())
@@ -430,7 +415,8 @@ impl AlphaComplex {
     pub fn regular_surface(&self, alpha: f64) -> Vec<[u32; 3]> {
         let mut out = Vec::new();
         for f in 0..self.num_triangles() {
-            if !(self.tri_min[f] <= alpha && alpha < self.tri_max[f]) {
+            let [lo, hi] = self.tri_iv[f];
+            if !(lo <= alpha && alpha < hi) {
                 continue;
             }
             let [t, n] = self.triangle_cells(f);
@@ -520,13 +506,13 @@ impl AlphaComplex {
         let pts = tri.points();
         let nt = tri.num_triangles();
         let mut tri_face = Vec::with_capacity(nt);
-        let mut tri_min = Vec::with_capacity(nt);
-        let mut tri_max = Vec::with_capacity(nt);
-        let mut non_gabriel = vec![false; self.edge_v.len()];
+        let mut tri_iv = Vec::with_capacity(nt);
         let edge_v = &self.edge_v;
         let edge_start = &self.edge_start;
-        let edge_min = &mut self.edge_min;
-        let edge_max = &mut self.edge_max;
+        // During the pass, an edge's slot holds [min of its triangles'
+        // α_min, max of their α_max], with the sign bit of the first set
+        // once a third vertex is found inside its diametral ball.
+        let edge_iv = &mut self.edge_iv;
         let cell_r = &mut self.cell_r;
         let lookup = |a: u32, b: u32| -> usize {
             let (a, b) = if a < b { (a, b) } else { (b, a) };
@@ -573,40 +559,36 @@ impl AlphaComplex {
                         rt.min(rn)
                     };
                     tri_face.push((t << 2) | i as u32);
-                    tri_min.push(amin);
-                    tri_max.push(amax);
+                    tri_iv.push([amin, amax]);
                     // Push to the three edges.
                     for (x, y, z) in [(ia, ib, ic), (ib, ic, ia), (ic, ia, ib)] {
-                        let e = lookup(x, y);
-                        if amax > edge_max[e] {
-                            edge_max[e] = amax;
+                        let slot = &mut edge_iv[lookup(x, y)];
+                        if amax > slot[1] {
+                            slot[1] = amax;
                         }
-                        if amin < edge_min[e] {
-                            edge_min[e] = amin;
-                        }
-                        if !non_gabriel[e]
-                            && exact::edge_diametral_side(
+                        let m = slot[0].abs().min(amin);
+                        let refuted = slot[0].is_sign_negative()
+                            || exact::edge_diametral_side(
                                 &pts[x as usize],
                                 &pts[y as usize],
                                 &pts[z as usize],
-                            ) < 0
-                        {
-                            non_gabriel[e] = true;
-                        }
+                            ) < 0;
+                        slot[0] = if refuted { -m } else { m };
                     }
                 }
             }
         }
-        for (e, &[a, b]) in edge_v.iter().enumerate() {
-            if !non_gabriel[e] {
+        for (slot, &[a, b]) in edge_iv.iter_mut().zip(edge_v) {
+            if slot[0].is_sign_negative() {
+                slot[0] = -slot[0];
+            } else {
                 let (p, q) = (&pts[a as usize], &pts[b as usize]);
                 let d = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
-                edge_min[e] = 0.5 * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                slot[0] = 0.5 * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
             }
         }
         self.tri_face = tri_face;
-        self.tri_min = tri_min;
-        self.tri_max = tri_max;
+        self.tri_iv = tri_iv;
     }
 }
 
