@@ -147,12 +147,12 @@ pub struct AlphaComplex {
     tri: Triangulation,
     /// Cell id -> circumradius (`+∞` for infinite cells).
     cell_r: Vec<f64>,
-    /// Edge id -> vertex ids `(a, b)`, `a < b`, grouped by `a`.
-    edge_v: Vec<[u32; 2]>,
+    /// Edge id -> vertex ids `(a, b)`, `a < b`, grouped by `a`, and
+    /// `[α_min, α_max]` (one record, so that a lookup and an update touch
+    /// the same cache line).
+    edges: Vec<EdgeRec>,
     /// Vertex id `a` -> first edge `(a, _)`; `num_vertices + 1` entries.
     edge_start: Vec<u32>,
-    /// Edge id -> `[α_min, α_max]`.
-    edge_iv: Vec<[f64; 2]>,
     /// Triangle id -> owning face, packed `4 * cell + local face`, with
     /// `cell` smaller than the neighbour across the face.
     tri_face: Vec<u32>,
@@ -172,23 +172,20 @@ impl AlphaComplex {
             return AlphaComplex {
                 tri,
                 cell_r: Vec::new(),
-                edge_v: Vec::new(),
+                edges: Vec::new(),
                 edge_start: vec![0; nv + 1],
-                edge_iv: Vec::new(),
                 tri_face: Vec::new(),
                 tri_iv: Vec::new(),
             };
         }
         let (order, mut bits) = cells_by_min_vertex(&tri);
-        let (edge_v, edge_start) = number_edges(&tri);
-        let ne = edge_v.len();
+        let (edges, edge_start) = number_edges(&tri);
         let nc = tri.num_tets();
         let mut ac = AlphaComplex {
             tri,
             cell_r: vec![f64::INFINITY; nc],
-            edge_v,
+            edges,
             edge_start,
-            edge_iv: vec![[f64::INFINITY, 0.0]; ne],
             tri_face: Vec::new(),
             tri_iv: Vec::new(),
         };
@@ -248,7 +245,7 @@ impl AlphaComplex {
 
     /// Number of finite edges.
     pub fn num_edges(&self) -> usize {
-        self.edge_v.len()
+        self.edges.len()
     }
 
     /// Number of finite triangles.
@@ -259,13 +256,13 @@ impl AlphaComplex {
     /// Vertex ids `(a, b)`, `a < b`, of edge `e`.
     #[inline]
     pub fn edge_vertices(&self, e: usize) -> [u32; 2] {
-        self.edge_v[e]
+        self.edges[e].v
     }
 
     /// `(α_min, α_max)` of edge `e`.
     #[inline]
     pub fn edge_interval(&self, e: usize) -> (f64, f64) {
-        (self.edge_iv[e][0], self.edge_iv[e][1])
+        (self.edges[e].iv[0], self.edges[e].iv[1])
     }
 
     /// The id of the edge between vertex ids `a` and `b`, if it exists.
@@ -273,9 +270,9 @@ impl AlphaComplex {
         let (a, b) = if a < b { (a, b) } else { (b, a) };
         let s = *self.edge_start.get(a as usize)? as usize;
         let e = *self.edge_start.get(a as usize + 1)? as usize;
-        self.edge_v[s..e]
+        self.edges[s..e]
             .iter()
-            .position(|x| x[1] == b)
+            .position(|x| x.v[1] == b)
             .map(|k| s + k)
     }
 
@@ -317,11 +314,6 @@ impl AlphaComplex {
         &self.cell_r
     }
 
-    /// `[α_min, α_max]` of every edge, indexed by edge id.
-    pub fn edge_intervals(&self) -> &[[f64; 2]] {
-        &self.edge_iv
-    }
-
     /// `[α_min, α_max]` of every triangle, indexed by triangle id.
     pub fn triangle_intervals(&self) -> &[[f64; 2]] {
         &self.tri_iv
@@ -336,11 +328,11 @@ impl AlphaComplex {
     /// Every edge with its interval, vertices as ascending input indices.
     pub fn edges(&self) -> impl Iterator<Item = EdgeInterval> + '_ {
         (0..self.num_edges()).map(move |e| {
-            let [a, b] = self.edge_v[e].map(|x| self.tri.input_index(x));
+            let [a, b] = self.edges[e].v.map(|x| self.tri.input_index(x));
             EdgeInterval {
                 vertices: if a < b { [a, b] } else { [b, a] },
-                alpha_min: self.edge_iv[e][0],
-                alpha_max: self.edge_iv[e][1],
+                alpha_min: self.edges[e].iv[0],
+                alpha_max: self.edges[e].iv[1],
             }
         })
     }
@@ -358,7 +350,7 @@ impl AlphaComplex {
     /// Ids of the edges of `F_{1,α}`: `α_min ≤ α ≤ α_max`.
     pub fn edge_ids_at(&self, alpha: f64) -> impl Iterator<Item = usize> + '_ {
         (0..self.num_edges())
-            .filter(move |&e| self.edge_iv[e][0] <= alpha && alpha <= self.edge_iv[e][1])
+            .filter(move |&e| self.edges[e].iv[0] <= alpha && alpha <= self.edges[e].iv[1])
     }
 
     /// Ids of the triangles of `F_{2,α}`: `α_min ≤ α ≤ α_max`.
@@ -370,7 +362,7 @@ impl AlphaComplex {
     /// `F_{1,α}` as ascending input-index pairs.
     pub fn edges_at(&self, alpha: f64) -> impl Iterator<Item = [u32; 2]> + '_ {
         self.edge_ids_at(alpha).map(move |e| {
-            let [a, b] = self.edge_v[e].map(|x| self.tri.input_index(x));
+            let [a, b] = self.edges[e].v.map(|x| self.tri.input_index(x));
             if a < b {
                 [a, b]
             } else {
@@ -391,8 +383,9 @@ impl AlphaComplex {
     /// α-complex or `F_α` changes).
     pub fn spectrum(&self) -> Vec<f64> {
         let mut v: Vec<f64> = self
-            .edge_iv
+            .edges
             .iter()
+            .map(|r| &r.iv)
             .chain(&self.tri_iv)
             .flatten()
             .chain(&self.cell_r)
@@ -507,22 +500,12 @@ impl AlphaComplex {
         let nt = tri.num_triangles();
         let mut tri_face = Vec::with_capacity(nt);
         let mut tri_iv = Vec::with_capacity(nt);
-        let edge_v = &self.edge_v;
         let edge_start = &self.edge_start;
-        // During the pass, an edge's slot holds [min of its triangles'
+        // During the pass, an edge's `iv` holds [min of its triangles'
         // α_min, max of their α_max], with the sign bit of the first set
         // once a third vertex is found inside its diametral ball.
-        let edge_iv = &mut self.edge_iv;
+        let edges = &mut self.edges;
         let cell_r = &mut self.cell_r;
-        let lookup = |a: u32, b: u32| -> usize {
-            let (a, b) = if a < b { (a, b) } else { (b, a) };
-            let s = edge_start[a as usize] as usize;
-            let mut e = s;
-            while edge_v[e][1] != b {
-                e += 1;
-            }
-            e
-        };
         // Cell ids in `order` are scattered in memory: gather each block's
         // cells first (independent loads, so many misses are in flight at
         // once), then work on the gathered copy.
@@ -562,7 +545,7 @@ impl AlphaComplex {
                     tri_iv.push([amin, amax]);
                     // Push to the three edges.
                     for (x, y, z) in [(ia, ib, ic), (ib, ic, ia), (ic, ia, ib)] {
-                        let slot = &mut edge_iv[lookup(x, y)];
+                        let slot = &mut find_edge_rec(edges, edge_start, x, y).iv;
                         if amax > slot[1] {
                             slot[1] = amax;
                         }
@@ -578,7 +561,9 @@ impl AlphaComplex {
                 }
             }
         }
-        for (slot, &[a, b]) in edge_iv.iter_mut().zip(edge_v) {
+        for rec in edges.iter_mut() {
+            let [a, b] = rec.v;
+            let slot = &mut rec.iv;
             if slot[0].is_sign_negative() {
                 slot[0] = -slot[0];
             } else {
@@ -590,6 +575,25 @@ impl AlphaComplex {
         self.tri_face = tri_face;
         self.tri_iv = tri_iv;
     }
+}
+
+/// An edge: vertex ids `(a, b)`, `a < b`, and `[α_min, α_max]`.
+#[derive(Clone, Copy, Debug)]
+struct EdgeRec {
+    v: [u32; 2],
+    iv: [f64; 2],
+}
+
+/// The record of edge `(x, y)` (which must exist), by a scan of the smaller
+/// vertex's bucket.
+#[inline]
+fn find_edge_rec<'a>(edges: &'a mut [EdgeRec], start: &[u32], x: u32, y: u32) -> &'a mut EdgeRec {
+    let (a, b) = if x < y { (x, y) } else { (y, x) };
+    let mut e = start[a as usize] as usize;
+    while edges[e].v[1] != b {
+        e += 1;
+    }
+    &mut edges[e]
 }
 
 /// Union-find root with path halving.
@@ -614,7 +618,7 @@ fn cell_masks(pts: &[Point3], v: &[u32; 4]) -> (f64, u8) {
 /// Numbers the finite edges `(a, b)`, `a < b` (vertex ids), grouped by
 /// `a`: a counting sort of the 6 edges of every finite tet on `a`, then a
 /// per-vertex deduplication. Returns the edges and the per-vertex offsets.
-fn number_edges(tri: &Triangulation) -> (Vec<[u32; 2]>, Vec<u32>) {
+fn number_edges(tri: &Triangulation) -> (Vec<EdgeRec>, Vec<u32>) {
     let nv = tri.num_vertices();
     let mut start = vec![0u32; nv + 1];
     for t in 0..tri.num_tets() as u32 {
@@ -651,7 +655,7 @@ fn number_edges(tri: &Triangulation) -> (Vec<[u32; 2]>, Vec<u32>) {
     // Euler: V − E + F − T = 1 for the (ball-shaped) finite complex.
     let nf = tri.num_triangles();
     let ne_guess = (nv + nf).saturating_sub(tri.num_finite_tets() + 1);
-    let mut edges: Vec<[u32; 2]> = Vec::with_capacity(ne_guess);
+    let mut edges: Vec<EdgeRec> = Vec::with_capacity(ne_guess);
     let mut estart = vec![0u32; nv + 1];
     // Deduplicate each bucket with a stamp per vertex (no sort: within a
     // vertex the edges stay in first-seen order, lookups scan the bucket).
@@ -660,7 +664,10 @@ fn number_edges(tri: &Triangulation) -> (Vec<[u32; 2]>, Vec<u32>) {
         for &b in &buf[start[a] as usize..start[a + 1] as usize] {
             if stamp[b as usize] != a as u32 {
                 stamp[b as usize] = a as u32;
-                edges.push([a as u32, b]);
+                edges.push(EdgeRec {
+                    v: [a as u32, b],
+                    iv: [f64::INFINITY, 0.0],
+                });
             }
         }
         estart[a + 1] = edges.len() as u32;
