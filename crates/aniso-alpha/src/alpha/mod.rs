@@ -211,7 +211,9 @@ impl AlphaComplex {
     /// Each coordinate is computed as `(Q_i1·x + Q_i2·y) + Q_i3·z`, each
     /// operation rounded to double in that order, without fused
     /// multiply-add (numpy's and the project's convention, reproducible bit
-    /// for bit).
+    /// for bit). Points that coincide after the transform (exact
+    /// duplicates, or distinct points collapsed by rounding) are merged
+    /// like duplicates: queries report the smallest input index.
     ///
     /// ```
     /// use aniso_alpha::alpha::{q_matrix, AlphaComplex};
