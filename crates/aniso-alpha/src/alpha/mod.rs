@@ -153,8 +153,8 @@ pub struct AlphaComplex {
     edges: Vec<EdgeRec>,
     /// Vertex id `a` -> first edge `(a, _)`; `num_vertices + 1` entries.
     edge_start: Vec<u32>,
-    /// Triangle id -> owning face, packed `4 * cell + local face`, with
-    /// `cell` smaller than the neighbour across the face.
+    /// Triangle id -> owning face, packed `4 * cell + local face`, where
+    /// `cell` (always finite) is the one that emitted the triangle.
     tri_face: Vec<u32>,
     /// Triangle id -> `[α_min, α_max]`.
     tri_iv: Vec<[f64; 2]>,
