@@ -181,3 +181,43 @@ fn grid_6_aniso_through_api() {
     }
     compare("grid_6_aniso", &ac);
 }
+
+/// Closed intervals: on `grid_6`, 875 simplices have α_min = α_max (= √3/2,
+/// the cube diagonals and the triangles inside each cube); they are in F_α
+/// at exactly that α, and only there (CGAL never calls them SINGULAR or
+/// REGULAR).
+#[test]
+fn grid_6_point_intervals_are_in_f_alpha() {
+    let ac = AlphaComplex::from_points(&read_xyz("grid_6.xyz")).unwrap();
+    let points: Vec<(Vec<u32>, f64)> = ac
+        .edges()
+        .filter(|e| e.alpha_min == e.alpha_max)
+        .map(|e| (e.vertices.to_vec(), e.alpha_min))
+        .chain(
+            ac.triangles()
+                .filter(|t| t.alpha_min == t.alpha_max)
+                .map(|t| (t.vertices.to_vec(), t.alpha_min)),
+        )
+        .collect();
+    assert_eq!(points.len(), 875);
+    let a = points[0].1;
+    assert!(points.iter().all(|p| p.1 == a));
+    assert!((a - 3f64.sqrt() / 2.0).abs() < 1e-15);
+    let at: std::collections::HashSet<Vec<u32>> = ac
+        .edges_at(a)
+        .map(|e| e.to_vec())
+        .chain(ac.triangles_at(a).map(|t| t.to_vec()))
+        .collect();
+    assert!(points.iter().all(|p| at.contains(&p.0)));
+    let below = a * (1.0 - 1e-12);
+    let above = a * (1.0 + 1e-12);
+    for alpha in [below, above] {
+        let n = ac
+            .edges_at(alpha)
+            .map(|e| e.to_vec())
+            .chain(ac.triangles_at(alpha).map(|t| t.to_vec()))
+            .filter(|s| points.iter().any(|p| &p.0 == s))
+            .count();
+        assert_eq!(n, 0, "at {alpha}");
+    }
+}

@@ -85,6 +85,26 @@ pub fn triangle_diametral_side(a: &Point3, b: &Point3, c: &Point3, p: &Point3) -
     ];
     let nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
     let d = ww * nn - wu * vv * (uu - uv) - wv * uu * (vv - uv);
+    // Semi-static stage: with M the largest |coordinate difference| in u, v,
+    // w, the permanent below is at most 144·M⁶ (ww ≤ 3M², its |u × v|²
+    // permanent ≤ 12M⁴, the other two terms ≤ 54M⁶ each), so 4e-15·144 =
+    // 5.8e-13 times M⁶ bounds the error.
+    let m = u[0]
+        .abs()
+        .max(u[1].abs())
+        .max(u[2].abs())
+        .max(v[0].abs().max(v[1].abs()).max(v[2].abs()))
+        .max(w[0].abs().max(w[1].abs()).max(w[2].abs()));
+    let m2 = m * m;
+    let eps = 5.8e-13 * (m2 * m2 * m2);
+    if (f64::MIN_POSITIVE..f64::MAX).contains(&eps) {
+        if d > eps {
+            return 1;
+        }
+        if -d > eps {
+            return -1;
+        }
+    }
     triangle_filter(&u, &v, &w, uu, vv, ww, d).unwrap_or_else(|| triangle_exact(a, b, c, p))
 }
 
@@ -155,21 +175,33 @@ fn triangle_exact(a: &Point3, b: &Point3, c: &Point3, p: &Point3) -> i32 {
     t1.sub(&t2).sub(&t3).sign()
 }
 
-/// Squared circumradius of the tetrahedron `abcd`, accurate to a few ulps
-/// even for slivers: `r² = |N|² / (4 det²)` with `det = u·(v × w)` and
+/// Squared circumradius of the tet `p`, accurate to a few ulps even for
+/// slivers: `r² = |N|² / (4 det²)` with `det = u·(v × w)` and
 /// `N = |u|²(v × w) + |v|²(w × u) + |w|²(u × v)` (`u, v, w` the edges from
-/// `a`). Both are evaluated in f64 with a forward error bound; when either
-/// may have lost more than about 10 bits to cancellation (a flat or
-/// nearly cospherical-and-flat tet), they are recomputed exactly and only
-/// then rounded. `+∞` for a flat tet.
+/// `p[0]`). Both are evaluated in f64 with a forward error bound; when
+/// either may have lost more than about 10 bits to cancellation (a flat or
+/// nearly flat tet), they are recomputed exactly and only then rounded.
+///
+/// Returned with the tet's Gabriel mask: bit `i`
+/// is set when `p[i]` is strictly inside the diametral sphere of the
+/// opposite face `FACE[i]` (`[1, 3, 2]`, `[0, 2, 3]`, `[0, 3, 1]`,
+/// `[0, 1, 2]`), i.e. `triangle_diametral_side(face…, p[i]) < 0`.
+///
+/// Faces 1–3 contain `p[0]`, so their tests share the edge vectors
+/// `u, v, w` from `p[0]`, their dot products and cross products with the
+/// radius computation: each `D` is evaluated with exactly the operations
+/// [`triangle_diametral_side`] would use for that face, and the same
+/// semi-static bound applies; undecided cases (and face 0) go through
+/// [`triangle_diametral_side`].
 #[inline]
-pub(crate) fn tet_radius2(a: &Point3, b: &Point3, c: &Point3, d: &Point3) -> f64 {
+pub(crate) fn cell_radius2_and_mask(p: [&Point3; 4]) -> (f64, u8) {
+    let [a, b, c, d] = p;
     let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
     let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
     let w = [d[0] - a[0], d[1] - a[1], d[2] - a[2]];
-    let uu = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
-    let vv = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
-    let ww = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+    let dot = |x: &Point3, y: &Point3| x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
+    let (uu, vv, ww) = (dot(&u, &u), dot(&v, &v), dot(&w, &w));
+    let (uv, vw, wu) = (dot(&u, &v), dot(&v, &w), dot(&w, &u));
     let cr = |x: &Point3, y: &Point3| {
         [
             x[1] * y[2] - x[2] * y[1],
@@ -177,6 +209,62 @@ pub(crate) fn tet_radius2(a: &Point3, b: &Point3, c: &Point3, d: &Point3) -> f64
             x[0] * y[1] - x[1] * y[0],
         ]
     };
+    let (cvw, cwu, cuv) = (cr(&v, &w), cr(&w, &u), cr(&u, &v));
+    let (nvw, nwu, nuv) = (dot(&cvw, &cvw), dot(&cwu, &cwu), dot(&cuv, &cuv));
+    let m = u[0]
+        .abs()
+        .max(u[1].abs())
+        .max(u[2].abs())
+        .max(v[0].abs().max(v[1].abs()).max(v[2].abs()))
+        .max(w[0].abs().max(w[1].abs()).max(w[2].abs()));
+    let m2 = m * m;
+    let eps = 5.8e-13 * (m2 * m2 * m2);
+    let ok = (f64::MIN_POSITIVE..f64::MAX).contains(&eps);
+    // D for face 3 (a, b, c) + apex d, face 1 (a, c, d) + apex b, face 2
+    // (a, d, b) + apex c, in `triangle_diametral_side`'s variable names.
+    let d3 = ww * nuv - wu * vv * (uu - uv) - vw * uu * (vv - uv);
+    let d1 = uu * nvw - uv * ww * (vv - vw) - wu * vv * (ww - vw);
+    let d2 = vv * nwu - vw * uu * (ww - wu) - uv * ww * (uu - wu);
+    let mut mask = 0u8;
+    for (i, dv, f) in [
+        (1usize, d1, [a, c, d, b]),
+        (2, d2, [a, d, b, c]),
+        (3, d3, [a, b, c, d]),
+    ] {
+        let s = if ok && dv > eps {
+            1
+        } else if ok && -dv > eps {
+            -1
+        } else {
+            triangle_diametral_side(f[0], f[1], f[2], f[3])
+        };
+        if s < 0 {
+            mask |= 1 << i;
+        }
+    }
+    if triangle_diametral_side(b, d, c, a) < 0 {
+        mask |= 1;
+    }
+    let r2 = radius2_from(p, &u, &v, &w, [uu, vv, ww], [cvw, cwu, cuv]);
+    (r2, mask)
+}
+
+/// Squared circumradius of the tet `p` from its edge vectors `u, v, w`
+/// (from `p[0]`), their squared lengths and the cross products
+/// `v × w, w × u, u × v`: shared by [`cell_radius2_and_mask`] and
+/// [`tet_radius2`] so that both give the same bits.
+#[inline(always)]
+fn radius2_from(
+    p: [&Point3; 4],
+    u: &Point3,
+    v: &Point3,
+    w: &Point3,
+    [uu, vv, ww]: [f64; 3],
+    [cvw, cwu, cuv]: [[f64; 3]; 3],
+) -> f64 {
+    let [a, b, c, d] = p;
+    // The circumradius. Relative errors are below ~8ε·p/|x|: keep the
+    // float result while that is under ~2e-12 (|x| ≥ 1e-3·p).
     let pc = |x: &Point3, y: &Point3| {
         [
             (x[1] * y[2]).abs() + (x[2] * y[1]).abs(),
@@ -184,20 +272,39 @@ pub(crate) fn tet_radius2(a: &Point3, b: &Point3, c: &Point3, d: &Point3) -> f64
             (x[0] * y[1]).abs() + (x[1] * y[0]).abs(),
         ]
     };
-    let (vw, wu, uv) = (cr(&v, &w), cr(&w, &u), cr(&u, &v));
-    let (pvw, pwu, puv) = (pc(&v, &w), pc(&w, &u), pc(&u, &v));
-    let det = u[0] * vw[0] + u[1] * vw[1] + u[2] * vw[2];
+    let (pvw, pwu, puv) = (pc(v, w), pc(w, u), pc(u, v));
+    let det = u[0] * cvw[0] + u[1] * cvw[1] + u[2] * cvw[2];
     let pdet = u[0].abs() * pvw[0] + u[1].abs() * pvw[1] + u[2].abs() * pvw[2];
-    let n: [f64; 3] = std::array::from_fn(|k| uu * vw[k] + vv * wu[k] + ww * uv[k]);
+    let n: [f64; 3] = std::array::from_fn(|k| uu * cvw[k] + vv * cwu[k] + ww * cuv[k]);
     let pn: [f64; 3] = std::array::from_fn(|k| uu * pvw[k] + vv * pwu[k] + ww * puv[k]);
     let nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
     let pnn = pn[0] * pn[0] + pn[1] * pn[1] + pn[2] * pn[2];
-    // Relative errors below ~8ε·p/|x|: keep the float result while that is
-    // under ~2e-12 (|x| ≥ 1e-3·p).
     if det.abs() >= 1e-3 * pdet && nn >= 1e-6 * pnn && pdet > 0.0 {
-        return nn / (4.0 * det * det);
+        nn / (4.0 * det * det)
+    } else {
+        tet_radius2_exact(a, b, c, d)
     }
-    tet_radius2_exact(a, b, c, d)
+}
+
+/// Squared circumradius of the tet `abcd` (`+∞` if flat), exactly as
+/// [`cell_radius2_and_mask`] computes it.
+#[inline]
+pub(crate) fn tet_radius2(p: [&Point3; 4]) -> f64 {
+    let [a, b, c, d] = p;
+    let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+    let w = [d[0] - a[0], d[1] - a[1], d[2] - a[2]];
+    let dot = |x: &Point3, y: &Point3| x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
+    let (uu, vv, ww) = (dot(&u, &u), dot(&v, &v), dot(&w, &w));
+    let cr = |x: &Point3, y: &Point3| {
+        [
+            x[1] * y[2] - x[2] * y[1],
+            x[2] * y[0] - x[0] * y[2],
+            x[0] * y[1] - x[1] * y[0],
+        ]
+    };
+    let (cvw, cwu, cuv) = (cr(&v, &w), cr(&w, &u), cr(&u, &v));
+    radius2_from(p, &u, &v, &w, [uu, vv, ww], [cvw, cwu, cuv])
 }
 
 #[cold]
@@ -424,6 +531,47 @@ mod tests {
         let r = a.mul(&b).sub(&one);
         assert_eq!(r.sign(), -1);
         assert_eq!(r.estimate(), -(2f64.powi(-120)));
+    }
+
+    /// The shared evaluation in `cell_radius2_and_mask` decides every face
+    /// like `triangle_diametral_side`, on random and on grid (tie-rich)
+    /// tets.
+    #[test]
+    fn cell_mask_matches_per_face_tests() {
+        const FACE: [[usize; 3]; 4] = [[1, 3, 2], [0, 2, 3], [0, 3, 1], [0, 1, 2]];
+        let mut s = 7u64;
+        let mut rnd = || {
+            s = s.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = s;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut set = 0;
+        for it in 0..20000 {
+            let p: [Point3; 4] = std::array::from_fn(|_| {
+                if it % 2 == 0 {
+                    [rnd(), rnd(), rnd()]
+                } else {
+                    [
+                        (rnd() * 4.0).floor(),
+                        (rnd() * 4.0).floor(),
+                        (rnd() * 4.0).floor(),
+                    ]
+                }
+            });
+            // positively oriented, non-flat tets only
+            if crate::geometry::predicates::orient3d(&p[0], &p[1], &p[2], &p[3]) <= 0 {
+                continue;
+            }
+            let (_, m) = cell_radius2_and_mask([&p[0], &p[1], &p[2], &p[3]]);
+            for (i, f) in FACE.iter().enumerate() {
+                let want = triangle_diametral_side(&p[f[0]], &p[f[1]], &p[f[2]], &p[i]) < 0;
+                assert_eq!((m >> i) & 1 == 1, want, "{p:?} face {i}");
+                set += want as usize;
+            }
+        }
+        assert!(set > 1000);
     }
 
     #[test]

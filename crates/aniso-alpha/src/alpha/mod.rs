@@ -25,20 +25,33 @@
 //! Everything is flat (`Vec`s indexed by `u32`), linear in the number of
 //! simplices, without hashing:
 //!
-//! 1. circumradius of every cell (`+∞` for infinite cells), computed
-//!    relative to a vertex of the tet;
-//! 2. edges: every finite tet emits its 6 edges `(a, b)`, `a < b`, bucketed
-//!    by `a` with a counting sort; each vertex's bucket is sorted and
-//!    deduplicated. The edges are then numbered by `(a, b)` and the
-//!    per-vertex offsets (CSR) give an `O(degree)` lookup;
-//! 3. triangles: each finite face once, from the cell with the smaller id;
-//!    its Gabriel test looks at the (one or two) opposite vertices, and it
-//!    then pushes its values to its three edges (α_max: max, α_min of the
-//!    cofaces: min, Gabriel test of the edge against the triangle's third
-//!    vertex; the third vertices of an edge's triangles are exactly the
-//!    vertices of its incident tets);
+//! 1. the finite cells are bucketed by their smallest vertex id (counting
+//!    sort). Vertex ids follow the engine's spatially coherent insertion
+//!    order while cell ids do not, so the main pass (3) visits the cells in
+//!    this order (gathering each block of 1024 cells first) and its
+//!    accesses to points and edges stay local;
+//! 2. edges: every finite tet (read in id order) emits its 6 edges
+//!    `(a, b)`, `a < b`, bucketed by `a` (counting sort); each bucket is
+//!    deduplicated with a per-vertex stamp. The edges are numbered grouped
+//!    by `a`, and the per-vertex offsets (CSR) give an `O(degree)` lookup;
+//! 3. one pass over the cells: each computes its circumradius (relative to
+//!    a vertex; recomputed exactly and rounded once for slivers, see
+//!    [`exact`]) and, for each of its faces, whether its opposite vertex is
+//!    strictly inside the face's diametral sphere (exact). A triangle is
+//!    emitted by the second of its two cells to be visited (or its finite
+//!    cell on the hull), when both sides are known: Gabriel iff neither
+//!    apex is inside. It then pushes its values to its three edges (max of
+//!    `α_max`, min of the cofaces' `α_min`, and the edge's own Gabriel test
+//!    against the triangle's third vertex: the third vertices of an edge's
+//!    triangles are exactly the vertices of its incident tets);
 //! 4. each edge's `α_min` is its half length if Gabriel, else the minimum
 //!    over its triangles.
+//!
+//! Memory: the complex adds about 8 bytes per cell, 20 per triangle and 24
+//! per edge to the triangulation (≈ 0.5 GB for 1M uniform points), plus
+//! transient buckets of 4 bytes per (tet, edge) incidence during step 2.
+//! The computation is sequential; the detector runs one complex per
+//! orientation, which is where parallelism belongs.
 //!
 //! The struct owns the triangulation (get it back with
 //! [`AlphaComplex::into_triangulation`]).
@@ -71,6 +84,13 @@ use crate::geometry::Point3;
 /// so that face `i` of a positively oriented tet has its normal (right-hand
 /// rule) pointing towards vertex `i`, i.e. into the tet.
 const FACE: [[usize; 3]; 4] = [[1, 3, 2], [0, 2, 3], [0, 3, 1], [0, 1, 2]];
+/// Mark of an infinite cell in the per-cell flag bytes (whose low 4 bits
+/// are the Gabriel mask of [`cell_masks`]).
+const INFINITE_CELL: u8 = 0x80;
+/// A cell's vertices and `(neighbour, mirror index)` per face.
+type GatheredCell = ([u32; 4], [(u32, usize); 4]);
+/// Mark of a finite cell already visited by the main pass.
+const DONE_CELL: u8 = 0x40;
 /// The 6 edges of a tet as local index pairs.
 const PAIRS: [[usize; 2]; 6] = [[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]];
 
@@ -102,8 +122,8 @@ pub struct TriangleInterval {
 /// The alpha intervals of every edge and triangle of a 3D Delaunay
 /// triangulation, and the circumradii of its tetrahedra.
 ///
-/// Ids: edges are numbered `0..num_edges()` in `(a, b)` order of their
-/// vertex ids, triangles `0..num_triangles()`; cells (tets) use the
+/// Ids: edges are numbered `0..num_edges()` grouped by their smaller
+/// vertex id, triangles `0..num_triangles()`; cells (tets) use the
 /// triangulation's ids. Vertex ids are the triangulation's (insertion
 /// order); every query that says *input* maps them to input indices.
 ///
@@ -127,17 +147,17 @@ pub struct AlphaComplex {
     tri: Triangulation,
     /// Cell id -> circumradius (`+∞` for infinite cells).
     cell_r: Vec<f64>,
-    /// Edge id -> vertex ids `(a, b)`, `a < b`, sorted.
-    edge_v: Vec<[u32; 2]>,
+    /// Edge id -> vertex ids `(a, b)`, `a < b`, grouped by `a`, and
+    /// `[α_min, α_max]` (one record, so that a lookup and an update touch
+    /// the same cache line).
+    edges: Vec<EdgeRec>,
     /// Vertex id `a` -> first edge `(a, _)`; `num_vertices + 1` entries.
     edge_start: Vec<u32>,
-    edge_min: Vec<f64>,
-    edge_max: Vec<f64>,
-    /// Triangle id -> owning face, packed `4 * cell + local face`, with
-    /// `cell` smaller than the neighbour across the face.
+    /// Triangle id -> owning face, packed `4 * cell + local face`, where
+    /// `cell` (always finite) is the one that emitted the triangle.
     tri_face: Vec<u32>,
-    tri_min: Vec<f64>,
-    tri_max: Vec<f64>,
+    /// Triangle id -> `[α_min, α_max]`.
+    tri_iv: Vec<[f64; 2]>,
 }
 
 impl AlphaComplex {
@@ -152,30 +172,24 @@ impl AlphaComplex {
             return AlphaComplex {
                 tri,
                 cell_r: Vec::new(),
-                edge_v: Vec::new(),
+                edges: Vec::new(),
                 edge_start: vec![0; nv + 1],
-                edge_min: Vec::new(),
-                edge_max: Vec::new(),
                 tri_face: Vec::new(),
-                tri_min: Vec::new(),
-                tri_max: Vec::new(),
+                tri_iv: Vec::new(),
             };
         }
-        let cell_r = cell_radii(&tri);
-        let (edge_v, edge_start) = number_edges(&tri);
-        let ne = edge_v.len();
+        let (order, mut bits) = cells_by_min_vertex(&tri);
+        let (edges, edge_start) = number_edges(&tri);
+        let nc = tri.num_tets();
         let mut ac = AlphaComplex {
             tri,
-            cell_r,
-            edge_v,
+            cell_r: vec![f64::INFINITY; nc],
+            edges,
             edge_start,
-            edge_min: vec![f64::INFINITY; ne],
-            edge_max: vec![0.0; ne],
             tri_face: Vec::new(),
-            tri_min: Vec::new(),
-            tri_max: Vec::new(),
+            tri_iv: Vec::new(),
         };
-        ac.compute_triangles_and_edges();
+        ac.compute_cells_triangles_edges(&order, &mut bits);
         ac
     }
 
@@ -197,7 +211,9 @@ impl AlphaComplex {
     /// Each coordinate is computed as `(Q_i1·x + Q_i2·y) + Q_i3·z`, each
     /// operation rounded to double in that order, without fused
     /// multiply-add (numpy's and the project's convention, reproducible bit
-    /// for bit).
+    /// for bit). Points that coincide after the transform (exact
+    /// duplicates, or distinct points collapsed by rounding) are merged
+    /// like duplicates: queries report the smallest input index.
     ///
     /// ```
     /// use aniso_alpha::alpha::{q_matrix, AlphaComplex};
@@ -231,7 +247,7 @@ impl AlphaComplex {
 
     /// Number of finite edges.
     pub fn num_edges(&self) -> usize {
-        self.edge_v.len()
+        self.edges.len()
     }
 
     /// Number of finite triangles.
@@ -242,13 +258,13 @@ impl AlphaComplex {
     /// Vertex ids `(a, b)`, `a < b`, of edge `e`.
     #[inline]
     pub fn edge_vertices(&self, e: usize) -> [u32; 2] {
-        self.edge_v[e]
+        self.edges[e].v
     }
 
     /// `(α_min, α_max)` of edge `e`.
     #[inline]
     pub fn edge_interval(&self, e: usize) -> (f64, f64) {
-        (self.edge_min[e], self.edge_max[e])
+        (self.edges[e].iv[0], self.edges[e].iv[1])
     }
 
     /// The id of the edge between vertex ids `a` and `b`, if it exists.
@@ -256,9 +272,9 @@ impl AlphaComplex {
         let (a, b) = if a < b { (a, b) } else { (b, a) };
         let s = *self.edge_start.get(a as usize)? as usize;
         let e = *self.edge_start.get(a as usize + 1)? as usize;
-        self.edge_v[s..e]
+        self.edges[s..e]
             .iter()
-            .position(|x| x[1] == b)
+            .position(|x| x.v[1] == b)
             .map(|k| s + k)
     }
 
@@ -273,8 +289,8 @@ impl AlphaComplex {
         [v[fi[0]], v[fi[1]], v[fi[2]]]
     }
 
-    /// The two cells on the sides of triangle `f` (the first has the
-    /// smaller id; either may be infinite).
+    /// The two cells on the sides of triangle `f`; the first is always
+    /// finite, the second is infinite for a hull triangle.
     #[inline]
     pub fn triangle_cells(&self, f: usize) -> [u32; 2] {
         let p = self.tri_face[f];
@@ -285,7 +301,7 @@ impl AlphaComplex {
     /// `(α_min, α_max)` of triangle `f`.
     #[inline]
     pub fn triangle_interval(&self, f: usize) -> (f64, f64) {
-        (self.tri_min[f], self.tri_max[f])
+        (self.tri_iv[f][0], self.tri_iv[f][1])
     }
 
     /// Circumradius of cell `t` (`+∞` for an infinite cell).
@@ -300,24 +316,9 @@ impl AlphaComplex {
         &self.cell_r
     }
 
-    /// The `α_min` values of all edges, indexed by edge id.
-    pub fn edge_alpha_min(&self) -> &[f64] {
-        &self.edge_min
-    }
-
-    /// The `α_max` values of all edges, indexed by edge id.
-    pub fn edge_alpha_max(&self) -> &[f64] {
-        &self.edge_max
-    }
-
-    /// The `α_min` values of all triangles, indexed by triangle id.
-    pub fn triangle_alpha_min(&self) -> &[f64] {
-        &self.tri_min
-    }
-
-    /// The `α_max` values of all triangles, indexed by triangle id.
-    pub fn triangle_alpha_max(&self) -> &[f64] {
-        &self.tri_max
+    /// `[α_min, α_max]` of every triangle, indexed by triangle id.
+    pub fn triangle_intervals(&self) -> &[[f64; 2]] {
+        &self.tri_iv
     }
 
     fn input3(&self, v: [u32; 3]) -> [u32; 3] {
@@ -329,11 +330,11 @@ impl AlphaComplex {
     /// Every edge with its interval, vertices as ascending input indices.
     pub fn edges(&self) -> impl Iterator<Item = EdgeInterval> + '_ {
         (0..self.num_edges()).map(move |e| {
-            let [a, b] = self.edge_v[e].map(|x| self.tri.input_index(x));
+            let [a, b] = self.edges[e].v.map(|x| self.tri.input_index(x));
             EdgeInterval {
                 vertices: if a < b { [a, b] } else { [b, a] },
-                alpha_min: self.edge_min[e],
-                alpha_max: self.edge_max[e],
+                alpha_min: self.edges[e].iv[0],
+                alpha_max: self.edges[e].iv[1],
             }
         })
     }
@@ -343,27 +344,27 @@ impl AlphaComplex {
     pub fn triangles(&self) -> impl Iterator<Item = TriangleInterval> + '_ {
         (0..self.num_triangles()).map(move |f| TriangleInterval {
             vertices: self.input3(self.triangle_vertices(f)),
-            alpha_min: self.tri_min[f],
-            alpha_max: self.tri_max[f],
+            alpha_min: self.tri_iv[f][0],
+            alpha_max: self.tri_iv[f][1],
         })
     }
 
     /// Ids of the edges of `F_{1,α}`: `α_min ≤ α ≤ α_max`.
     pub fn edge_ids_at(&self, alpha: f64) -> impl Iterator<Item = usize> + '_ {
         (0..self.num_edges())
-            .filter(move |&e| self.edge_min[e] <= alpha && alpha <= self.edge_max[e])
+            .filter(move |&e| self.edges[e].iv[0] <= alpha && alpha <= self.edges[e].iv[1])
     }
 
     /// Ids of the triangles of `F_{2,α}`: `α_min ≤ α ≤ α_max`.
     pub fn triangle_ids_at(&self, alpha: f64) -> impl Iterator<Item = usize> + '_ {
         (0..self.num_triangles())
-            .filter(move |&f| self.tri_min[f] <= alpha && alpha <= self.tri_max[f])
+            .filter(move |&f| self.tri_iv[f][0] <= alpha && alpha <= self.tri_iv[f][1])
     }
 
     /// `F_{1,α}` as ascending input-index pairs.
     pub fn edges_at(&self, alpha: f64) -> impl Iterator<Item = [u32; 2]> + '_ {
         self.edge_ids_at(alpha).map(move |e| {
-            let [a, b] = self.edge_v[e].map(|x| self.tri.input_index(x));
+            let [a, b] = self.edges[e].v.map(|x| self.tri.input_index(x));
             if a < b {
                 [a, b]
             } else {
@@ -384,11 +385,11 @@ impl AlphaComplex {
     /// α-complex or `F_α` changes).
     pub fn spectrum(&self) -> Vec<f64> {
         let mut v: Vec<f64> = self
-            .edge_min
+            .edges
             .iter()
-            .chain(&self.edge_max)
-            .chain(&self.tri_min)
-            .chain(&self.tri_max)
+            .map(|r| &r.iv)
+            .chain(&self.tri_iv)
+            .flatten()
             .chain(&self.cell_r)
             .copied()
             .filter(|x| x.is_finite())
@@ -409,7 +410,8 @@ impl AlphaComplex {
     pub fn regular_surface(&self, alpha: f64) -> Vec<[u32; 3]> {
         let mut out = Vec::new();
         for f in 0..self.num_triangles() {
-            if !(self.tri_min[f] <= alpha && alpha < self.tri_max[f]) {
+            let [lo, hi] = self.tri_iv[f];
+            if !(lo <= alpha && alpha < hi) {
                 continue;
             }
             let [t, n] = self.triangle_cells(f);
@@ -487,85 +489,112 @@ impl AlphaComplex {
         order.last().map(|&t| self.cell_r[t as usize])
     }
 
-    /// Steps 3–4 of the algorithm (module docs).
-    fn compute_triangles_and_edges(&mut self) {
+    /// Steps 1, 3 and 4 of the algorithm (module docs), fused in one pass
+    /// over the finite cells in `order`: each cell gets its circumradius and
+    /// Gabriel mask (see [`cell_masks`]) and marks itself [`DONE_CELL`] in
+    /// `bits`; a triangle is created by the second of its two cells to be
+    /// visited (or by its finite cell on the hull), when both sides' data
+    /// are known.
+    #[inline(never)]
+    fn compute_cells_triangles_edges(&mut self, order: &[u32], bits: &mut [u8]) {
         let tri = &self.tri;
         let pts = tri.points();
         let nt = tri.num_triangles();
         let mut tri_face = Vec::with_capacity(nt);
-        let mut tri_min = Vec::with_capacity(nt);
-        let mut tri_max = Vec::with_capacity(nt);
-        let mut non_gabriel = vec![false; self.edge_v.len()];
-        let edge_v = &self.edge_v;
+        let mut tri_iv = Vec::with_capacity(nt);
         let edge_start = &self.edge_start;
-        let edge_min = &mut self.edge_min;
-        let edge_max = &mut self.edge_max;
-        let cell_r = &self.cell_r;
-        let lookup = |a: u32, b: u32| -> usize {
-            let (a, b) = if a < b { (a, b) } else { (b, a) };
-            let s = edge_start[a as usize] as usize;
-            let mut e = s;
-            while edge_v[e][1] != b {
-                e += 1;
-            }
-            e
-        };
-        for t in 0..tri.num_tets() as u32 {
-            let v = tri.tet(t);
-            let finite = v[3] != INFINITE;
-            for i in 0..4 {
-                if !finite && i != 3 {
-                    continue;
-                }
-                let (n, j) = tri.neighbor(t, i);
-                if n < t {
-                    continue;
-                }
-                let f = FACE[i];
-                let (ia, ib, ic) = (v[f[0]], v[f[1]], v[f[2]]);
-                let (a, b, c) = (&pts[ia as usize], &pts[ib as usize], &pts[ic as usize]);
-                let apex_t = v[i];
-                let apex_n = tri.tet(n)[j];
-                let (rho, gabriel) = triangle_rho_gabriel(a, b, c, apex_t, apex_n, pts);
-                let rt = cell_r[t as usize];
-                let rn = cell_r[n as usize];
-                let amax = rt.max(rn);
-                let amin = if gabriel { rho } else { rt.min(rn) };
-                tri_face.push((t << 2) | i as u32);
-                tri_min.push(amin);
-                tri_max.push(amax);
-                // Push to the three edges.
-                for (x, y, z) in [(ia, ib, ic), (ib, ic, ia), (ic, ia, ib)] {
-                    let e = lookup(x, y);
-                    if amax > edge_max[e] {
-                        edge_max[e] = amax;
+        // During the pass, an edge's `iv` holds [min of its triangles'
+        // α_min, max of their α_max], with the sign bit of the first set
+        // once a third vertex is found inside its diametral ball.
+        let edges = &mut self.edges;
+        let cell_r = &mut self.cell_r;
+        // Cell ids in `order` are scattered in memory: gather each block's
+        // cells first (independent loads, so many misses are in flight at
+        // once), then work on the gathered copy.
+        const BLOCK: usize = 1024;
+        let mut block: Vec<GatheredCell> = Vec::with_capacity(BLOCK);
+        for chunk in order.chunks(BLOCK) {
+            block.clear();
+            block.extend(
+                chunk
+                    .iter()
+                    .map(|&t| (tri.tet(t), [0, 1, 2, 3].map(|i| tri.neighbor(t, i)))),
+            );
+            for (&t, (v, nbr)) in chunk.iter().zip(&block) {
+                let v = *v;
+                let (rt, mt) = cell_masks(pts, &v);
+                cell_r[t as usize] = rt;
+                bits[t as usize] = mt | DONE_CELL;
+                for i in 0..4 {
+                    let (n, j) = nbr[i];
+                    // Owner: the second cell visited, or the finite one.
+                    let bn = bits[n as usize];
+                    if bn & (INFINITE_CELL | DONE_CELL) == 0 {
+                        continue;
                     }
-                    if amin < edge_min[e] {
-                        edge_min[e] = amin;
-                    }
-                    if !non_gabriel[e]
-                        && exact::edge_diametral_side(
-                            &pts[x as usize],
-                            &pts[y as usize],
-                            &pts[z as usize],
-                        ) < 0
-                    {
-                        non_gabriel[e] = true;
+                    let f = FACE[i];
+                    let (ia, ib, ic) = (v[f[0]], v[f[1]], v[f[2]]);
+                    let gabriel = (mt >> i) & 1 == 0 && (bn >> j) & 1 == 0;
+                    let rn = cell_r[n as usize];
+                    let amax = rt.max(rn);
+                    let amin = if gabriel {
+                        triangle_rho_sorted(pts, [ia, ib, ic])
+                    } else {
+                        rt.min(rn)
+                    };
+                    tri_face.push((t << 2) | i as u32);
+                    tri_iv.push([amin, amax]);
+                    // Push to the three edges.
+                    for (x, y, z) in [(ia, ib, ic), (ib, ic, ia), (ic, ia, ib)] {
+                        let slot = &mut find_edge_rec(edges, edge_start, x, y).iv;
+                        if amax > slot[1] {
+                            slot[1] = amax;
+                        }
+                        let m = slot[0].abs().min(amin);
+                        let refuted = slot[0].is_sign_negative()
+                            || exact::edge_diametral_side(
+                                &pts[x as usize],
+                                &pts[y as usize],
+                                &pts[z as usize],
+                            ) < 0;
+                        slot[0] = if refuted { -m } else { m };
                     }
                 }
             }
         }
-        for (e, &[a, b]) in edge_v.iter().enumerate() {
-            if !non_gabriel[e] {
+        for rec in edges.iter_mut() {
+            let [a, b] = rec.v;
+            let slot = &mut rec.iv;
+            if slot[0].is_sign_negative() {
+                slot[0] = -slot[0];
+            } else {
                 let (p, q) = (&pts[a as usize], &pts[b as usize]);
                 let d = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
-                edge_min[e] = 0.5 * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                slot[0] = 0.5 * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
             }
         }
         self.tri_face = tri_face;
-        self.tri_min = tri_min;
-        self.tri_max = tri_max;
+        self.tri_iv = tri_iv;
     }
+}
+
+/// An edge: vertex ids `(a, b)`, `a < b`, and `[α_min, α_max]`.
+#[derive(Clone, Copy, Debug)]
+struct EdgeRec {
+    v: [u32; 2],
+    iv: [f64; 2],
+}
+
+/// The record of edge `(x, y)` (which must exist), by a scan of the smaller
+/// vertex's bucket.
+#[inline]
+fn find_edge_rec<'a>(edges: &'a mut [EdgeRec], start: &[u32], x: u32, y: u32) -> &'a mut EdgeRec {
+    let (a, b) = if x < y { (x, y) } else { (y, x) };
+    let mut e = start[a as usize] as usize;
+    while edges[e].v[1] != b {
+        e += 1;
+    }
+    &mut edges[e]
 }
 
 /// Union-find root with path halving.
@@ -578,30 +607,22 @@ fn find(parent: &mut [u32], mut x: u32) -> u32 {
     x
 }
 
-/// Circumradius of every cell (`+∞` for infinite cells).
-pub(crate) fn cell_radii(tri: &Triangulation) -> Vec<f64> {
-    let pts = tri.points();
-    (0..tri.num_tets() as u32)
-        .map(|t| {
-            let v = tri.tet(t);
-            if v[3] == INFINITE {
-                f64::INFINITY
-            } else {
-                let p = |k: usize| &pts[v[k] as usize];
-                exact::tet_radius2(p(0), p(1), p(2), p(3)).sqrt()
-            }
-        })
-        .collect()
+/// Circumradius of the finite cell with vertices `v`, and its 4-bit
+/// Gabriel mask: bit `i` is set when vertex `i` lies strictly inside the
+/// diametral sphere of the opposite face (so that face is not Gabriel).
+#[inline]
+fn cell_masks(pts: &[Point3], v: &[u32; 4]) -> (f64, u8) {
+    let (r2, m) = exact::cell_radius2_and_mask(v.map(|k| &pts[k as usize]));
+    (r2.sqrt(), m)
 }
 
-/// Numbers the finite edges by `(a, b)`, `a < b` (vertex ids), with a
-/// counting sort of the 6 edges of every finite tet on `a` and a per-vertex
-/// sort + dedup. Returns the edges and the per-vertex offsets.
-fn number_edges(tri: &Triangulation) -> (Vec<[u32; 2]>, Vec<u32>) {
+/// Numbers the finite edges `(a, b)`, `a < b` (vertex ids), grouped by
+/// `a`: a counting sort of the 6 edges of every finite tet on `a`, then a
+/// per-vertex deduplication. Returns the edges and the per-vertex offsets.
+fn number_edges(tri: &Triangulation) -> (Vec<EdgeRec>, Vec<u32>) {
     let nv = tri.num_vertices();
-    let nc = tri.num_tets() as u32;
     let mut start = vec![0u32; nv + 1];
-    for t in 0..nc {
+    for t in 0..tri.num_tets() as u32 {
         let v = tri.tet(t);
         if v[3] == INFINITE {
             continue;
@@ -615,7 +636,7 @@ fn number_edges(tri: &Triangulation) -> (Vec<[u32; 2]>, Vec<u32>) {
     }
     let mut fill: Vec<u32> = start[..nv].to_vec();
     let mut buf = vec![0u32; start[nv] as usize];
-    for t in 0..nc {
+    for t in 0..tri.num_tets() as u32 {
         let v = tri.tet(t);
         if v[3] == INFINITE {
             continue;
@@ -635,16 +656,19 @@ fn number_edges(tri: &Triangulation) -> (Vec<[u32; 2]>, Vec<u32>) {
     // Euler: V − E + F − T = 1 for the (ball-shaped) finite complex.
     let nf = tri.num_triangles();
     let ne_guess = (nv + nf).saturating_sub(tri.num_finite_tets() + 1);
-    let mut edges: Vec<[u32; 2]> = Vec::with_capacity(ne_guess);
+    let mut edges: Vec<EdgeRec> = Vec::with_capacity(ne_guess);
     let mut estart = vec![0u32; nv + 1];
+    // Deduplicate each bucket with a stamp per vertex (no sort: within a
+    // vertex the edges stay in first-seen order, lookups scan the bucket).
+    let mut stamp = vec![u32::MAX; nv];
     for a in 0..nv {
-        let s = &mut buf[start[a] as usize..start[a + 1] as usize];
-        insertion_sort(s);
-        let mut last = u32::MAX;
-        for &b in s.iter() {
-            if b != last {
-                edges.push([a as u32, b]);
-                last = b;
+        for &b in &buf[start[a] as usize..start[a + 1] as usize] {
+            if stamp[b as usize] != a as u32 {
+                stamp[b as usize] = a as u32;
+                edges.push(EdgeRec {
+                    v: [a as u32, b],
+                    iv: [f64::INFINITY, 0.0],
+                });
             }
         }
         estart[a + 1] = edges.len() as u32;
@@ -652,65 +676,63 @@ fn number_edges(tri: &Triangulation) -> (Vec<[u32; 2]>, Vec<u32>) {
     (edges, estart)
 }
 
-/// Sorts a short slice (a vertex's bucket holds a few dozen entries).
-fn insertion_sort(s: &mut [u32]) {
-    if s.len() > 64 {
-        s.sort_unstable();
-        return;
-    }
-    for i in 1..s.len() {
-        let x = s[i];
-        let mut j = i;
-        while j > 0 && s[j - 1] > x {
-            s[j] = s[j - 1];
-            j -= 1;
+/// The finite cells grouped by their smallest vertex id (a counting sort),
+/// and the per-cell flag bytes with [`INFINITE_CELL`] set on infinite
+/// cells. Vertex ids follow the spatially coherent insertion order while
+/// cell ids do not, so visiting cells in this order keeps the accesses to
+/// points and edges local.
+fn cells_by_min_vertex(tri: &Triangulation) -> (Vec<u32>, Vec<u8>) {
+    let nv = tri.num_vertices();
+    let nc = tri.num_tets() as u32;
+    let mut start = vec![0u32; nv + 1];
+    let mut flags = vec![0u8; nc as usize];
+    for t in 0..nc {
+        let v = tri.tet(t);
+        if v[3] != INFINITE {
+            start[v[0].min(v[1]).min(v[2].min(v[3])) as usize + 1] += 1;
+        } else {
+            flags[t as usize] = INFINITE_CELL;
         }
-        s[j] = x;
     }
+    for k in 0..nv {
+        start[k + 1] += start[k];
+    }
+    let mut order = vec![0u32; start[nv] as usize];
+    for t in 0..nc {
+        let v = tri.tet(t);
+        if v[3] != INFINITE {
+            let slot = &mut start[v[0].min(v[1]).min(v[2].min(v[3])) as usize];
+            order[*slot as usize] = t;
+            *slot += 1;
+        }
+    }
+    (order, flags)
 }
 
-/// Circumradius of the triangle `abc` and whether it is Gabriel with
-/// respect to the apexes of its two cells (vertex ids, [`INFINITE`] for
-/// none).
+/// Circumradius of the triangle `abc` (radius of its smallest
+/// circumsphere), as `|b − a| |c − a| |c − b| / (2 |(b − a) × (c − a)|)`:
+/// no cancellation in the numerator, and the cross product is made
+/// accurate for nearly collinear triangles.
 #[inline]
-pub(crate) fn triangle_rho_gabriel(
-    a: &Point3,
-    b: &Point3,
-    c: &Point3,
-    apex_t: u32,
-    apex_n: u32,
-    pts: &[Point3],
-) -> (f64, bool) {
+fn triangle_rho(a: &Point3, b: &Point3, c: &Point3) -> f64 {
     let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
     let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
     let d = [c[0] - b[0], c[1] - b[1], c[2] - b[2]];
     let uu = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
     let vv = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
     let dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-    let uv = u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
     let nn = exact::cross_norm2(a, b, c, &u, &v);
-    // R = |u| |v| |c − b| / (2 |u × v|): no cancellation in the numerator.
-    let rho = 0.5 * ((uu * vv * dd) / nn).sqrt();
-    let mut gabriel = true;
-    for apex in [apex_t, apex_n] {
-        if apex == INFINITE || !gabriel {
-            continue;
-        }
-        let p = &pts[apex as usize];
-        let w = [p[0] - a[0], p[1] - a[1], p[2] - a[2]];
-        let ww = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
-        let wu = w[0] * u[0] + w[1] * u[1] + w[2] * u[2];
-        let wv = w[0] * v[0] + w[1] * v[1] + w[2] * v[2];
-        let dv = ww * nn - wu * vv * (uu - uv) - wv * uu * (vv - uv);
-        let s = match exact::triangle_filter(&u, &v, &w, uu, vv, ww, dv) {
-            Some(s) => s,
-            None => exact::triangle_diametral_side(a, b, c, p),
-        };
-        if s < 0 {
-            gabriel = false;
-        }
-    }
-    (rho, gabriel)
+    0.5 * ((uu * vv * dd) / nn).sqrt()
+}
+
+/// [`triangle_rho`] of the triangle with vertex ids `f`, evaluated with the
+/// ids in ascending order, so that the rounding does not depend on which
+/// cell reports the triangle (the detector's `F_α` relies on it).
+#[inline]
+pub(crate) fn triangle_rho_sorted(pts: &[Point3], mut f: [u32; 3]) -> f64 {
+    f.sort_unstable();
+    let [a, b, c] = f.map(|v| &pts[v as usize]);
+    triangle_rho(a, b, c)
 }
 
 /// `Q = diag(e)·R`: row `i` of the rotation `r` scaled by `e[i]`

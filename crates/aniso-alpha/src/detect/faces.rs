@@ -13,11 +13,40 @@
 //!   only needed when `ρ ≤ α <` the smallest incident circumradius.
 //!
 //! This is the same membership as [`crate::alpha::AlphaComplex`]'s
-//! `edges_at` / `triangles_at` (checked in tests), for far less work.
+//! `edges_at` / `triangles_at`, bit for bit (same radius arithmetic, exact
+//! Gabriel predicates; checked in tests at every critical value), for far
+//! less work: most exact Gabriel tests are skipped.
 
-use crate::alpha::exact::edge_diametral_side;
-use crate::alpha::{cell_radii, triangle_rho_gabriel};
+use crate::alpha::exact::{edge_diametral_side, tet_radius2, triangle_diametral_side};
+use crate::alpha::triangle_rho_sorted;
 use crate::delaunay::{Triangulation, INFINITE};
+
+/// Circumradius of every cell (`+∞` for infinite cells), with the same
+/// arithmetic as [`crate::alpha::AlphaComplex`].
+fn cell_radii(tri: &Triangulation) -> Vec<f64> {
+    let pts = tri.points();
+    (0..tri.num_tets() as u32)
+        .map(|t| {
+            let v = tri.tet(t);
+            if v[3] == INFINITE {
+                f64::INFINITY
+            } else {
+                let p = |k: usize| &pts[v[k] as usize];
+                tet_radius2([p(0), p(1), p(2), p(3)]).sqrt()
+            }
+        })
+        .collect()
+}
+
+/// Whether the triangle `f` (vertex ids) is Gabriel with respect to the
+/// apexes of its two cells ([`INFINITE`] for none): exact.
+fn triangle_gabriel(tri: &Triangulation, f: [u32; 3], apexes: [u32; 2]) -> bool {
+    let [a, b, c] = f.map(|w| tri.point(w));
+    apexes
+        .iter()
+        .filter(|&&w| w != INFINITE)
+        .all(|&w| triangle_diametral_side(a, b, c, tri.point(w)) >= 0)
+}
 
 const FACE: [[usize; 3]; 4] = [[1, 3, 2], [0, 2, 3], [0, 3, 1], [0, 1, 2]];
 
@@ -35,12 +64,10 @@ fn triangle_in(tri: &Triangulation, r: &[f64], sides: [(u32, usize); 2], alpha: 
     }
     let v = tri.tet(t);
     let f = FACE[i].map(|k| v[k]);
-    let [a, b, c] = f.map(|w| tri.point(w));
-    let (rho, gabriel) = triangle_rho_gabriel(a, b, c, v[i], tri.tet(n)[j], tri.points());
-    if rho > alpha {
+    if triangle_rho_sorted(tri.points(), f) > alpha {
         return false;
     }
-    gabriel || r0.min(r1) <= alpha
+    r0.min(r1) <= alpha || triangle_gabriel(tri, f, [v[i], tri.tet(n)[j]])
 }
 
 /// The triangles of `F_{2,α}`: input-index triples, ascending within each.

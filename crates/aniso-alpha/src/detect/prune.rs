@@ -211,14 +211,33 @@ impl CandidatePairs {
         q: &[[f64; 3]; 3],
         radius: f64,
     ) -> Vec<bool> {
-        let mut keep = vec![false; self.n];
+        self.core_under(points, q, radius, 1)
+    }
+
+    /// The `k`-core of the graph joining the points within `radius` under
+    /// Q (restricted to the candidate pairs): the largest set in which every
+    /// point has at least `k` neighbours. For `radius = 2α` it is exact for
+    /// `F_{k,α,Q}`: the vertices of a k-simplex of `F_α` are pairwise within
+    /// 2α, so together they have degree ≥ k and survive the peeling; and a
+    /// point inside an empty-ball candidate of a simplex of the core is
+    /// within 2α of its k + 1 vertices, so it is never peeled either. `k = 1`
+    /// drops the isolated points; `k = 2` (planes) also drops isolated
+    /// pairs and chains of background points. (The detector uses `k = 1`:
+    /// with `k = 2` a clean plane is often left alone, and a nearly flat
+    /// set triangulates into slivers that cost more than the points saved.)
+    pub fn core_under(
+        &self,
+        points: &[[f64; 3]],
+        q: &[[f64; 3]; 3],
+        radius: f64,
+        k: u32,
+    ) -> Vec<bool> {
+        let n = self.n;
         let r2 = radius * radius;
+        let mut close: Vec<[u32; 2]> = Vec::new();
+        let mut deg = vec![0u32; n];
         for &[i, j] in &self.pairs {
-            let (i, j) = (i as usize, j as usize);
-            if keep[i] && keep[j] {
-                continue;
-            }
-            let (a, b) = (&points[i], &points[j]);
+            let (a, b) = (&points[i as usize], &points[j as usize]);
             let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
             let mut s = 0.0;
             for row in q {
@@ -226,11 +245,49 @@ impl CandidatePairs {
                 s += x * x;
             }
             if s <= r2 {
-                keep[i] = true;
-                keep[j] = true;
+                close.push([i, j]);
+                deg[i as usize] += 1;
+                deg[j as usize] += 1;
             }
         }
-        keep
+        if k <= 1 {
+            return deg.iter().map(|&d| d >= 1).collect();
+        }
+        // Adjacency (CSR) of the close pairs, then peel.
+        let mut start = vec![0u32; n + 1];
+        for &[i, j] in &close {
+            start[i as usize + 1] += 1;
+            start[j as usize + 1] += 1;
+        }
+        for v in 0..n {
+            start[v + 1] += start[v];
+        }
+        let mut fill = start.clone();
+        let mut adj = vec![0u32; close.len() * 2];
+        for &[i, j] in &close {
+            adj[fill[i as usize] as usize] = j;
+            fill[i as usize] += 1;
+            adj[fill[j as usize] as usize] = i;
+            fill[j as usize] += 1;
+        }
+        let mut removed = vec![false; n];
+        let mut stack: Vec<u32> = (0..n as u32).filter(|&v| deg[v as usize] < k).collect();
+        for &v in &stack {
+            removed[v as usize] = true;
+        }
+        while let Some(v) = stack.pop() {
+            for &w in &adj[start[v as usize] as usize..start[v as usize + 1] as usize] {
+                let w = w as usize;
+                if !removed[w] {
+                    deg[w] -= 1;
+                    if deg[w] < k {
+                        removed[w] = true;
+                        stack.push(w as u32);
+                    }
+                }
+            }
+        }
+        removed.iter().map(|&r| !r).collect()
     }
 }
 
@@ -303,6 +360,33 @@ mod tests {
             }
         }
         assert!(CandidatePairs::new(&[[0.0; 3]; 10], 1.0, 5).is_none());
+    }
+
+    #[test]
+    fn two_core_peels_pairs_and_chains_but_keeps_triangles() {
+        let id = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        // A triangle (0, 1, 2), a pair (3, 4), a chain 5-6-7 hanging off
+        // nothing, and a point 8 near the triangle's corner 0 only.
+        let pts = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [10.0, 0.0, 0.0],
+            [11.0, 0.0, 0.0],
+            [20.0, 0.0, 0.0],
+            [21.0, 0.0, 0.0],
+            [22.0, 0.0, 0.0],
+            [-1.0, -0.5, 0.0],
+        ];
+        let c = CandidatePairs::new(&pts, 1.5, usize::MAX).unwrap();
+        assert_eq!(
+            c.core_under(&pts, &id, 1.5, 2),
+            vec![true, true, true, false, false, false, false, false, false]
+        );
+        assert_eq!(
+            c.core_under(&pts, &id, 1.5, 1),
+            vec![true, true, true, true, true, true, true, true, true]
+        );
     }
 
     #[test]

@@ -1,0 +1,77 @@
+//! Times the triangulation and the alpha intervals of a point set and
+//! prints one JSON line.
+//!
+//! `cargo run --release --example alpha_time -- points.bin` (raw
+//! little-endian f64 triples, as in the `triangulate` example), or
+//! `cargo run --release --example alpha_time -- uniform 100000`.
+//! Add `--repeat N` to report the fastest of N runs.
+use aniso_alpha::alpha::AlphaComplex;
+use aniso_alpha::delaunay::Triangulation;
+use std::time::Instant;
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let kind = args.get(1).map(String::as_str).unwrap_or("uniform");
+    let n: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(100_000);
+    let pts: Vec<[f64; 3]> = if kind.ends_with(".bin") {
+        let bytes = std::fs::read(kind).expect("read .bin");
+        bytes
+            .chunks_exact(24)
+            .map(|c| {
+                let g = |k: usize| f64::from_le_bytes(c[8 * k..8 * k + 8].try_into().unwrap());
+                [g(0), g(1), g(2)]
+            })
+            .collect()
+    } else {
+        let mut s = 20240601u64;
+        let mut rnd = || {
+            s = s.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = s;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+        };
+        (0..n).map(|_| [rnd(), rnd(), rnd()]).collect()
+    };
+    // `--repeat N`: run N times and report the fastest of each phase (the
+    // machine may be shared; the minimum is the least noisy figure).
+    let repeat: usize = args
+        .iter()
+        .position(|a| a == "--repeat")
+        .and_then(|k| args.get(k + 1))
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1);
+    let (mut t_tri, mut t_int) = (f64::INFINITY, f64::INFINITY);
+    let (mut c_tri, mut c_int) = (f64::INFINITY, f64::INFINITY);
+    let mut ac = None;
+    for _ in 0..repeat.max(1) {
+        drop(ac.take());
+        let (t0, c0) = (Instant::now(), cpu_seconds());
+        let tri = Triangulation::new(&pts).expect("triangulation");
+        t_tri = t_tri.min(t0.elapsed().as_secs_f64());
+        c_tri = c_tri.min(cpu_seconds() - c0);
+        let (t1, c1) = (Instant::now(), cpu_seconds());
+        ac = Some(AlphaComplex::new(tri));
+        t_int = t_int.min(t1.elapsed().as_secs_f64());
+        c_int = c_int.min(cpu_seconds() - c1);
+    }
+    let ac = ac.expect("at least one run");
+    println!(
+        "{{\"n\": {}, \"tets\": {}, \"edges\": {}, \"triangles\": {}, \"triangulate\": {t_tri:.4}, \"intervals\": {t_int:.4}, \"total\": {:.4}, \"cpu_triangulate\": {c_tri:.4}, \"cpu_intervals\": {c_int:.4}}}",
+        pts.len(),
+        ac.triangulation().num_finite_tets(),
+        ac.num_edges(),
+        ac.num_triangles(),
+        t_tri + t_int
+    );
+}
+
+/// CPU time of this process in seconds (Linux `/proc/self/schedstat`, in
+/// ns), or NaN elsewhere: on a shared machine wall time includes the time
+/// spent waiting for a core.
+fn cpu_seconds() -> f64 {
+    std::fs::read_to_string("/proc/self/schedstat")
+        .ok()
+        .and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok())
+        .map_or(f64::NAN, |ns| ns * 1e-9)
+}
