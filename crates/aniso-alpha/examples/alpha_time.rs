@@ -5,6 +5,8 @@
 //! little-endian f64 triples, as in the `triangulate` example), or
 //! `cargo run --release --example alpha_time -- uniform 100000`.
 //! Add `--repeat N` to report the fastest of N runs.
+mod common;
+
 use aniso_alpha::alpha::AlphaComplex;
 use aniso_alpha::delaunay::Triangulation;
 use std::time::Instant;
@@ -13,26 +15,7 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let kind = args.get(1).map(String::as_str).unwrap_or("uniform");
     let n: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(100_000);
-    let pts: Vec<[f64; 3]> = if kind.ends_with(".bin") {
-        let bytes = std::fs::read(kind).expect("read .bin");
-        bytes
-            .chunks_exact(24)
-            .map(|c| {
-                let g = |k: usize| f64::from_le_bytes(c[8 * k..8 * k + 8].try_into().unwrap());
-                [g(0), g(1), g(2)]
-            })
-            .collect()
-    } else {
-        let mut s = 20240601u64;
-        let mut rnd = || {
-            s = s.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = s;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-        };
-        (0..n).map(|_| [rnd(), rnd(), rnd()]).collect()
-    };
+    let pts = common::from_args(kind, n);
     // `--repeat N`: run N times and report the fastest of each phase (the
     // machine may be shared; the minimum is the least noisy figure).
     let repeat: usize = args

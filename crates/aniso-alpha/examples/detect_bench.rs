@@ -41,8 +41,16 @@ fn main() {
     let poly = SceneOptions::polyhedron().seed(1).generate().unwrap();
     let planes = SceneOptions::planes().seed(1).generate().unwrap();
     row("Fig. 12 lines (box)", &lines, Detector::lines(1.0, 10.0, 4));
-    row("Fig. 10 polyhedron (box)", &poly, Detector::planes(1.0, 4.0, 8.0, 20));
-    row("Fig. 5 planes (box)", &planes, Detector::planes(1.0, 4.0, 8.0, 20));
+    row(
+        "Fig. 10 polyhedron (box)",
+        &poly,
+        Detector::planes(1.0, 4.0, 8.0, 20),
+    );
+    row(
+        "Fig. 5 planes (box)",
+        &planes,
+        Detector::planes(1.0, 4.0, 8.0, 20),
+    );
     // Pruning gain.
     row(
         "Fig. 12 lines, no pruning",
@@ -70,7 +78,11 @@ fn main() {
     }
     // Denser backgrounds.
     for x in [0.02, 0.03] {
-        let sc = SceneOptions::lines().seed(1).background_per_ellipsoid(x).generate().unwrap();
+        let sc = SceneOptions::lines()
+            .seed(1)
+            .background_per_ellipsoid(x)
+            .generate()
+            .unwrap();
         row(
             &format!("lines, background {x}/ellipsoid"),
             &sc,
@@ -78,7 +90,15 @@ fn main() {
         );
     }
     if big {
-        let sc = SceneOptions::lines().seed(1).background(1_000_000).generate().unwrap();
-        row("lines + 1M background (box)", &sc, Detector::lines(1.0, 10.0, 4));
+        let sc = SceneOptions::lines()
+            .seed(1)
+            .background(1_000_000)
+            .generate()
+            .unwrap();
+        row(
+            "lines + 1M background (box)",
+            &sc,
+            Detector::lines(1.0, 10.0, 4),
+        );
     }
 }

@@ -196,20 +196,20 @@ fn triangle_exact(a: &Point3, b: &Point3, c: &Point3, p: &Point3) -> i32 {
 #[inline]
 pub(crate) fn cell_radius2_and_mask(p: [&Point3; 4]) -> (f64, u8) {
     let [a, b, c, d] = p;
-    let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-    let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-    let w = [d[0] - a[0], d[1] - a[1], d[2] - a[2]];
+    let f = TetFrame::new(p);
+    let TetFrame {
+        u,
+        v,
+        w,
+        uu,
+        vv,
+        ww,
+        cvw,
+        cwu,
+        cuv,
+    } = f;
     let dot = |x: &Point3, y: &Point3| x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
-    let (uu, vv, ww) = (dot(&u, &u), dot(&v, &v), dot(&w, &w));
     let (uv, vw, wu) = (dot(&u, &v), dot(&v, &w), dot(&w, &u));
-    let cr = |x: &Point3, y: &Point3| {
-        [
-            x[1] * y[2] - x[2] * y[1],
-            x[2] * y[0] - x[0] * y[2],
-            x[0] * y[1] - x[1] * y[0],
-        ]
-    };
-    let (cvw, cwu, cuv) = (cr(&v, &w), cr(&w, &u), cr(&u, &v));
     let (nvw, nwu, nuv) = (dot(&cvw, &cvw), dot(&cwu, &cwu), dot(&cuv, &cuv));
     let m = u[0]
         .abs()
@@ -245,23 +245,27 @@ pub(crate) fn cell_radius2_and_mask(p: [&Point3; 4]) -> (f64, u8) {
     if triangle_diametral_side(b, d, c, a) < 0 {
         mask |= 1;
     }
-    let r2 = radius2_from(p, &u, &v, &w, [uu, vv, ww], [cvw, cwu, cuv]);
+    let r2 = radius2_from(p, &f);
     (r2, mask)
 }
 
-/// Squared circumradius of the tet `p` from its edge vectors `u, v, w`
-/// (from `p[0]`), their squared lengths and the cross products
-/// `v × w, w × u, u × v`: shared by [`cell_radius2_and_mask`] and
-/// [`tet_radius2`] so that both give the same bits.
+/// Squared circumradius of the tet `p` from its [`TetFrame`]: shared by
+/// [`cell_radius2_and_mask`] and [`tet_radius2`] so that both give the
+/// same bits.
 #[inline(always)]
-fn radius2_from(
-    p: [&Point3; 4],
-    u: &Point3,
-    v: &Point3,
-    w: &Point3,
-    [uu, vv, ww]: [f64; 3],
-    [cvw, cwu, cuv]: [[f64; 3]; 3],
-) -> f64 {
+fn radius2_from(p: [&Point3; 4], f: &TetFrame) -> f64 {
+    let TetFrame {
+        u,
+        v,
+        w,
+        uu,
+        vv,
+        ww,
+        cvw,
+        cwu,
+        cuv,
+    } = *f;
+    let (u, v, w) = (&u, &v, &w);
     let [a, b, c, d] = p;
     // The circumradius. Relative errors are below ~8ε·p/|x|: keep the
     // float result while that is under ~2e-12 (|x| ≥ 1e-3·p).
@@ -290,21 +294,52 @@ fn radius2_from(
 /// [`cell_radius2_and_mask`] computes it.
 #[inline]
 pub(crate) fn tet_radius2(p: [&Point3; 4]) -> f64 {
-    let [a, b, c, d] = p;
-    let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-    let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-    let w = [d[0] - a[0], d[1] - a[1], d[2] - a[2]];
-    let dot = |x: &Point3, y: &Point3| x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
-    let (uu, vv, ww) = (dot(&u, &u), dot(&v, &v), dot(&w, &w));
-    let cr = |x: &Point3, y: &Point3| {
-        [
-            x[1] * y[2] - x[2] * y[1],
-            x[2] * y[0] - x[0] * y[2],
-            x[0] * y[1] - x[1] * y[0],
-        ]
-    };
-    let (cvw, cwu, cuv) = (cr(&v, &w), cr(&w, &u), cr(&u, &v));
-    radius2_from(p, &u, &v, &w, [uu, vv, ww], [cvw, cwu, cuv])
+    radius2_from(p, &TetFrame::new(p))
+}
+
+/// The edge vectors `u, v, w` of a tet from its first vertex, their
+/// squared lengths and the cross products `v × w, w × u, u × v`: the
+/// common start of [`cell_radius2_and_mask`] and [`tet_radius2`].
+#[derive(Clone, Copy)]
+struct TetFrame {
+    u: Point3,
+    v: Point3,
+    w: Point3,
+    uu: f64,
+    vv: f64,
+    ww: f64,
+    cvw: Point3,
+    cwu: Point3,
+    cuv: Point3,
+}
+
+impl TetFrame {
+    #[inline(always)]
+    fn new(p: [&Point3; 4]) -> TetFrame {
+        let [a, b, c, d] = p;
+        let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+        let w = [d[0] - a[0], d[1] - a[1], d[2] - a[2]];
+        let dot = |x: &Point3, y: &Point3| x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
+        let cr = |x: &Point3, y: &Point3| {
+            [
+                x[1] * y[2] - x[2] * y[1],
+                x[2] * y[0] - x[0] * y[2],
+                x[0] * y[1] - x[1] * y[0],
+            ]
+        };
+        TetFrame {
+            uu: dot(&u, &u),
+            vv: dot(&v, &v),
+            ww: dot(&w, &w),
+            cvw: cr(&v, &w),
+            cwu: cr(&w, &u),
+            cuv: cr(&u, &v),
+            u,
+            v,
+            w,
+        }
+    }
 }
 
 #[cold]
