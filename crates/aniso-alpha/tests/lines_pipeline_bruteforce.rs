@@ -293,3 +293,31 @@ fn crossing_lines_are_split_into_two() {
         [0, 0, 0]
     );
 }
+
+/// The engine's anisotropic α-shape (Delaunay of Q·P, exact intervals,
+/// pruning) equals the brute-force "some empty ellipsoid touches the edge"
+/// on the lines scene, orientation by orientation.
+#[test]
+fn detector_orientation_faces_equal_brute_force() {
+    use aniso_alpha::detect::detector::Detector;
+    let opts = SceneOptions::lines().seed(3);
+    let scene = opts.generate().unwrap();
+    let p = opts.paper_params();
+    let det = Detector::lines(p.alpha, p.lambda3, p.nb_c);
+    let rotations = orientations(StructureKind::Lines, &Sampler::default(), false).unwrap();
+    let mut compared = 0;
+    for r in rotations.iter().step_by(9) {
+        let a = Anisotropy::from_matrix_rows(*r, det.elongation()).unwrap();
+        let mut brute = exposed_edges(&a.transform(&scene.points), p.alpha);
+        brute.sort_unstable();
+        let ours: Vec<[u32; 2]> = det
+            .orientation_faces(&scene.points, r)
+            .unwrap()
+            .iter()
+            .map(|f| [f[0], f[1]])
+            .collect();
+        assert_eq!(ours, brute);
+        compared += ours.len();
+    }
+    assert!(compared > 100, "{compared} edges compared");
+}

@@ -336,13 +336,15 @@ impl<'a> Detector<'a> {
 
     /// F_{k,α,Q} of one orientation, filtered, as sorted input-index
     /// simplices.
-    fn one_orientation<S: Face>(
+    /// F_{k,α,Q} of one orientation (unfiltered), as sorted input-index
+    /// simplices, and the number of points triangulated.
+    fn raw_faces<S: Face>(
         &self,
         points: &[[f64; 3]],
         a: &Anisotropy,
         cands: Option<&CandidatePairs>,
         radius: f64,
-    ) -> OrientationResult<S> {
+    ) -> (Vec<S>, usize) {
         let alpha = self.alpha;
         let (map, mut reduced): (Vec<u32>, Vec<[f64; 3]>) = match cands {
             Some(c) => {
@@ -372,11 +374,7 @@ impl<'a> Detector<'a> {
         };
         let triangulated = reduced.len();
         if reduced.len() < 2 {
-            return OrientationResult {
-                faces: Vec::new(),
-                triangulated,
-                raw: 0,
-            };
+            return (Vec::new(), triangulated);
         }
         let n_real = map.len() as u32;
         let mut tri = Triangulation::new(&reduced).ok();
@@ -418,6 +416,18 @@ impl<'a> Detector<'a> {
                 .collect(),
             None => Vec::new(),
         };
+        (faces, triangulated)
+    }
+
+    /// F_{k,α,Q} of one orientation, path-filtered, with counters.
+    fn one_orientation<S: Face>(
+        &self,
+        points: &[[f64; 3]],
+        a: &Anisotropy,
+        cands: Option<&CandidatePairs>,
+        radius: f64,
+    ) -> OrientationResult<S> {
+        let (faces, triangulated) = self.raw_faces::<S>(points, a, cands, radius);
         let raw = faces.len();
         let faces = filter(&faces, self.nb_c).unwrap_or_default();
         OrientationResult {
@@ -425,6 +435,39 @@ impl<'a> Detector<'a> {
             triangulated,
             raw,
         }
+    }
+
+    /// The anisotropic α-shape `F_{k,α,Q}(P)` of one orientation (rows of
+    /// R), before the path filter: sorted simplices of input indices,
+    /// ascending within each. This is what [`Self::run`] computes for each
+    /// orientation of its set, and a way to look at one of them.
+    ///
+    /// # Errors
+    /// As [`Self::run`].
+    pub fn orientation_faces(
+        &self,
+        points: &[[f64; 3]],
+        rotation: &Mat3,
+    ) -> Result<Vec<Vec<u32>>, DetectError> {
+        self.check(points)?;
+        let a = Anisotropy::from_matrix_rows(*rotation, self.elongation())?;
+        let radius = 2.0 * self.alpha * (1.0 + 1e-9);
+        let mut out: Vec<Vec<u32>> = match self.kind {
+            StructureKind::Lines => self
+                .raw_faces::<[u32; 2]>(points, &a, None, radius)
+                .0
+                .iter()
+                .map(|f| f.to_vec())
+                .collect(),
+            StructureKind::Planes => self
+                .raw_faces::<[u32; 3]>(points, &a, None, radius)
+                .0
+                .iter()
+                .map(|f| f.to_vec())
+                .collect(),
+        };
+        out.sort_unstable();
+        Ok(out)
     }
 
     fn structures<S: Face>(&self, points: &[[f64; 3]], kept: Vec<S>, stats: RunStats) -> Detection {
