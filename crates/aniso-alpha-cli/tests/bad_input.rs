@@ -257,3 +257,16 @@ fn timings_are_json_on_success_only() {
     assert_eq!(o.status.code(), Some(1));
     assert_eq!(String::from_utf8_lossy(&o.stderr).lines().count(), 1);
 }
+
+#[test]
+fn coordinates_beyond_exact_arithmetic() {
+    let d = TempDir::new("range");
+    let out = d.0.join("out.tets");
+    let huge = d.file("huge.xyz", b"0 0 0\n1 0 0\n0 1 0\n0 0 1e200\n");
+    expect_error(&d, &huge, &out, &["huge.xyz", "point 3", "rescale"]);
+    let tiny = d.file(
+        "tiny.xyz",
+        b"1e-300 0 0\n0 1e-300 0\n0 0 1e-300\n1e-300 1e-300 1e-300\n",
+    );
+    expect_error(&d, &tiny, &out, &["tiny.xyz", "point 0", "rescale"]);
+}

@@ -482,3 +482,35 @@ fn brute_force_oracle_small_sets() {
         assert_eq!(ours, brute_force(pts), "{pts:?}");
     }
 }
+
+#[test]
+fn coordinates_outside_the_exact_range_are_refused() {
+    use aniso_alpha::delaunay::{DelaunayError, COORD_RANGE};
+    // Overflow (1e200) or underflow (1e-300) would make the predicates
+    // silently inexact: typed error naming the point.
+    let mut pts = points(&mut Rng(1), 20);
+    pts[7][1] = 1e200;
+    assert!(matches!(
+        Triangulation::new(&pts),
+        Err(DelaunayError::OutOfRange {
+            index: 7,
+            coord: 1,
+            ..
+        })
+    ));
+    let tiny: Vec<[f64; 3]> = points(&mut Rng(2), 20)
+        .iter()
+        .map(|p| p.map(|c| c * 1e-300))
+        .collect();
+    assert!(matches!(
+        Triangulation::new(&tiny),
+        Err(DelaunayError::OutOfRange { .. })
+    ));
+    // The ends of the range, and zero, are fine.
+    let mut edge = points(&mut Rng(3), 20);
+    edge[0] = [COORD_RANGE.1, 0.0, 0.0];
+    edge[1] = [COORD_RANGE.0, 0.0, -0.0];
+    check_valid(&edge);
+    let msg = Triangulation::new(&pts).unwrap_err().to_string();
+    assert!(msg.contains("point 7") && msg.contains("rescale"), "{msg}");
+}

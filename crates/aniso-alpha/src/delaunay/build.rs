@@ -376,6 +376,14 @@ pub(super) fn build(points: &[[f64; 3]]) -> Result<Triangulation, DelaunayError>
                     value,
                 });
             }
+            let m = value.abs();
+            if m > super::COORD_RANGE.1 || (m != 0.0 && m < super::COORD_RANGE.0) {
+                return Err(DelaunayError::OutOfRange {
+                    index,
+                    coord,
+                    value,
+                });
+            }
         }
     }
     // (-0.0 == 0.0 for every comparison below, so signed zeros are one point.)

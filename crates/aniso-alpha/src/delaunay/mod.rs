@@ -53,9 +53,27 @@ pub enum DelaunayError {
         /// The value found.
         value: f64,
     },
+    /// A coordinate is outside the range where the exact predicates are
+    /// guaranteed (see [`COORD_RANGE`]): rescale the data.
+    OutOfRange {
+        /// Index of the offending point in the input.
+        index: usize,
+        /// Which coordinate (0 = x, 1 = y, 2 = z).
+        coord: usize,
+        /// The value found.
+        value: f64,
+    },
     /// More points than the `u32` indices can address.
     TooManyPoints(usize),
 }
+
+/// The magnitudes a nonzero coordinate may have: `[COORD_RANGE.0,
+/// COORD_RANGE.1]` (zero is always fine). Within it, the products of the
+/// in-sphere determinant (degree 5 in coordinate differences, and their
+/// error terms) neither overflow nor underflow, which is what makes the
+/// predicates exact; outside it a result could silently be wrong, so
+/// [`Triangulation::new`] refuses it with [`DelaunayError::OutOfRange`].
+pub const COORD_RANGE: (f64, f64) = (1e-60, 1e55);
 
 impl std::fmt::Display for DelaunayError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -69,6 +87,18 @@ impl std::fmt::Display for DelaunayError {
                 f,
                 "point {index} has a non-finite {} coordinate ({value})",
                 ["x", "y", "z"][*coord]
+            ),
+            DelaunayError::OutOfRange {
+                index,
+                coord,
+                value,
+            } => write!(
+                f,
+                "point {index} has {} coordinate {value:e}, outside the range of exact \
+                 arithmetic ({:e} to {:e} in magnitude, or 0): rescale the data",
+                ["x", "y", "z"][*coord],
+                COORD_RANGE.0,
+                COORD_RANGE.1
             ),
             DelaunayError::TooManyPoints(n) => {
                 write!(
@@ -128,7 +158,8 @@ impl Triangulation {
     ///
     /// # Errors
     /// [`DelaunayError::Empty`] for no points, [`DelaunayError::NonFinite`]
-    /// for a NaN or infinite coordinate.
+    /// for a NaN or infinite coordinate, [`DelaunayError::OutOfRange`] for a
+    /// coordinate whose magnitude is outside [`COORD_RANGE`].
     pub fn new(points: &[[f64; 3]]) -> Result<Self, DelaunayError> {
         build::build(points)
     }

@@ -61,6 +61,13 @@ pub enum DetectError {
         /// Index of the point.
         index: usize,
     },
+    /// A coordinate's magnitude is above 1e50 or below 1e-30 (and not 0):
+    /// outside the range where the exact arithmetic is guaranteed after
+    /// the anisotropic transform. Rescale the data.
+    OutOfRange {
+        /// Index of the point.
+        index: usize,
+    },
     /// The orientation sampler's parameters are invalid.
     Orientations(OrientationError),
     /// The anisotropy is invalid.
@@ -77,6 +84,11 @@ impl fmt::Display for DetectError {
             DetectError::NonFinite { index } => {
                 write!(f, "point {index} has a non-finite coordinate")
             }
+            DetectError::OutOfRange { index } => write!(
+                f,
+                "point {index} has a coordinate outside 1e-30..1e50 in magnitude (or 0), \
+                 the range of exact arithmetic: rescale the data"
+            ),
             DetectError::Orientations(e) => write!(f, "orientations: {e}"),
             DetectError::Anisotropy(e) => write!(f, "anisotropy: {e}"),
             DetectError::Cancelled => write!(f, "cancelled"),
@@ -239,6 +251,15 @@ impl<'a> Detector<'a> {
         }
         if let Some(index) = points.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
             return Err(DetectError::NonFinite { index });
+        }
+        // Tighter than the triangulation's range, so that every transformed
+        // point Q·p stays inside it (|Q·p| ≤ √3·max|p|; cancellation leaves
+        // either 0 or at least an ulp of the inputs).
+        if let Some(index) = points.iter().position(|p| {
+            p.iter()
+                .any(|c| c.abs() > 1e50 || (*c != 0.0 && c.abs() < 1e-30))
+        }) {
+            return Err(DetectError::OutOfRange { index });
         }
         Ok(())
     }
