@@ -196,19 +196,16 @@ fn valid_input_gets_past_reading() {
     let input = d.file("good.xyz", b"0 0 0\n1 0 0\n0 1 0\n0 0 1\n");
     let o = run(&[Path::new("delaunay"), &input, Path::new("--tets"), &out]);
     let stderr = String::from_utf8_lossy(&o.stderr);
-    match o.status.code() {
-        // Engine wired: a complete output.
-        Some(0) => assert_eq!(std::fs::read_to_string(&out).unwrap().lines().count(), 1),
-        // Engine not in this build yet.
-        _ => {
-            assert_eq!(o.status.code(), Some(1));
-            assert_eq!(
-                stderr.trim_end(),
-                "error: delaunay: not available in this build yet"
-            );
-            assert!(!out.exists());
-        }
-    }
+    assert_eq!(o.status.code(), Some(0), "{stderr}");
+    // One positively oriented tet: (0, 1, 2, 3) up to an even permutation.
+    let tets = std::fs::read_to_string(&out).unwrap();
+    let t: Vec<u32> = tets.split_whitespace().map(|x| x.parse().unwrap()).collect();
+    assert_eq!(t.len(), 4, "{tets}");
+    let inversions = (0..4)
+        .flat_map(|i| (i + 1..4).map(move |j| (i, j)))
+        .filter(|&(i, j)| t[i] > t[j])
+        .count();
+    assert_eq!(inversions % 2, 0, "{tets}");
 }
 
 #[test]

@@ -10,9 +10,9 @@ use crate::geometry::Point3;
 /// sides (one of them infinite on the convex hull).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Triangle {
-    /// The three vertex ids, in the order they appear in `sides[0]`'s face
-    /// (counter-clockwise seen from `sides[0]`'s opposite vertex side... i.e.
-    /// oriented with its normal pointing *into* `sides[0]`'s complement).
+    /// The three vertex ids, ordered so that the triangle's normal (right-
+    /// hand rule) points into the tetrahedron `sides[0].0` (towards its
+    /// fourth vertex; outward from the hull when that tet is infinite).
     pub vertices: [u32; 3],
     /// `(tet, local face index)` on each side; `sides[0].0 < sides[1].0`.
     pub sides: [(u32, usize); 2],
