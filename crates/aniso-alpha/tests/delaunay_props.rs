@@ -514,3 +514,30 @@ fn coordinates_outside_the_exact_range_are_refused() {
     let msg = Triangulation::new(&pts).unwrap_err().to_string();
     assert!(msg.contains("point 7") && msg.contains("rescale"), "{msg}");
 }
+
+#[test]
+fn triangle_and_hull_orientations() {
+    use aniso_alpha::delaunay::INFINITE;
+    for pts in [points(&mut Rng(11), 200), shuffled(grid(4), &mut Rng(12))] {
+        let tri = check_valid(&pts);
+        let mut n = 0;
+        for t in tri.triangles() {
+            let (c, i) = t.sides[0];
+            let apex = tri.tet(c)[i];
+            let [a, b, d] = t.vertices.map(|v| *tri.point(v));
+            if apex != INFINITE {
+                // The normal points into sides[0]: towards its apex.
+                assert_eq!(orient3d(&a, &b, &d, tri.point(apex)), 1);
+            }
+            n += 1;
+        }
+        assert_eq!(n, tri.num_triangles());
+        // Hull facets face outward: every vertex is on their inner side.
+        for f in tri.hull_facets() {
+            let [a, b, c] = f.map(|v| *tri.point(v));
+            for v in 0..tri.num_vertices() as u32 {
+                assert!(orient3d(&a, &b, &c, tri.point(v)) <= 0);
+            }
+        }
+    }
+}
