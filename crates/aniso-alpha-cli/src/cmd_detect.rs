@@ -227,6 +227,9 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
             "background_points": det.labels.iter().filter(|&&l| l < 0).count(),
             "seconds": seconds,
         });
+        // Wall seconds of the phases so far (the report itself is the last
+        // output written).
+        report["timings"] = timings.to_value();
         if let Some(ev) = &scores {
             report["scores"] = json!({
                 "precision": ev.precision, "recall": ev.recall, "f1": ev.f1,

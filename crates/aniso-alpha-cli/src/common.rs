@@ -176,6 +176,11 @@ impl Timings {
 
     /// The JSON object: phases in the order first seen, then `total`.
     pub fn to_json(&self) -> String {
+        self.to_value().to_string()
+    }
+
+    /// The phases so far (and the total) as a JSON object.
+    pub fn to_value(&self) -> serde_json::Value {
         let mut map = serde_json::Map::new();
         for (name, s) in &self.phases {
             map.insert((*name).to_string(), round_json(*s));
@@ -184,7 +189,7 @@ impl Timings {
             "total".to_string(),
             round_json(self.start.elapsed().as_secs_f64()),
         );
-        serde_json::Value::Object(map).to_string()
+        serde_json::Value::Object(map)
     }
 }
 

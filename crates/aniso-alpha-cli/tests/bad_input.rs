@@ -199,7 +199,10 @@ fn valid_input_gets_past_reading() {
     assert_eq!(o.status.code(), Some(0), "{stderr}");
     // One positively oriented tet: (0, 1, 2, 3) up to an even permutation.
     let tets = std::fs::read_to_string(&out).unwrap();
-    let t: Vec<u32> = tets.split_whitespace().map(|x| x.parse().unwrap()).collect();
+    let t: Vec<u32> = tets
+        .split_whitespace()
+        .map(|x| x.parse().unwrap())
+        .collect();
     assert_eq!(t.len(), 4, "{tets}");
     let inversions = (0..4)
         .flat_map(|i| (i + 1..4).map(move |j| (i, j)))

@@ -271,6 +271,12 @@ fn synth_detect_eval_chain() {
     assert_eq!(r["orientations"], 162);
     assert!(r["structures"].as_array().unwrap().len() >= 5);
     assert_eq!(r["structures"][0]["primitive"]["type"], "line");
+    assert!(r["structures"][0]["primitive"]["rms_residual"]
+        .as_f64()
+        .is_some());
+    assert!(r["timings"]["read"].as_f64().is_some());
+    assert!(r["timings"]["detect"].as_f64().is_some());
+    assert_eq!(r["parameters"]["min_size"], 4);
     let o = ok(&[
         "eval",
         "--truth",
