@@ -321,12 +321,12 @@ fn summary(name: &str, det: &Detection, params: &serde_json::Value, seconds: f64
         det.labels.len(),
         params["structure"].as_str().unwrap_or("?"),
         det.kind.k(),
-        params["alpha"],
+        params["alpha"].as_f64().unwrap_or(f64::NAN),
         params["lambda2"]
             .as_f64()
             .map(|l| format!("lambda2 {l}, "))
             .unwrap_or_default(),
-        params["lambda3"],
+        params["lambda3"].as_f64().unwrap_or(f64::NAN),
         params["min_size"],
     ));
     o.push_str(&format!(
