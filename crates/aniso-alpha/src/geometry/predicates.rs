@@ -876,54 +876,32 @@ mod tests {
 
     #[test]
     fn coplanar_circle() {
-        let p0 = [0.0, 0.0, 0.0];
-        let p1 = [2.0, 0.0, 0.0];
-        let p2 = [0.0, 2.0, 0.0];
-        assert_eq!(
-            coplanar_side_of_bounded_circle(&p0, &p1, &p2, &[1.0, 1.0, 0.0]),
-            1
-        );
-        assert_eq!(
-            coplanar_side_of_bounded_circle(&p0, &p1, &p2, &[2.0, 2.0, 0.0]),
-            0
-        );
-        assert_eq!(
-            coplanar_side_of_bounded_circle(&p0, &p1, &p2, &[3.0, 3.0, 0.0]),
-            -1
-        );
-        // Reversed orientation of the triangle gives the same answer.
-        assert_eq!(
-            coplanar_side_of_bounded_circle(&p1, &p0, &p2, &[1.0, 1.0, 0.0]),
-            1
-        );
-        // A vertical plane x = 1: falls back to another projection.
-        let q0 = [1.0, 0.0, 0.0];
-        let q1 = [1.0, 2.0, 0.0];
-        let q2 = [1.0, 0.0, 2.0];
-        assert_eq!(
-            coplanar_side_of_bounded_circle(&q0, &q1, &q2, &[1.0, 1.0, 1.0]),
-            1
-        );
-        assert_eq!(
-            coplanar_side_of_bounded_circle(&q0, &q1, &q2, &[1.0, 2.0, 2.0]),
-            0
-        );
-        assert_eq!(
-            coplanar_side_of_bounded_circle(&q0, &q1, &q2, &[1.0, 5.0, 2.0]),
-            -1
-        );
-        // A plane y = 3 (needs the xz projection).
-        let r0 = [0.0, 3.0, 0.0];
-        let r1 = [2.0, 3.0, 0.0];
-        let r2 = [0.0, 3.0, 2.0];
-        assert_eq!(
-            coplanar_side_of_bounded_circle(&r0, &r1, &r2, &[1.0, 3.0, 1.0]),
-            1
-        );
-        assert_eq!(
-            coplanar_side_of_bounded_circle(&r0, &r1, &r2, &[2.0, 3.0, 2.0]),
-            0
-        );
+        // (triangle, query, expected side): planes z = 0, x = 1 (needs the
+        // yz projection) and y = 3 (needs xz); a reversed triangle gives
+        // the same answer.
+        let xy = [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]];
+        let yx = [[2.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 2.0, 0.0]];
+        let x1 = [[1.0, 0.0, 0.0], [1.0, 2.0, 0.0], [1.0, 0.0, 2.0]];
+        let y3 = [[0.0, 3.0, 0.0], [2.0, 3.0, 0.0], [0.0, 3.0, 2.0]];
+        let cases = [
+            (xy, [1.0, 1.0, 0.0], 1),
+            (xy, [2.0, 2.0, 0.0], 0),
+            (xy, [3.0, 3.0, 0.0], -1),
+            (yx, [1.0, 1.0, 0.0], 1),
+            (x1, [1.0, 1.0, 1.0], 1),
+            (x1, [1.0, 2.0, 2.0], 0),
+            (x1, [1.0, 5.0, 2.0], -1),
+            (y3, [1.0, 3.0, 1.0], 1),
+            (y3, [2.0, 3.0, 2.0], 0),
+            (y3, [5.0, 3.0, 5.0], -1),
+        ];
+        for (t, q, want) in cases {
+            assert_eq!(
+                coplanar_side_of_bounded_circle(&t[0], &t[1], &t[2], &q),
+                want,
+                "{t:?} {q:?}"
+            );
+        }
     }
 
     #[test]
