@@ -67,53 +67,25 @@ struct Builder<K: Kernel> {
     rng: SplitMix64,
     // Scratch, reused across insertions.
     conflicts: Vec<u32>,
-    /// New tets of the current insertion, packed with the face index of
-    /// their outer neighbour.
-    new_tets: Vec<u32>,
-    /// Per-vertex head of the edge lists used to link new tets (all
-    /// `u32::MAX` between insertions).
-    vhead: Vec<u32>,
-    links: Vec<Link>,
+    /// New tets of the current insertion: each packed with the face index
+    /// of its outer neighbour, and the conflict tet it replaces.
+    new_tets: Vec<(u32, u32)>,
     last: u32,
+    /// Set when the tet count reached [`MAX_CELLS`]; the build then stops.
+    overflow: bool,
 }
 
-/// An entry of the per-vertex edge lists: edge (a, b), a < b, seen on face
-/// `face` (packed) of a new tet.
-#[derive(Clone, Copy, Debug)]
-struct Link {
-    a: u32,
-    b: u32,
-    face: u32,
-    next: u32,
-}
+/// Tet ids are packed with a 2-bit face index into a `u32`, so there can be
+/// at most 2^30 tetrahedra (about 150 million uniform points).
+const MAX_CELLS: usize = 1 << 30;
 
-/// For faces `f != g` of a tet, the local indices of the two vertices on
-/// both faces (the edge they share).
-const EDGE_OF_FACES: [[(usize, usize); 4]; 4] = {
-    let mut t = [[(0, 0); 4]; 4];
-    let mut f = 0;
-    while f < 4 {
-        let mut g = 0;
-        while g < 4 {
-            if f != g {
-                let mut e = [0usize; 2];
-                let mut k = 0;
-                let mut i = 0;
-                while i < 4 {
-                    if i != f && i != g {
-                        e[k] = i;
-                        k += 1;
-                    }
-                    i += 1;
-                }
-                t[f][g] = (e[0], e[1]);
-            }
-            g += 1;
-        }
-        f += 1;
-    }
-    t
-};
+/// Headroom kept below [`MAX_CELLS`] before each insertion, so that a
+/// single insertion can never overflow (a cavity with 2^24 boundary facets
+/// would be needed).
+const CELL_HEADROOM: usize = 1 << 24;
+
+/// Points gathered per chunk in insertion order.
+const GATHER: usize = 1024;
 
 impl<K: Kernel> Builder<K> {
     #[inline(always)]
@@ -125,6 +97,11 @@ impl<K: Kernel> Builder<K> {
     fn alloc(&mut self) -> u32 {
         if let Some(t) = self.free.pop() {
             t
+        } else if self.cells.len() >= MAX_CELLS - 1 {
+            // Unreachable with the headroom check in `run`; stay in bounds
+            // and let `run` report the overflow.
+            self.overflow = true;
+            0
         } else {
             let t = self.cells.len() as u32;
             self.cells.push(Cell {
@@ -198,7 +175,9 @@ impl<K: Kernel> Builder<K> {
         // Conflict region by graph search; `conflicts` doubles as the stack.
         // Each boundary facet found (conflict tet c, face f, outer tet
         // not in conflict) immediately gets its new tet: c with vertex f
-        // replaced by q, keeping c's outer neighbour.
+        // replaced by q, keeping c's outer neighbour. The slot `f` of c
+        // (c is about to die) then points to the new tet, which is how the
+        // linking below recognises boundary facets.
         self.conflicts.clear();
         self.new_tets.clear();
         self.conflicts.push(start);
@@ -228,59 +207,52 @@ impl<K: Kernel> Builder<K> {
                 nn[f] = outer;
                 self.cells[nt as usize] = Cell { v, n: nn };
                 self.cells[n].n[(outer & 3) as usize] = pack(nt, f);
-                self.new_tets.push(pack(nt, f));
+                self.cells[c as usize].n[f] = pack(nt, f);
+                self.new_tets.push((pack(nt, f), c));
             }
         }
 
-        // Link the new tets to each other. The face of a new tet opposite
-        // index g (g != f) holds q and an edge (a, b) of the cavity's
-        // boundary; exactly two new tets share it. Pair them through short
-        // per-vertex lists keyed by the smaller endpoint (the infinite
-        // vertex is the largest id, so it is never a key).
-        self.links.clear();
+        // Link the new tets to each other. The face of new tet nt (built
+        // on facet f of conflict tet c) opposite g != f holds q and an edge
+        // (a, b) of the cavity boundary. Its neighbour is the new tet of
+        // the next boundary facet met when turning around (a, b) from c
+        // across its face g, through conflict tets only: every cell
+        // visited is part of this insertion and already in cache.
         let cells = &mut self.cells[..];
-        let vhead = &mut self.vhead[..];
         let mark = &mut self.mark[..];
-        for &packed in &self.new_tets {
+        for &(packed, c) in &self.new_tets {
             let (nt, f) = ((packed >> 2) as usize, (packed & 3) as usize);
-            let v = cells[nt].v;
             // The outer tet was marked CLEAR; reset it.
             mark[(cells[nt].n[f] >> 2) as usize] = 0;
             for g in 0..4 {
-                if g == f {
+                if g == f || cells[nt].n[g] != UNSET {
                     continue;
                 }
-                let (i, j) = EDGE_OF_FACES[f][g];
-                let (a, b) = if v[i] < v[j] {
-                    (v[i], v[j])
-                } else {
-                    (v[j], v[i])
-                };
-                let mut e = vhead[a as usize];
+                // Invariant: we are about to cross face `gc` of conflict
+                // tet `cur`; its faces `gc` and `hc` both contain (a, b).
+                let (mut cur, mut gc, mut hc) = (c as usize, g, f);
                 loop {
-                    if e == u32::MAX {
-                        self.links.push(Link {
-                            a,
-                            b,
-                            face: pack(nt as u32, g),
-                            next: vhead[a as usize],
-                        });
-                        vhead[a as usize] = (self.links.len() - 1) as u32;
+                    let x = cells[cur].n[gc];
+                    let t2 = (x >> 2) as usize;
+                    if cells[t2].v[gc] == vid {
+                        // (cur, gc) is a boundary facet and t2 its new tet;
+                        // the face of t2 holding (q, a, b) is opposite hc.
+                        cells[nt].n[g] = pack(t2 as u32, hc);
+                        cells[t2].n[hc] = pack(nt as u32, g);
                         break;
                     }
-                    let l = self.links[e as usize];
-                    if l.b == b {
-                        let (mt, h) = ((l.face >> 2) as usize, (l.face & 3) as usize);
-                        cells[nt].n[g] = pack(mt as u32, h);
-                        cells[mt].n[h] = pack(nt as u32, g);
-                        break;
-                    }
-                    e = l.next;
+                    // t2 is in conflict too: the face crossed is (a, b, w)
+                    // with w = cur.v[hc]; next cross t2's face opposite w.
+                    let w = cells[cur].v[hc];
+                    let tv = cells[t2].v;
+                    let kw = (tv[1] == w) as usize
+                        + 2 * (tv[2] == w) as usize
+                        + 3 * (tv[3] == w) as usize;
+                    hc = (x & 3) as usize;
+                    gc = kw;
+                    cur = t2;
                 }
             }
-        }
-        for l in &self.links {
-            vhead[l.a as usize] = u32::MAX;
         }
 
         // Free the cavity.
@@ -290,8 +262,8 @@ impl<K: Kernel> Builder<K> {
         }
         self.free.extend_from_slice(&self.conflicts);
         // Start the next walk from a new finite tet if there is one.
-        let mut last = self.new_tets[0] >> 2;
-        for &p in self.new_tets.iter().rev() {
+        let mut last = self.new_tets[0].0 >> 2;
+        for &(p, _) in self.new_tets.iter().rev() {
             if cells[(p >> 2) as usize].v[3] != INFINITE {
                 last = p >> 2;
                 break;
@@ -395,11 +367,11 @@ pub(super) fn build(points: &[[f64; 3]]) -> Result<Triangulation, DelaunayError>
 
     // Uniform points give about 6.8 tets per point; untouched capacity costs
     // address space, not resident memory.
-    let expected_tets = 7 * n + n / 2 + 64;
+    let expected_tets = (7 * n + n / 2 + 64).min(MAX_CELLS);
     if SmallGrid::applies(points) {
-        Ok(run::<SmallGrid>(points, &order, init, expected_tets))
+        run::<SmallGrid>(points, &order, init, expected_tets)
     } else {
-        Ok(run::<Filtered>(points, &order, init, expected_tets))
+        run::<Filtered>(points, &order, init, expected_tets)
     }
 }
 
@@ -409,7 +381,7 @@ fn run<K: Kernel>(
     order: &[u32],
     init: [u32; 4],
     expected_tets: usize,
-) -> Triangulation {
+) -> Result<Triangulation, DelaunayError> {
     let n = points.len();
     let mut b = Builder::<K> {
         kernel: std::marker::PhantomData,
@@ -420,9 +392,8 @@ fn run<K: Kernel>(
         rng: SplitMix64::new(0xC0FFEE),
         conflicts: Vec::new(),
         new_tets: Vec::new(),
-        vhead: vec![u32::MAX; n],
-        links: Vec::new(),
         last: 0,
+        overflow: false,
     };
     let mut vert_input: Vec<u32> = Vec::with_capacity(n);
     let mut input_vert = vec![u32::MAX; n];
@@ -455,28 +426,42 @@ fn run<K: Kernel>(
     link_by_faces(&mut b.cells, &[0, 1, 2, 3, 4]);
     b.last = t0;
 
-    for &i in order {
-        if input_vert[i as usize] != u32::MAX {
-            continue; // one of the initial four
-        }
-        let vid = b.pts.len() as u32;
-        b.pts.push(points[i as usize]);
-        match b.insert(vid) {
-            None => {
-                vert_input.push(i);
-                input_vert[i as usize] = vid;
+    // The points are gathered in insertion order a chunk at a time: the
+    // order is a shuffle of the input, and independent loads overlap their
+    // cache misses where loads inside the insertion loop would not.
+    let mut chunk: Vec<Point3> = Vec::with_capacity(GATHER);
+    for ids in order.chunks(GATHER) {
+        chunk.clear();
+        chunk.extend(ids.iter().map(|&i| points[i as usize]));
+        for (&i, p) in ids.iter().zip(&chunk) {
+            if init.contains(&i) {
+                continue; // one of the initial four
             }
-            Some(w) => {
-                b.pts.pop();
-                input_vert[i as usize] = w;
-                if i < vert_input[w as usize] {
-                    vert_input[w as usize] = i;
+            if b.cells.len() + CELL_HEADROOM > MAX_CELLS || b.overflow {
+                return Err(DelaunayError::TooManyTets(n));
+            }
+            let vid = b.pts.len() as u32;
+            b.pts.push(*p);
+            match b.insert(vid) {
+                None => {
+                    vert_input.push(i);
+                    input_vert[i as usize] = vid;
+                }
+                Some(w) => {
+                    b.pts.pop();
+                    input_vert[i as usize] = w;
+                    if i < vert_input[w as usize] {
+                        vert_input[w as usize] = i;
+                    }
                 }
             }
         }
     }
+    if b.overflow {
+        return Err(DelaunayError::TooManyTets(n));
+    }
     drop(std::mem::take(&mut b.mark));
-    compact(b, vert_input, input_vert)
+    Ok(compact(b, vert_input, input_vert))
 }
 
 /// Links the faces of a few tets by brute force (used for the first five).

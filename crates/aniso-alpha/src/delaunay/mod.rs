@@ -65,6 +65,10 @@ pub enum DelaunayError {
     },
     /// More points than the `u32` indices can address.
     TooManyPoints(usize),
+    /// The triangulation of this many points needs more than 2^30
+    /// tetrahedra, the most the packed `u32` adjacency can address (uniform
+    /// data reaches it near 150 million points).
+    TooManyTets(usize),
 }
 
 /// The magnitudes a nonzero coordinate may have: `[COORD_RANGE.0,
@@ -106,6 +110,11 @@ impl std::fmt::Display for DelaunayError {
                     "{n} points is more than this library can index (2^32 - 2)"
                 )
             }
+            DelaunayError::TooManyTets(n) => write!(
+                f,
+                "the triangulation of {n} points needs more than 2^30 tetrahedra, \
+                 more than this library can index: split the data"
+            ),
         }
     }
 }
