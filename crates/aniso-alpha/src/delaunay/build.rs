@@ -4,7 +4,7 @@ use super::order::{brio_order, SplitMix64};
 use super::{DelaunayError, Triangulation, INFINITE};
 use crate::geometry::predicates::{
     collinear, coplanar_incircle_perturbed, insphere_perturbed_k, orient3d, Filtered, Kernel,
-    SmallGrid,
+    SmallGrid, StaticFilter,
 };
 use crate::geometry::Point3;
 
@@ -42,22 +42,29 @@ fn pack(t: u32, i: usize) -> u32 {
 /// circumsphere; for an infinite tet, `q` is strictly beyond its hull facet,
 /// or in the facet's plane and inside its circumcircle.
 #[inline(always)]
-pub(crate) fn tet_in_conflict<K: Kernel>(pts: &[Point3], v: &[u32; 4], q: &Point3) -> bool {
+pub(crate) fn tet_in_conflict<K: Kernel>(
+    pts: &[Point3],
+    v: &[u32; 4],
+    q: &Point3,
+    filter: &StaticFilter,
+) -> bool {
     let p = |w: u32| &pts[w as usize];
     if v[3] == INFINITE {
-        let o = K::orient3d(p(v[0]), p(v[1]), p(v[2]), q);
+        let o = K::orient3d_static(p(v[0]), p(v[1]), p(v[2]), q, filter);
         if o != 0 {
             return o > 0;
         }
         coplanar_incircle_perturbed(p(v[0]), p(v[1]), p(v[2]), q) > 0
     } else {
-        insphere_perturbed_k::<K>(p(v[0]), p(v[1]), p(v[2]), p(v[3]), q) > 0
+        insphere_perturbed_k::<K>(p(v[0]), p(v[1]), p(v[2]), p(v[3]), q, filter) > 0
     }
 }
 
 /// Working state of the incremental construction.
 struct Builder<K: Kernel> {
     kernel: std::marker::PhantomData<K>,
+    /// Static bounds for the predicates over the whole input.
+    filter: StaticFilter,
     pts: Vec<Point3>,
     cells: Vec<Cell>,
     /// Per-tet flag during one insertion: 0, [`IN_CONFLICT`] or [`CLEAR`];
@@ -119,7 +126,7 @@ impl<K: Kernel> Builder<K> {
     fn orient_replaced(&self, t: &[u32; 4], i: usize, q: &Point3) -> i32 {
         let mut p = [self.p(t[0]), self.p(t[1]), self.p(t[2]), self.p(t[3])];
         p[i] = q;
-        K::orient3d(p[0], p[1], p[2], p[3])
+        K::orient3d_static(p[0], p[1], p[2], p[3], &self.filter)
     }
 
     /// Remembering stochastic walk from `self.last` to a tetrahedron in
@@ -130,7 +137,7 @@ impl<K: Kernel> Builder<K> {
         let mut t = self.last;
         let v = self.cells[t as usize].v;
         if v[3] == INFINITE {
-            if K::orient3d(self.p(v[0]), self.p(v[1]), self.p(v[2]), q) > 0 {
+            if K::orient3d_static(self.p(v[0]), self.p(v[1]), self.p(v[2]), q, &self.filter) > 0 {
                 return t;
             }
             t = self.cells[t as usize].n[3] >> 2;
@@ -194,7 +201,8 @@ impl<K: Kernel> Builder<K> {
                 if m == IN_CONFLICT {
                     continue;
                 }
-                if m != CLEAR && tet_in_conflict::<K>(&self.pts, &self.cells[n].v, &q) {
+                if m != CLEAR && tet_in_conflict::<K>(&self.pts, &self.cells[n].v, &q, &self.filter)
+                {
                     self.mark[n] = IN_CONFLICT;
                     self.conflicts.push(n as u32);
                     continue;
@@ -385,6 +393,7 @@ fn run<K: Kernel>(
     let n = points.len();
     let mut b = Builder::<K> {
         kernel: std::marker::PhantomData,
+        filter: StaticFilter::for_points(points),
         pts: Vec::with_capacity(n),
         cells: Vec::with_capacity(expected_tets),
         mark: Vec::with_capacity(expected_tets),

@@ -2,7 +2,7 @@
 
 use super::build::{tet_in_conflict, FACE};
 use super::{Triangulation, INFINITE};
-use crate::geometry::predicates::{orient3d, Filtered};
+use crate::geometry::predicates::{orient3d, Filtered, StaticFilter};
 
 /// A broken invariant found by [`Triangulation::validate`].
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -128,7 +128,14 @@ impl Triangulation {
                     return Err(ValidationError::Adjacency { tet: t, face: i });
                 }
                 let w = self.cells[n as usize].v[j];
-                if w != INFINITE && tet_in_conflict::<Filtered>(&self.pts, &v, self.point(w)) {
+                if w != INFINITE
+                    && tet_in_conflict::<Filtered>(
+                        &self.pts,
+                        &v,
+                        self.point(w),
+                        &StaticFilter::NONE,
+                    )
+                {
                     return Err(ValidationError::NotDelaunay { tet: t, face: i });
                 }
             }
