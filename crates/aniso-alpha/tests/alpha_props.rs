@@ -101,3 +101,63 @@ proptest! {
         prop_assert!(count.values().all(|&v| v == 0));
     }
 }
+
+/// The interval pass splits its work across rayon's threads: the result
+/// (ids, order and bits of every interval and radius) must not depend on
+/// how many there are. 60k points make several blocks of the triangle pass
+/// and several edge runs per thread.
+#[test]
+fn intervals_do_not_depend_on_thread_count() {
+    let mut s = 0x5151_u64;
+    let mut unif = || {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (s >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut pts: Vec<[f64; 3]> = (0..60_000).map(|_| [unif(), unif(), unif()]).collect();
+    // And a degenerate part: an integer grid (many equal radii, ties).
+    for i in 0..20 {
+        for j in 0..20 {
+            for k in 0..20 {
+                pts.push([2.0 + i as f64 * 0.05, j as f64 * 0.05, k as f64 * 0.05]);
+            }
+        }
+    }
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| AlphaComplex::from_points(&pts).unwrap())
+    };
+    let one = run(1);
+    for threads in [2, 3] {
+        let other = run(threads);
+        assert_eq!(one.num_edges(), other.num_edges());
+        assert_eq!(one.num_triangles(), other.num_triangles());
+        for e in 0..one.num_edges() {
+            assert_eq!(one.edge_vertices(e), other.edge_vertices(e));
+            let (a, b) = (one.edge_interval(e), other.edge_interval(e));
+            assert_eq!(
+                (a.0.to_bits(), a.1.to_bits()),
+                (b.0.to_bits(), b.1.to_bits())
+            );
+        }
+        for f in 0..one.num_triangles() {
+            assert_eq!(one.triangle_vertices(f), other.triangle_vertices(f));
+            let (a, b) = (one.triangle_interval(f), other.triangle_interval(f));
+            assert_eq!(
+                (a.0.to_bits(), a.1.to_bits()),
+                (b.0.to_bits(), b.1.to_bits())
+            );
+        }
+        let bits = |ac: &AlphaComplex| {
+            ac.tet_radii()
+                .iter()
+                .map(|r| r.to_bits())
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(bits(&one), bits(&other));
+    }
+}

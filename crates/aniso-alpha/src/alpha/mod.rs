@@ -84,13 +84,8 @@ use crate::geometry::Point3;
 /// so that face `i` of a positively oriented tet has its normal (right-hand
 /// rule) pointing towards vertex `i`, i.e. into the tet.
 const FACE: [[usize; 3]; 4] = [[1, 3, 2], [0, 2, 3], [0, 3, 1], [0, 1, 2]];
-/// Mark of an infinite cell in the per-cell flag bytes (whose low 4 bits
-/// are the Gabriel mask of [`cell_masks`]).
-const INFINITE_CELL: u8 = 0x80;
 /// A cell's vertices and `(neighbour, mirror index)` per face.
 type GatheredCell = ([u32; 4], [(u32, usize); 4]);
-/// Mark of a finite cell already visited by the main pass.
-const DONE_CELL: u8 = 0x40;
 /// The 6 edges of a tet as local index pairs.
 const PAIRS: [[usize; 2]; 6] = [[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]];
 
@@ -178,18 +173,23 @@ impl AlphaComplex {
                 tri_iv: Vec::new(),
             };
         }
-        let (order, mut bits) = cells_by_min_vertex(&tri);
+        let order = cells_by_min_vertex(&tri);
         let (edges, edge_start) = number_edges(&tri);
-        let nc = tri.num_tets();
         let mut ac = AlphaComplex {
             tri,
-            cell_r: vec![f64::INFINITY; nc],
+            cell_r: Vec::new(),
             edges,
             edge_start,
             tri_face: Vec::new(),
             tri_iv: Vec::new(),
         };
-        ac.compute_cells_triangles_edges(&order, &mut bits);
+        let by_id = cell_pass(&ac.tri);
+        ac.cell_r = by_id.iter().map(|c| c.r).collect();
+        // In visiting order, so that the triangle pass reads the data of a
+        // region's cells together.
+        let cells: Vec<CellData> = order.iter().map(|&t| by_id[t as usize]).collect();
+        drop(by_id);
+        ac.compute_triangles_edges(&order, &cells);
         ac
     }
 
@@ -489,80 +489,67 @@ impl AlphaComplex {
         order.last().map(|&t| self.cell_r[t as usize])
     }
 
-    /// Steps 1, 3 and 4 of the algorithm (module docs), fused in one pass
-    /// over the finite cells in `order`: each cell gets its circumradius and
-    /// Gabriel mask (see [`cell_masks`]) and marks itself [`DONE_CELL`] in
-    /// `bits`; a triangle is created by the second of its two cells to be
-    /// visited (or by its finite cell on the hull), when both sides' data
-    /// are known.
+    /// Steps 3 and 4 of the algorithm (module docs), after [`cell_pass`]
+    /// has stored every cell's circumradius and Gabriel mask. The finite
+    /// cells are visited in `order`; a triangle is created by the later of
+    /// its two cells in that order (or by its finite cell on the hull), and
+    /// pushes its interval to its three edges.
+    ///
+    /// The work goes by blocks of cells. Within a block, the per-triangle
+    /// part (intervals, edge lookups, the edges' Gabriel tests against the
+    /// third vertex) only reads shared data and runs in parallel with the
+    /// `parallel` feature; the edge updates are then applied in order, so
+    /// the result is identical for any number of threads.
     #[inline(never)]
-    fn compute_cells_triangles_edges(&mut self, order: &[u32], bits: &mut [u8]) {
+    fn compute_triangles_edges(&mut self, order: &[u32], cells: &[CellData]) {
         let tri = &self.tri;
-        let pts = tri.points();
         let nt = tri.num_triangles();
         let mut tri_face = Vec::with_capacity(nt);
         let mut tri_iv = Vec::with_capacity(nt);
-        let edge_start = &self.edge_start;
+        // Position of each finite cell in `order` (`u32::MAX` for infinite
+        // cells): the owner rule, and the index into `cells`.
+        let mut pos = vec![u32::MAX; tri.num_tets()];
+        for (k, &t) in order.iter().enumerate() {
+            pos[t as usize] = k as u32;
+        }
         // During the pass, an edge's `iv` holds [min of its triangles'
         // α_min, max of their α_max], with the sign bit of the first set
         // once a third vertex is found inside its diametral ball.
-        let edges = &mut self.edges;
-        let cell_r = &mut self.cell_r;
-        // Cell ids in `order` are scattered in memory: gather each block's
-        // cells first (independent loads, so many misses are in flight at
-        // once), then work on the gathered copy.
-        const BLOCK: usize = 1024;
-        let mut block: Vec<GatheredCell> = Vec::with_capacity(BLOCK);
-        for chunk in order.chunks(BLOCK) {
-            block.clear();
-            block.extend(
-                chunk
-                    .iter()
-                    .map(|&t| (tri.tet(t), [0, 1, 2, 3].map(|i| tri.neighbor(t, i)))),
-            );
-            for (&t, (v, nbr)) in chunk.iter().zip(&block) {
-                let v = *v;
-                let (rt, mt) = cell_masks(pts, &v);
-                cell_r[t as usize] = rt;
-                bits[t as usize] = mt | DONE_CELL;
-                for i in 0..4 {
-                    let (n, j) = nbr[i];
-                    // Owner: the second cell visited, or the finite one.
-                    let bn = bits[n as usize];
-                    if bn & (INFINITE_CELL | DONE_CELL) == 0 {
-                        continue;
-                    }
-                    let f = FACE[i];
-                    let (ia, ib, ic) = (v[f[0]], v[f[1]], v[f[2]]);
-                    let gabriel = (mt >> i) & 1 == 0 && (bn >> j) & 1 == 0;
-                    let rn = cell_r[n as usize];
-                    let amax = rt.max(rn);
-                    let amin = if gabriel {
-                        triangle_rho_sorted(pts, [ia, ib, ic])
-                    } else {
-                        rt.min(rn)
-                    };
-                    tri_face.push((t << 2) | i as u32);
-                    tri_iv.push([amin, amax]);
-                    // Push to the three edges.
-                    for (x, y, z) in [(ia, ib, ic), (ib, ic, ia), (ic, ia, ib)] {
-                        let slot = &mut find_edge_rec(edges, edge_start, x, y).iv;
-                        if amax > slot[1] {
-                            slot[1] = amax;
-                        }
-                        let m = slot[0].abs().min(amin);
-                        let refuted = slot[0].is_sign_negative()
-                            || exact::edge_diametral_side(
-                                &pts[x as usize],
-                                &pts[y as usize],
-                                &pts[z as usize],
-                            ) < 0;
-                        slot[0] = if refuted { -m } else { m };
-                    }
-                }
+        const BLOCK: usize = 1 << 16;
+        const SUB: usize = 2048;
+        for (b, block) in order.chunks(BLOCK).enumerate() {
+            let base = b * BLOCK;
+            let ctx = TriangleCtx {
+                tri: &self.tri,
+                cells,
+                pos: &pos,
+                edges: &self.edges,
+                edge_start: &self.edge_start,
+            };
+            #[cfg(feature = "parallel")]
+            let parts: Vec<Vec<TriangleOut>> = {
+                use rayon::prelude::*;
+                block
+                    .par_chunks(SUB)
+                    .enumerate()
+                    .map(|(k, sub)| ctx.triangles_of(sub, base + k * SUB))
+                    .collect()
+            };
+            #[cfg(not(feature = "parallel"))]
+            let parts: Vec<Vec<TriangleOut>> = block
+                .chunks(SUB)
+                .enumerate()
+                .map(|(k, sub)| ctx.triangles_of(sub, base + k * SUB))
+                .collect();
+            for out in parts.iter().flatten() {
+                tri_face.push(out.face);
+                tri_iv.push(out.iv);
             }
+            apply_edge_updates(&mut self.edges, &parts);
         }
-        for rec in edges.iter_mut() {
+        drop(pos);
+        let pts = self.tri.points();
+        for rec in self.edges.iter_mut() {
             let [a, b] = rec.v;
             let slot = &mut rec.iv;
             if slot[0].is_sign_negative() {
@@ -578,6 +565,146 @@ impl AlphaComplex {
     }
 }
 
+/// Edges per ownership run in [`apply_edge_updates`].
+#[cfg(feature = "parallel")]
+const EDGE_RUN: usize = 1024;
+
+/// Pushes the triangles' intervals and Gabriel refutations to their edges:
+/// an edge's `iv` keeps [min of α_min, max of α_max] with the sign bit of
+/// the first set once refuted. The update commutes, so with the `parallel`
+/// feature the edges are dealt to the threads in runs of [`EDGE_RUN`] ids
+/// (each thread reads every triangle and applies the updates of its own
+/// runs) and the result does not depend on the split.
+fn apply_edge_updates(edges: &mut [EdgeRec], parts: &[Vec<TriangleOut>]) {
+    #[inline(always)]
+    fn update(slot: &mut [f64; 2], out: &TriangleOut, k: usize) {
+        if out.iv[1] > slot[1] {
+            slot[1] = out.iv[1];
+        }
+        let m = slot[0].abs().min(out.iv[0]);
+        let refuted = (out.refuted >> k) & 1 == 1;
+        slot[0] = if refuted || slot[0].is_sign_negative() {
+            -m
+        } else {
+            m
+        };
+    }
+    #[cfg(feature = "parallel")]
+    {
+        use rayon::prelude::*;
+        let t = rayon::current_num_threads().clamp(1, 8);
+        if t > 1 {
+            let mut lists: Vec<Vec<&mut [EdgeRec]>> = (0..t).map(|_| Vec::new()).collect();
+            for (k, run) in edges.chunks_mut(EDGE_RUN).enumerate() {
+                lists[k % t].push(run);
+            }
+            lists.into_par_iter().enumerate().for_each(|(w, mut runs)| {
+                for out in parts.iter().flatten() {
+                    for k in 0..3 {
+                        let e = out.edges[k] as usize;
+                        let run = e / EDGE_RUN;
+                        if run % t == w {
+                            update(&mut runs[run / t][e % EDGE_RUN].iv, out, k);
+                        }
+                    }
+                }
+            });
+            return;
+        }
+    }
+    for out in parts.iter().flatten() {
+        for k in 0..3 {
+            update(&mut edges[out.edges[k] as usize].iv, out, k);
+        }
+    }
+}
+
+/// Read-only data of the triangle pass.
+struct TriangleCtx<'a> {
+    tri: &'a Triangulation,
+    cells: &'a [CellData],
+    pos: &'a [u32],
+    edges: &'a [EdgeRec],
+    edge_start: &'a [u32],
+}
+
+/// A triangle found by the triangle pass: its owning face, interval, the
+/// ids of its edges (`ab`, `bc`, `ca`) and, per edge, whether the third
+/// vertex lies strictly inside the edge's diametral ball.
+struct TriangleOut {
+    face: u32,
+    iv: [f64; 2],
+    edges: [u32; 3],
+    refuted: u8,
+}
+
+impl TriangleCtx<'_> {
+    /// The triangles owned by the cells `cells`, which sit at positions
+    /// `first..` of the visiting order.
+    fn triangles_of(&self, cells: &[u32], first: usize) -> Vec<TriangleOut> {
+        let tri = self.tri;
+        let pts = tri.points();
+        // Cell ids are scattered in memory: gather the cells first
+        // (independent loads, so many misses are in flight at once), then
+        // work on the gathered copy.
+        let gathered: Vec<GatheredCell> = cells
+            .iter()
+            .map(|&t| (tri.tet(t), [0, 1, 2, 3].map(|i| tri.neighbor(t, i))))
+            .collect();
+        let mut out = Vec::with_capacity(2 * cells.len() + 8);
+        for (k, (&t, (v, nbr))) in cells.iter().zip(&gathered).enumerate() {
+            let here = (first + k) as u32;
+            let CellData { r: rt, mask: mt } = self.cells[here as usize];
+            for i in 0..4 {
+                let (n, j) = nbr[i];
+                // Owner: the later cell in the order, or the finite one.
+                let p = self.pos[n as usize];
+                if p != u32::MAX && p > here {
+                    continue;
+                }
+                let CellData { r: rn, mask: bn } = if p == u32::MAX {
+                    CellData {
+                        r: f64::INFINITY,
+                        mask: 0,
+                    }
+                } else {
+                    self.cells[p as usize]
+                };
+                let f = FACE[i];
+                let (ia, ib, ic) = (v[f[0]], v[f[1]], v[f[2]]);
+                let gabriel = (mt >> i) & 1 == 0 && (bn >> j) & 1 == 0;
+                let amax = rt.max(rn);
+                let amin = if gabriel {
+                    triangle_rho_sorted(pts, [ia, ib, ic])
+                } else {
+                    rt.min(rn)
+                };
+                let mut edges = [0u32; 3];
+                let mut refuted = 0u8;
+                for (e, (x, y, z)) in [(ia, ib, ic), (ib, ic, ia), (ic, ia, ib)]
+                    .into_iter()
+                    .enumerate()
+                {
+                    edges[e] = find_edge_id(self.edges, self.edge_start, x, y);
+                    let inside = exact::edge_diametral_side(
+                        &pts[x as usize],
+                        &pts[y as usize],
+                        &pts[z as usize],
+                    ) < 0;
+                    refuted |= (inside as u8) << e;
+                }
+                out.push(TriangleOut {
+                    face: (t << 2) | i as u32,
+                    iv: [amin, amax],
+                    edges,
+                    refuted,
+                });
+            }
+        }
+        out
+    }
+}
+
 /// An edge: vertex ids `(a, b)`, `a < b`, and `[α_min, α_max]`.
 #[derive(Clone, Copy, Debug)]
 struct EdgeRec {
@@ -585,16 +712,16 @@ struct EdgeRec {
     iv: [f64; 2],
 }
 
-/// The record of edge `(x, y)` (which must exist), by a scan of the smaller
+/// The id of edge `(x, y)` (which must exist), by a scan of the smaller
 /// vertex's bucket.
 #[inline]
-fn find_edge_rec<'a>(edges: &'a mut [EdgeRec], start: &[u32], x: u32, y: u32) -> &'a mut EdgeRec {
+fn find_edge_id(edges: &[EdgeRec], start: &[u32], x: u32, y: u32) -> u32 {
     let (a, b) = if x < y { (x, y) } else { (y, x) };
     let mut e = start[a as usize] as usize;
     while edges[e].v[1] != b {
         e += 1;
     }
-    &mut edges[e]
+    e as u32
 }
 
 /// Union-find root with path halving.
@@ -605,6 +732,45 @@ fn find(parent: &mut [u32], mut x: u32) -> u32 {
         x = p;
     }
     x
+}
+
+/// A finite cell's circumradius and Gabriel mask (see [`cell_masks`]).
+#[derive(Clone, Copy, Debug)]
+struct CellData {
+    r: f64,
+    mask: u8,
+}
+
+/// Step 1 of the algorithm: the circumradius and Gabriel mask of every
+/// cell, by cell id (`+∞` and no mask for infinite cells). Cells are
+/// independent, so with the `parallel` feature they are split across
+/// rayon's threads; the values do not depend on the split.
+fn cell_pass(tri: &Triangulation) -> Vec<CellData> {
+    let pts = tri.points();
+    let work = |t: u32| {
+        let v = tri.tet(t);
+        if v[3] == INFINITE {
+            CellData {
+                r: f64::INFINITY,
+                mask: 0,
+            }
+        } else {
+            let (r, mask) = cell_masks(pts, &v);
+            CellData { r, mask }
+        }
+    };
+    let nc = tri.num_tets() as u32;
+    #[cfg(feature = "parallel")]
+    {
+        use rayon::prelude::*;
+        (0..nc)
+            .into_par_iter()
+            .with_min_len(1 << 12)
+            .map(work)
+            .collect()
+    }
+    #[cfg(not(feature = "parallel"))]
+    (0..nc).map(work).collect()
 }
 
 /// Circumradius of the finite cell with vertices `v`, and its 4-bit
@@ -676,22 +842,18 @@ fn number_edges(tri: &Triangulation) -> (Vec<EdgeRec>, Vec<u32>) {
     (edges, estart)
 }
 
-/// The finite cells grouped by their smallest vertex id (a counting sort),
-/// and the per-cell flag bytes with [`INFINITE_CELL`] set on infinite
-/// cells. Vertex ids follow the spatially coherent insertion order while
-/// cell ids do not, so visiting cells in this order keeps the accesses to
-/// points and edges local.
-fn cells_by_min_vertex(tri: &Triangulation) -> (Vec<u32>, Vec<u8>) {
+/// The finite cells grouped by their smallest vertex id (a counting sort).
+/// Vertex ids follow the spatially coherent insertion order while cell ids
+/// do not, so visiting cells in this order keeps the accesses to points and
+/// edges local.
+fn cells_by_min_vertex(tri: &Triangulation) -> Vec<u32> {
     let nv = tri.num_vertices();
     let nc = tri.num_tets() as u32;
     let mut start = vec![0u32; nv + 1];
-    let mut flags = vec![0u8; nc as usize];
     for t in 0..nc {
         let v = tri.tet(t);
         if v[3] != INFINITE {
             start[v[0].min(v[1]).min(v[2].min(v[3])) as usize + 1] += 1;
-        } else {
-            flags[t as usize] = INFINITE_CELL;
         }
     }
     for k in 0..nv {
@@ -706,7 +868,7 @@ fn cells_by_min_vertex(tri: &Triangulation) -> (Vec<u32>, Vec<u8>) {
             *slot += 1;
         }
     }
-    (order, flags)
+    order
 }
 
 /// Circumradius of the triangle `abc` (radius of its smallest
