@@ -27,31 +27,37 @@
 //!
 //! 1. the finite cells are bucketed by their smallest vertex id (counting
 //!    sort). Vertex ids follow the engine's spatially coherent insertion
-//!    order while cell ids do not, so the main pass (3) visits the cells in
-//!    this order (gathering each block of 1024 cells first) and its
+//!    order while cell ids do not, so the triangle pass (4) visits the
+//!    cells in this order (gathering each block of cells first) and its
 //!    accesses to points and edges stay local;
 //! 2. edges: every finite tet (read in id order) emits its 6 edges
 //!    `(a, b)`, `a < b`, bucketed by `a` (counting sort); each bucket is
 //!    deduplicated with a per-vertex stamp. The edges are numbered grouped
 //!    by `a`, and the per-vertex offsets (CSR) give an `O(degree)` lookup;
-//! 3. one pass over the cells: each computes its circumradius (relative to
-//!    a vertex; recomputed exactly and rounded once for slivers, see
-//!    [`exact`]) and, for each of its faces, whether its opposite vertex is
-//!    strictly inside the face's diametral sphere (exact). A triangle is
-//!    emitted by the second of its two cells to be visited (or its finite
-//!    cell on the hull), when both sides are known: Gabriel iff neither
-//!    apex is inside. It then pushes its values to its three edges (max of
+//! 3. every cell's circumradius (relative to a vertex; recomputed exactly
+//!    and rounded once for slivers, see [`exact`]) and, for each of its
+//!    faces, whether its opposite vertex is strictly inside the face's
+//!    diametral sphere (exact);
+//! 4. a triangle is emitted by the later of its two cells in the order of
+//!    (1) (or its finite cell on the hull): Gabriel iff neither apex is
+//!    inside. It then pushes its values to its three edges (max of
 //!    `α_max`, min of the cofaces' `α_min`, and the edge's own Gabriel test
 //!    against the triangle's third vertex: the third vertices of an edge's
 //!    triangles are exactly the vertices of its incident tets);
-//! 4. each edge's `α_min` is its half length if Gabriel, else the minimum
+//! 5. each edge's `α_min` is its half length if Gabriel, else the minimum
 //!    over its triangles.
+//!
+//! With the `parallel` feature (default), steps 3 and 4 run on rayon's
+//! threads: cells are independent; triangles are computed in parallel per
+//! block of cells, and their edge updates (min, max and "refuted", which
+//! commute) are applied by threads that each own interleaved runs of edge
+//! ids. Ids, order and every bit of the result are the same for any
+//! number of threads (tested).
 //!
 //! Memory: the complex adds about 8 bytes per cell, 20 per triangle and 24
 //! per edge to the triangulation (≈ 0.5 GB for 1M uniform points), plus
-//! transient buckets of 4 bytes per (tet, edge) incidence during step 2.
-//! The computation is sequential; the detector runs one complex per
-//! orientation, which is where parallelism belongs.
+//! transient buckets of 4 bytes per (tet, edge) incidence during step 2
+//! and 4 bytes per cell (position and mask) during steps 3–4.
 //!
 //! The struct owns the triangulation (get it back with
 //! [`AlphaComplex::into_triangulation`]).
@@ -183,13 +189,15 @@ impl AlphaComplex {
             tri_face: Vec::new(),
             tri_iv: Vec::new(),
         };
-        let by_id = cell_pass(&ac.tri);
-        ac.cell_r = by_id.iter().map(|c| c.r).collect();
-        // In visiting order, so that the triangle pass reads the data of a
-        // region's cells together.
-        let cells: Vec<CellData> = order.iter().map(|&t| by_id[t as usize]).collect();
-        drop(by_id);
-        ac.compute_triangles_edges(&order, &cells);
+        // Per cell: its position in `order` and its Gabriel mask, packed
+        // (`pos << 4 | mask`), `u32::MAX` for infinite cells.
+        let mut posmask = vec![u32::MAX; ac.tri.num_tets()];
+        for (k, &t) in order.iter().enumerate() {
+            posmask[t as usize] = (k as u32) << 4;
+        }
+        ac.cell_r = vec![f64::INFINITY; ac.tri.num_tets()];
+        cell_pass(&ac.tri, &mut ac.cell_r, &mut posmask);
+        ac.compute_triangles_edges(&order, &posmask);
         ac
     }
 
@@ -489,7 +497,7 @@ impl AlphaComplex {
         order.last().map(|&t| self.cell_r[t as usize])
     }
 
-    /// Steps 3 and 4 of the algorithm (module docs), after [`cell_pass`]
+    /// Steps 4 and 5 of the algorithm (module docs), after [`cell_pass`]
     /// has stored every cell's circumradius and Gabriel mask. The finite
     /// cells are visited in `order`; a triangle is created by the later of
     /// its two cells in that order (or by its finite cell on the hull), and
@@ -501,28 +509,21 @@ impl AlphaComplex {
     /// `parallel` feature; the edge updates are then applied in order, so
     /// the result is identical for any number of threads.
     #[inline(never)]
-    fn compute_triangles_edges(&mut self, order: &[u32], cells: &[CellData]) {
-        let tri = &self.tri;
-        let nt = tri.num_triangles();
+    fn compute_triangles_edges(&mut self, order: &[u32], posmask: &[u32]) {
+        let nt = self.tri.num_triangles();
         let mut tri_face = Vec::with_capacity(nt);
         let mut tri_iv = Vec::with_capacity(nt);
-        // Position of each finite cell in `order` (`u32::MAX` for infinite
-        // cells): the owner rule, and the index into `cells`.
-        let mut pos = vec![u32::MAX; tri.num_tets()];
-        for (k, &t) in order.iter().enumerate() {
-            pos[t as usize] = k as u32;
-        }
         // During the pass, an edge's `iv` holds [min of its triangles'
         // α_min, max of their α_max], with the sign bit of the first set
         // once a third vertex is found inside its diametral ball.
-        const BLOCK: usize = 1 << 16;
-        const SUB: usize = 2048;
+        const BLOCK: usize = 1 << 14;
+        const SUB: usize = 1024;
         for (b, block) in order.chunks(BLOCK).enumerate() {
             let base = b * BLOCK;
             let ctx = TriangleCtx {
                 tri: &self.tri,
-                cells,
-                pos: &pos,
+                cell_r: &self.cell_r,
+                posmask,
                 edges: &self.edges,
                 edge_start: &self.edge_start,
             };
@@ -547,7 +548,6 @@ impl AlphaComplex {
             }
             apply_edge_updates(&mut self.edges, &parts);
         }
-        drop(pos);
         let pts = self.tri.points();
         for rec in self.edges.iter_mut() {
             let [a, b] = rec.v;
@@ -622,8 +622,8 @@ fn apply_edge_updates(edges: &mut [EdgeRec], parts: &[Vec<TriangleOut>]) {
 /// Read-only data of the triangle pass.
 struct TriangleCtx<'a> {
     tri: &'a Triangulation,
-    cells: &'a [CellData],
-    pos: &'a [u32],
+    cell_r: &'a [f64],
+    posmask: &'a [u32],
     edges: &'a [EdgeRec],
     edge_start: &'a [u32],
 }
@@ -654,22 +654,20 @@ impl TriangleCtx<'_> {
         let mut out = Vec::with_capacity(2 * cells.len() + 8);
         for (k, (&t, (v, nbr))) in cells.iter().zip(&gathered).enumerate() {
             let here = (first + k) as u32;
-            let CellData { r: rt, mask: mt } = self.cells[here as usize];
+            let rt = self.cell_r[t as usize];
+            let mt = self.posmask[t as usize] & 0xf;
             for i in 0..4 {
                 let (n, j) = nbr[i];
                 // Owner: the later cell in the order, or the finite one.
-                let p = self.pos[n as usize];
-                if p != u32::MAX && p > here {
+                let pm = self.posmask[n as usize];
+                let bn = if pm == u32::MAX {
+                    0
+                } else if pm >> 4 > here {
                     continue;
-                }
-                let CellData { r: rn, mask: bn } = if p == u32::MAX {
-                    CellData {
-                        r: f64::INFINITY,
-                        mask: 0,
-                    }
                 } else {
-                    self.cells[p as usize]
+                    pm & 0xf
                 };
+                let rn = self.cell_r[n as usize];
                 let f = FACE[i];
                 let (ia, ib, ic) = (v[f[0]], v[f[1]], v[f[2]]);
                 let gabriel = (mt >> i) & 1 == 0 && (bn >> j) & 1 == 0;
@@ -734,43 +732,37 @@ fn find(parent: &mut [u32], mut x: u32) -> u32 {
     x
 }
 
-/// A finite cell's circumradius and Gabriel mask (see [`cell_masks`]).
-#[derive(Clone, Copy, Debug)]
-struct CellData {
-    r: f64,
-    mask: u8,
-}
-
-/// Step 1 of the algorithm: the circumradius and Gabriel mask of every
-/// cell, by cell id (`+∞` and no mask for infinite cells). Cells are
-/// independent, so with the `parallel` feature they are split across
-/// rayon's threads; the values do not depend on the split.
-fn cell_pass(tri: &Triangulation) -> Vec<CellData> {
+/// Step 3 of the algorithm: the circumradius and Gabriel mask (see
+/// [`cell_masks`]) of every finite cell, by cell id, into `cell_r` and the
+/// low 4 bits of `posmask` (where infinite cells are `u32::MAX` and keep
+/// their `+∞` radius). Cells are independent, so with the `parallel`
+/// feature they are split across rayon's threads; the values do not depend
+/// on the split.
+fn cell_pass(tri: &Triangulation, cell_r: &mut [f64], posmask: &mut [u32]) {
     let pts = tri.points();
-    let work = |t: u32| {
-        let v = tri.tet(t);
-        if v[3] == INFINITE {
-            CellData {
-                r: f64::INFINITY,
-                mask: 0,
-            }
-        } else {
-            let (r, mask) = cell_masks(pts, &v);
-            CellData { r, mask }
+    let work = |(t, (r, pm)): (usize, (&mut f64, &mut u32))| {
+        if *pm != u32::MAX {
+            let (rt, mt) = cell_masks(pts, &tri.tet(t as u32));
+            *r = rt;
+            *pm |= mt as u32;
         }
     };
-    let nc = tri.num_tets() as u32;
     #[cfg(feature = "parallel")]
     {
         use rayon::prelude::*;
-        (0..nc)
-            .into_par_iter()
+        cell_r
+            .par_iter_mut()
+            .zip(posmask.par_iter_mut())
+            .enumerate()
             .with_min_len(1 << 12)
-            .map(work)
-            .collect()
+            .for_each(work);
     }
     #[cfg(not(feature = "parallel"))]
-    (0..nc).map(work).collect()
+    cell_r
+        .iter_mut()
+        .zip(posmask.iter_mut())
+        .enumerate()
+        .for_each(work);
 }
 
 /// Circumradius of the finite cell with vertices `v`, and its 4-bit
