@@ -31,6 +31,9 @@ pub(crate) struct Cell {
 /// `(0, 1, 2, 3)`, so face `i` seen from vertex `i` is counter-clockwise.
 pub(crate) const FACE: [[usize; 3]; 4] = [[1, 3, 2], [0, 2, 3], [0, 3, 1], [0, 1, 2]];
 
+/// For each face index, the other three.
+const OTHER: [[usize; 3]; 4] = [[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]];
+
 #[inline(always)]
 fn pack(t: u32, i: usize) -> u32 {
     (t << 2) | i as u32
@@ -232,8 +235,8 @@ impl<K: Kernel> Builder<K> {
             let (nt, f) = ((packed >> 2) as usize, (packed & 3) as usize);
             // The outer tet was marked CLEAR; reset it.
             mark[(cells[nt].n[f] >> 2) as usize] = 0;
-            for g in 0..4 {
-                if g == f || cells[nt].n[g] != UNSET {
+            for g in OTHER[f] {
+                if cells[nt].n[g] != UNSET {
                     continue;
                 }
                 // Invariant: we are about to cross face `gc` of conflict
@@ -263,9 +266,9 @@ impl<K: Kernel> Builder<K> {
             }
         }
 
-        // Free the cavity.
+        // Free the cavity (dead cells are only marked DEAD at compaction:
+        // they are exactly the free list then).
         for &c in &self.conflicts {
-            cells[c as usize].v = [DEAD; 4];
             mark[c as usize] = 0;
         }
         self.free.extend_from_slice(&self.conflicts);
@@ -504,7 +507,16 @@ fn link_by_faces(cells: &mut [Cell], ids: &[u32]) {
 /// Drops dead tets by moving live tets from the end into the holes (only
 /// the cells on the free list move; the rest stay where they are).
 fn compact<K: Kernel>(b: Builder<K>, vert_input: Vec<u32>, input_vert: Vec<u32>) -> Triangulation {
-    let Builder { pts, mut cells, .. } = b;
+    let Builder {
+        pts,
+        mut cells,
+        free,
+        ..
+    } = b;
+    for &t in &free {
+        cells[t as usize].v[0] = DEAD;
+    }
+    drop(free);
     let dead = |c: &Cell| c.v[0] == DEAD;
     let mut end = cells.len();
     let mut i = 0;
