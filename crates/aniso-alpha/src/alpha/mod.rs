@@ -592,19 +592,21 @@ fn apply_edge_updates(edges: &mut [EdgeRec], parts: &[Vec<TriangleOut>]) {
     #[cfg(feature = "parallel")]
     {
         use rayon::prelude::*;
-        let t = rayon::current_num_threads().clamp(1, 8);
+        // A power of two, so that the owner of a run is a mask away.
+        let shift = rayon::current_num_threads().clamp(1, 8).ilog2();
+        let t = 1usize << shift;
         if t > 1 {
             let mut lists: Vec<Vec<&mut [EdgeRec]>> = (0..t).map(|_| Vec::new()).collect();
             for (k, run) in edges.chunks_mut(EDGE_RUN).enumerate() {
-                lists[k % t].push(run);
+                lists[k & (t - 1)].push(run);
             }
             lists.into_par_iter().enumerate().for_each(|(w, mut runs)| {
                 for out in parts.iter().flatten() {
                     for k in 0..3 {
                         let e = out.edges[k] as usize;
                         let run = e / EDGE_RUN;
-                        if run % t == w {
-                            update(&mut runs[run / t][e % EDGE_RUN].iv, out, k);
+                        if run & (t - 1) == w {
+                            update(&mut runs[run >> shift][e % EDGE_RUN].iv, out, k);
                         }
                     }
                 }
