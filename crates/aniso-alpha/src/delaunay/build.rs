@@ -12,10 +12,13 @@ use crate::geometry::Point3;
 const DEAD: u32 = u32::MAX - 1;
 /// An adjacency slot not yet linked.
 const UNSET: u32 = u32::MAX;
-/// Flag: the tet is in the current conflict region.
-const IN_CONFLICT: u8 = 1;
-/// Flag: the tet was tested and is not in conflict.
-const CLEAR: u8 = 2;
+/// Flag on a tet's `v[0]`: the tet is in the current conflict region.
+/// Vertex ids stay below 2^31 (see [`DelaunayError::TooManyPoints`]), and
+/// `v[0]` and `v[1]` are never the infinite vertex (always at index 3), so
+/// the top bit of either is free; flags live only during one insertion.
+const IN_CONFLICT: u32 = 1 << 31;
+/// Flag on a tet's `v[1]`: the tet was tested and is not in conflict.
+const CLEAR: u32 = 1 << 31;
 
 /// One tetrahedron: vertex ids and packed neighbours (`4 * tet + mirror`),
 /// interleaved so that visiting a tet touches one 32-byte block.
@@ -70,9 +73,6 @@ struct Builder<K: Kernel> {
     filter: StaticFilter,
     pts: Vec<Point3>,
     cells: Vec<Cell>,
-    /// Per-tet flag during one insertion: 0, [`IN_CONFLICT`] or [`CLEAR`];
-    /// reset to 0 before the insertion returns.
-    mark: Vec<u8>,
     free: Vec<u32>,
     rng: SplitMix64,
     // Scratch, reused across insertions.
@@ -118,7 +118,6 @@ impl<K: Kernel> Builder<K> {
                 v: [DEAD; 4],
                 n: [UNSET; 4],
             });
-            self.mark.push(0);
             t
         }
     }
@@ -191,7 +190,7 @@ impl<K: Kernel> Builder<K> {
         self.conflicts.clear();
         self.new_tets.clear();
         self.conflicts.push(start);
-        self.mark[start as usize] = IN_CONFLICT;
+        self.cells[start as usize].v[0] |= IN_CONFLICT;
         let mut k = 0;
         while k < self.conflicts.len() {
             let c = self.conflicts[k];
@@ -200,19 +199,19 @@ impl<K: Kernel> Builder<K> {
             for f in 0..4 {
                 let outer = cell.n[f];
                 let n = (outer >> 2) as usize;
-                let m = self.mark[n];
-                if m == IN_CONFLICT {
+                let nv = self.cells[n].v;
+                if nv[0] & IN_CONFLICT != 0 {
                     continue;
                 }
-                if m != CLEAR && tet_in_conflict::<K>(&self.pts, &self.cells[n].v, &q, &self.filter)
-                {
-                    self.mark[n] = IN_CONFLICT;
+                if nv[1] & CLEAR == 0 && tet_in_conflict::<K>(&self.pts, &nv, &q, &self.filter) {
+                    self.cells[n].v[0] |= IN_CONFLICT;
                     self.conflicts.push(n as u32);
                     continue;
                 }
-                self.mark[n] = CLEAR;
+                self.cells[n].v[1] |= CLEAR;
                 let nt = self.alloc();
                 let mut v = cell.v;
+                v[0] &= !IN_CONFLICT;
                 v[f] = vid;
                 let mut nn = [UNSET; 4];
                 nn[f] = outer;
@@ -230,11 +229,10 @@ impl<K: Kernel> Builder<K> {
         // across its face g, through conflict tets only: every cell
         // visited is part of this insertion and already in cache.
         let cells = &mut self.cells[..];
-        let mark = &mut self.mark[..];
         for &(packed, c) in &self.new_tets {
             let (nt, f) = ((packed >> 2) as usize, (packed & 3) as usize);
             // The outer tet was marked CLEAR; reset it.
-            mark[(cells[nt].n[f] >> 2) as usize] = 0;
+            cells[(cells[nt].n[f] >> 2) as usize].v[1] &= !CLEAR;
             for g in OTHER[f] {
                 if cells[nt].n[g] != UNSET {
                     continue;
@@ -253,8 +251,11 @@ impl<K: Kernel> Builder<K> {
                         break;
                     }
                     // t2 is in conflict too: the face crossed is (a, b, w)
-                    // with w = cur.v[hc]; next cross t2's face opposite w.
+                    // with w = cur.v[hc]; next cross t2's face opposite w
+                    // (only `v[0]` of a conflict tet carries a flag; it is
+                    // never the infinite vertex, whose id has the top bit).
                     let w = cells[cur].v[hc];
+                    let w = if hc == 0 { w & !IN_CONFLICT } else { w };
                     let tv = cells[t2].v;
                     let kw = (tv[1] == w) as usize
                         + 2 * (tv[2] == w) as usize
@@ -267,10 +268,8 @@ impl<K: Kernel> Builder<K> {
         }
 
         // Free the cavity (dead cells are only marked DEAD at compaction:
-        // they are exactly the free list then).
-        for &c in &self.conflicts {
-            mark[c as usize] = 0;
-        }
+        // they are exactly the free list then; their flags do not matter,
+        // as a reused cell is overwritten whole).
         self.free.extend_from_slice(&self.conflicts);
         // Start the next walk from a new finite tet if there is one.
         let mut last = self.new_tets[0].0 >> 2;
@@ -399,7 +398,6 @@ fn run<K: Kernel>(
         filter: StaticFilter::for_points(points),
         pts: Vec::with_capacity(n),
         cells: Vec::with_capacity(expected_tets),
-        mark: Vec::with_capacity(expected_tets),
         free: Vec::new(),
         rng: SplitMix64::new(0xC0FFEE),
         conflicts: Vec::new(),
@@ -472,7 +470,6 @@ fn run<K: Kernel>(
     if b.overflow {
         return Err(DelaunayError::TooManyTets(n));
     }
-    drop(std::mem::take(&mut b.mark));
     Ok(compact(b, vert_input, input_vert))
 }
 
