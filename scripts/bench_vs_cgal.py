@@ -5,6 +5,7 @@ the ratios (ours / CGAL) of time and peak RSS as a Markdown table.
     python3 scripts/bench_vs_cgal.py                       # Delaunay, default sets
     python3 scripts/bench_vs_cgal.py --what alpha --sets uniform_100k uniform_1m
     python3 scripts/bench_vs_cgal.py --reps 5 --sets grid50
+    python3 scripts/bench_vs_cgal.py --what alpha --threads 1   # our side on one core
 
 Setup (once): CGAL from Debian (`apt-get install libcgal-dev libgmp-dev
 libmpfr-dev`), numpy (`pip install numpy`). The script copies the peer
@@ -59,23 +60,26 @@ def setup():
         "--example", "triangulate", "--example", "alpha_time"], cwd=ROOT)
 
 
-def timed(cmd):
+def timed(cmd, env=None):
     """Runs cmd under /usr/bin/time; returns (last JSON line of stdout, peak RSS MiB)."""
     p = subprocess.run(["/usr/bin/time", "-f", "RSS_KB %M"] + cmd,
-                       capture_output=True, text=True, check=True)
+                       capture_output=True, text=True, check=True, env=env)
     rss = next(int(l.split()[1]) for l in p.stderr.splitlines() if l.startswith("RSS_KB"))
     line = [l for l in p.stdout.splitlines() if l.startswith("{")][-1]
     return json.loads(line), rss / 1024.0
 
 
-def run_case(what, data, reps):
+def run_case(what, data, reps, threads=None):
     ours_bin = os.path.join(ROOT, "target", "release", "examples",
                             "triangulate" if what == "delaunay" else "alpha_time")
     cgal_bin = os.path.join(PEERS, "bin", "cgal_delaunay" if what == "delaunay" else "cgal_alpha")
     ours_t, cgal_t, ours_m, cgal_m = [], [], [], []
     info = {}
+    env = dict(os.environ)
+    if threads:
+        env["RAYON_NUM_THREADS"] = str(threads)
     for _ in range(reps):
-        o, om = timed([ours_bin, data])
+        o, om = timed([ours_bin, data], env)
         c, cm = timed([cgal_bin, data])
         if what == "delaunay":
             ours_t.append(o["time_s"])
@@ -97,15 +101,20 @@ def main():
     ap.add_argument("--what", choices=["delaunay", "alpha"], default="delaunay")
     ap.add_argument("--sets", nargs="+", default=["uniform_100k", "uniform_1m", "grid50"])
     ap.add_argument("--reps", type=int, default=3)
+    ap.add_argument("--threads", type=int, default=None,
+                    help="threads for our side (RAYON_NUM_THREADS; default: all cores). "
+                         "The triangulation is single-threaded either way; the alpha "
+                         "intervals use rayon. CGAL's programs are single-threaded.")
     args = ap.parse_args()
     setup()
     print(f"load average before: {open('/proc/loadavg').read().split()[:3]}")
+    print(f"our threads: {args.threads or 'all cores'} (of {os.cpu_count()})")
     print()
     print(f"| {args.what} | ours (s) | CGAL (s) | time ratio | ours RSS (MiB) | CGAL RSS (MiB) | RSS ratio | counts | all reps ours / CGAL (s) |")
     print("|---|---:|---:|---:|---:|---:|---:|---|---|")
     for s in args.sets:
         data = os.path.join(PEERS, "data", s + ".bin")
-        ot, ct, om, cm, ol, cl, info = run_case(args.what, data, args.reps)
+        ot, ct, om, cm, ol, cl, info = run_case(args.what, data, args.reps, args.threads)
         counts = ", ".join(f"{k} {v}" for k, v in info.items())
         reps = "; ".join(f"{a:.3f}/{b:.3f}" for a, b in zip(ol, cl))
         print(f"| {s} | {ot:.3f} | {ct:.3f} | {ot / ct:.2f} | {om:.0f} | {cm:.0f} | {om / cm:.2f} | {counts} | {reps} |")
