@@ -534,7 +534,7 @@ impl SceneOptions {
                 let c = crossing_anchor(self.kind, &rotated);
                 [anchor[0] - c[0], anchor[1] - c[1], anchor[2] - c[2]]
             } else {
-                let (lo, hi) = bounds(&rotated);
+                let (lo, hi) = crate::geometry::bounding_box(&rotated);
                 let mut o = [0.0; 3];
                 let mut fits = true;
                 for k in 0..3 {
@@ -685,18 +685,6 @@ fn centroid(p: &[[f64; 3]]) -> [f64; 3] {
     }
     let n = p.len().max(1) as f64;
     [c[0] / n, c[1] / n, c[2] / n]
-}
-
-fn bounds(p: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for q in p {
-        for k in 0..3 {
-            lo[k] = lo[k].min(q[k]);
-            hi[k] = hi[k].max(q[k]);
-        }
-    }
-    (lo, hi)
 }
 
 fn dist2(a: [f64; 3], b: [f64; 3]) -> f64 {

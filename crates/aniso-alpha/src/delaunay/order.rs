@@ -111,14 +111,7 @@ pub(crate) fn brio_order(points: &[[f64; 3]], seed: u64) -> Vec<u32> {
         let j = rng.below(i + 1);
         idx.swap(i, j);
     }
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for p in points {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
+    let (lo, hi) = crate::geometry::bounding_box(points);
     let max = ((1u64 << HILBERT_BITS) - 1) as f64;
     let mut scale = [0.0; 3];
     for k in 0..3 {

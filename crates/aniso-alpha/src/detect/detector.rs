@@ -404,14 +404,7 @@ impl<'a> Detector<'a> {
             // four far sentinels around it make the set 3-dimensional. They
             // are isolated (farther than 2α from everything), so F_α is
             // unchanged.
-            let mut lo = [f64::INFINITY; 3];
-            let mut hi = [f64::NEG_INFINITY; 3];
-            for p in &reduced {
-                for k in 0..3 {
-                    lo[k] = lo[k].min(p[k]);
-                    hi[k] = hi[k].max(p[k]);
-                }
-            }
+            let (lo, hi) = crate::geometry::bounding_box(&reduced);
             let ext = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max) + 4.0 * alpha + 1.0;
             let c = [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]));
             // Distance from any point of the box to a sentinel: at least

@@ -71,14 +71,7 @@ struct Grid {
 impl Grid {
     fn new(points: &[[f64; 3]], radius: f64) -> Grid {
         let n = points.len();
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        for p in points {
-            for k in 0..3 {
-                lo[k] = lo[k].min(p[k]);
-                hi[k] = hi[k].max(p[k]);
-            }
-        }
+        let (lo, hi) = crate::geometry::bounding_box(points);
         let mut side = radius.max(f64::MIN_POSITIVE);
         let cells_for = |side: f64| -> [usize; 3] {
             [0, 1, 2].map(|k| (((hi[k] - lo[k]) / side).floor() as usize).saturating_add(1))

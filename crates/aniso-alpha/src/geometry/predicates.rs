@@ -469,14 +469,7 @@ impl StaticFilter {
 
     /// The static bounds for a set of finite points.
     pub fn for_points(points: &[Point3]) -> StaticFilter {
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        for p in points {
-            for k in 0..3 {
-                lo[k] = lo[k].min(p[k]);
-                hi[k] = hi[k].max(p[k]);
-            }
-        }
+        let (lo, hi) = super::bounding_box(points);
         if points.is_empty() || !lo.iter().chain(&hi).all(|v| v.is_finite()) {
             return StaticFilter::NONE;
         }
