@@ -81,18 +81,21 @@ struct Builder<K: Kernel> {
     /// of its outer neighbour, and the conflict tet it replaces.
     new_tets: Vec<(u32, u32)>,
     last: u32,
-    /// Set when the tet count reached [`MAX_CELLS`]; the build then stops.
-    overflow: bool,
+    /// The most cells (live or free) the build may hold: [`MAX_CELLS`]
+    /// (lower in tests of the limit).
+    max_cells: usize,
 }
 
-/// Tet ids are packed with a 2-bit face index into a `u32`, so there can be
-/// at most 2^30 tetrahedra (about 150 million uniform points).
-const MAX_CELLS: usize = 1 << 30;
+/// The tet limit was reached during an insertion (the builder is then left
+/// inconsistent and must be dropped).
+#[derive(Debug)]
+struct TetLimit;
 
-/// Headroom kept below [`MAX_CELLS`] before each insertion, so that a
-/// single insertion can never overflow (a cavity with 2^24 boundary facets
-/// would be needed).
-const CELL_HEADROOM: usize = 1 << 24;
+/// Tet ids are packed with a 2-bit face index into a `u32`, so there can be
+/// at most 2^30 tetrahedra (about 150 million uniform points). An insertion
+/// that would need more stops the build with
+/// [`DelaunayError::TooManyTets`].
+const MAX_CELLS: usize = 1 << 30;
 
 /// Points gathered per chunk in insertion order.
 const GATHER: usize = 1024;
@@ -103,22 +106,21 @@ impl<K: Kernel> Builder<K> {
         &self.pts[v as usize]
     }
 
+    /// A free cell: a recycled one, or a new one unless that would pass
+    /// the tet limit.
     #[inline]
-    fn alloc(&mut self) -> u32 {
+    fn alloc(&mut self) -> Result<u32, TetLimit> {
         if let Some(t) = self.free.pop() {
-            t
-        } else if self.cells.len() >= MAX_CELLS - 1 {
-            // Unreachable with the headroom check in `run`; stay in bounds
-            // and let `run` report the overflow.
-            self.overflow = true;
-            0
+            Ok(t)
+        } else if self.cells.len() >= self.max_cells {
+            Err(TetLimit)
         } else {
             let t = self.cells.len() as u32;
             self.cells.push(Cell {
                 v: [DEAD; 4],
                 n: [UNSET; 4],
             });
-            t
+            Ok(t)
         }
     }
 
@@ -169,15 +171,15 @@ impl<K: Kernel> Builder<K> {
     }
 
     /// Inserts point `q` as vertex `vid`; returns the vertex it duplicates,
-    /// if any (then nothing changes).
+    /// if any (then nothing changes), or [`TetLimit`].
     #[inline(never)]
-    fn insert(&mut self, vid: u32) -> Option<u32> {
+    fn insert(&mut self, vid: u32) -> Result<Option<u32>, TetLimit> {
         let q = self.pts[vid as usize];
         let start = self.locate(&q);
         // A duplicate lies on a vertex of the located (finite) tet.
         for &w in &self.cells[start as usize].v {
             if w != INFINITE && self.pts[w as usize] == q {
-                return Some(w);
+                return Ok(Some(w));
             }
         }
 
@@ -209,7 +211,7 @@ impl<K: Kernel> Builder<K> {
                     continue;
                 }
                 self.cells[n].v[1] |= CLEAR;
-                let nt = self.alloc();
+                let nt = self.alloc()?;
                 let mut v = cell.v;
                 v[0] &= !IN_CONFLICT;
                 v[f] = vid;
@@ -280,7 +282,7 @@ impl<K: Kernel> Builder<K> {
             }
         }
         self.last = last;
-        None
+        Ok(None)
     }
 }
 
@@ -342,6 +344,15 @@ fn lower_dimensional(points: &[Point3], dim: usize) -> Triangulation {
 }
 
 pub(super) fn build(points: &[[f64; 3]]) -> Result<Triangulation, DelaunayError> {
+    build_with_max_cells(points, MAX_CELLS)
+}
+
+/// [`build`] with a given tet limit (at most [`MAX_CELLS`]; lower only to
+/// test the limit).
+fn build_with_max_cells(
+    points: &[[f64; 3]],
+    max_cells: usize,
+) -> Result<Triangulation, DelaunayError> {
     let n = points.len();
     if n == 0 {
         return Err(DelaunayError::Empty);
@@ -377,11 +388,11 @@ pub(super) fn build(points: &[[f64; 3]]) -> Result<Triangulation, DelaunayError>
 
     // Uniform points give about 6.8 tets per point; untouched capacity costs
     // address space, not resident memory.
-    let expected_tets = (7 * n + n / 2 + 64).min(MAX_CELLS);
+    let expected_tets = (7 * n + n / 2 + 64).min(max_cells);
     if SmallGrid::applies(points) {
-        run::<SmallGrid>(points, &order, init, expected_tets)
+        run::<SmallGrid>(points, &order, init, expected_tets, max_cells)
     } else {
-        run::<Filtered>(points, &order, init, expected_tets)
+        run::<Filtered>(points, &order, init, expected_tets, max_cells)
     }
 }
 
@@ -391,8 +402,10 @@ fn run<K: Kernel>(
     order: &[u32],
     init: [u32; 4],
     expected_tets: usize,
+    max_cells: usize,
 ) -> Result<Triangulation, DelaunayError> {
     let n = points.len();
+    let too_many = |_: TetLimit| DelaunayError::TooManyTets(n);
     let mut b = Builder::<K> {
         kernel: std::marker::PhantomData,
         filter: StaticFilter::for_points(points),
@@ -403,7 +416,7 @@ fn run<K: Kernel>(
         conflicts: Vec::new(),
         new_tets: Vec::new(),
         last: 0,
-        overflow: false,
+        max_cells: max_cells.min(MAX_CELLS),
     };
     let mut vert_input: Vec<u32> = Vec::with_capacity(n);
     let mut input_vert = vec![u32::MAX; n];
@@ -424,10 +437,10 @@ fn run<K: Kernel>(
         vert_input.push(i);
         input_vert[i as usize] = v as u32;
     }
-    let t0 = b.alloc();
+    let t0 = b.alloc().map_err(too_many)?;
     b.cells[t0 as usize].v = [0, 1, 2, 3];
     for i in 0..4 {
-        let ti = b.alloc();
+        let ti = b.alloc().map_err(too_many)?;
         // Face i of the first tet, reversed so that the infinite vertex (at
         // index 3, as in every infinite tet) is on its outer side.
         let f = FACE[i];
@@ -447,12 +460,9 @@ fn run<K: Kernel>(
             if init.contains(&i) {
                 continue; // one of the initial four
             }
-            if b.cells.len() + CELL_HEADROOM > MAX_CELLS || b.overflow {
-                return Err(DelaunayError::TooManyTets(n));
-            }
             let vid = b.pts.len() as u32;
             b.pts.push(*p);
-            match b.insert(vid) {
+            match b.insert(vid).map_err(too_many)? {
                 None => {
                     vert_input.push(i);
                     input_vert[i as usize] = vid;
@@ -466,9 +476,6 @@ fn run<K: Kernel>(
                 }
             }
         }
-    }
-    if b.overflow {
-        return Err(DelaunayError::TooManyTets(n));
     }
     Ok(compact(b, vert_input, input_vert))
 }
@@ -561,7 +568,32 @@ fn compact<K: Kernel>(b: Builder<K>, vert_input: Vec<u32>, input_vert: Vec<u32>)
 
 #[cfg(test)]
 mod tests {
-    use super::FACE;
+    use super::{build_with_max_cells, DelaunayError, FACE};
+
+    #[test]
+    fn tet_limit_is_a_typed_error() {
+        let mut s = 99u64;
+        let mut unif = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let pts: Vec<[f64; 3]> = (0..2000).map(|_| [unif(), unif(), unif()]).collect();
+        // About 13k finite tets plus the hull's: limits below that stop the
+        // build at the first tet too many, whether during the first five
+        // tets or in the middle of an insertion, without a panic.
+        for max in [0, 4, 5, 6, 100, 5000, 12_000] {
+            assert_eq!(
+                build_with_max_cells(&pts, max).err(),
+                Some(DelaunayError::TooManyTets(2000)),
+                "limit {max}"
+            );
+        }
+        let tri = build_with_max_cells(&pts, 1 << 20).unwrap();
+        tri.validate().unwrap();
+        assert_eq!(tri.num_vertices(), 2000);
+    }
 
     #[test]
     fn face_table_is_even() {
