@@ -47,8 +47,8 @@
 //! 5. each edge's `α_min` is its half length if Gabriel, else the minimum
 //!    over its triangles.
 //!
-//! With the `parallel` feature (default), steps 3 and 4 run on rayon's
-//! threads: cells are independent; triangles are computed in parallel per
+//! With the `parallel` feature (default), steps 1 and 3 overlap step 2,
+//! and steps 3 and 4 run on rayon's threads: cells are independent; triangles are computed in parallel per
 //! block of cells, and their edge updates (min, max and "refuted", which
 //! commute) are applied by threads that each own interleaved runs of edge
 //! ids. Ids, order and every bit of the result are the same for any
@@ -179,24 +179,34 @@ impl AlphaComplex {
                 tri_iv: Vec::new(),
             };
         }
-        let order = cells_by_min_vertex(&tri);
-        let (edges, edge_start) = number_edges(&tri);
+        // Steps 1 and 3 (order, then the cells) and step 2 (edges) are
+        // independent: with the `parallel` feature they overlap (the edge
+        // numbering is sequential and memory-bound).
+        let cells = || {
+            let order = cells_by_min_vertex(&tri);
+            // Per cell: its position in `order` and its Gabriel mask, packed
+            // (`pos << 4 | mask`), `u32::MAX` for infinite cells.
+            let mut posmask = vec![u32::MAX; tri.num_tets()];
+            for (k, &t) in order.iter().enumerate() {
+                posmask[t as usize] = (k as u32) << 4;
+            }
+            let mut cell_r = vec![f64::INFINITY; tri.num_tets()];
+            cell_pass(&tri, &mut cell_r, &mut posmask);
+            (order, posmask, cell_r)
+        };
+        #[cfg(feature = "parallel")]
+        let ((order, posmask, cell_r), (edges, edge_start)) =
+            rayon::join(cells, || number_edges(&tri));
+        #[cfg(not(feature = "parallel"))]
+        let ((order, posmask, cell_r), (edges, edge_start)) = (cells(), number_edges(&tri));
         let mut ac = AlphaComplex {
             tri,
-            cell_r: Vec::new(),
+            cell_r,
             edges,
             edge_start,
             tri_face: Vec::new(),
             tri_iv: Vec::new(),
         };
-        // Per cell: its position in `order` and its Gabriel mask, packed
-        // (`pos << 4 | mask`), `u32::MAX` for infinite cells.
-        let mut posmask = vec![u32::MAX; ac.tri.num_tets()];
-        for (k, &t) in order.iter().enumerate() {
-            posmask[t as usize] = (k as u32) << 4;
-        }
-        ac.cell_r = vec![f64::INFINITY; ac.tri.num_tets()];
-        cell_pass(&ac.tri, &mut ac.cell_r, &mut posmask);
         ac.compute_triangles_edges(&order, &posmask);
         ac
     }
