@@ -251,6 +251,13 @@ fn insphere_det(d: &[f64; 12]) -> f64 {
 /// ```
 #[inline(always)]
 pub fn orient3d(a: &Point3, b: &Point3, c: &Point3, d: &Point3) -> i32 {
+    orient3d_with(a, b, c, d, f64::INFINITY)
+}
+
+/// [`orient3d`], first trying a static bound on the error of the plain
+/// determinant (see [`StaticFilter`]; `+∞` skips that step).
+#[inline(always)]
+fn orient3d_with(a: &Point3, b: &Point3, c: &Point3, d: &Point3, static_bound: f64) -> i32 {
     // Shewchuk's orient3d(a, b, c, d) = det[a − d, b − d, c − d] = −det[b − a, c − a, d − a].
     let adx = a[0] - d[0];
     let bdx = b[0] - d[0];
@@ -265,6 +272,12 @@ pub fn orient3d(a: &Point3, b: &Point3, c: &Point3, d: &Point3) -> i32 {
     let det = adz * (bdx * cdy - cdx * bdy)
         + bdz * (cdx * ady - adx * cdy)
         + cdz * (adx * bdy - bdx * ady);
+    if det > static_bound {
+        return -1;
+    }
+    if -det > static_bound {
+        return 1;
+    }
     // Semi-static filter: Shewchuk's bound is O3D_ERRBOUND_A times the
     // permanent, and the permanent is at most 6·X·Y·Z where X, Y, Z bound
     // the absolute differences per axis. 4.7e-15 > 6·(7 + 56ε)ε with margin
@@ -293,6 +306,20 @@ pub fn orient3d(a: &Point3, b: &Point3, c: &Point3, d: &Point3) -> i32 {
 /// ```
 #[inline(always)]
 pub fn insphere(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> i32 {
+    insphere_with(a, b, c, d, e, f64::INFINITY)
+}
+
+/// [`insphere`], first trying a static bound on the error of the plain
+/// determinant (see [`StaticFilter`]; `+∞` skips that step).
+#[inline(always)]
+fn insphere_with(
+    a: &Point3,
+    b: &Point3,
+    c: &Point3,
+    d: &Point3,
+    e: &Point3,
+    static_bound: f64,
+) -> i32 {
     let aex = a[0] - e[0];
     let bex = b[0] - e[0];
     let cex = c[0] - e[0];
@@ -324,6 +351,14 @@ pub fn insphere(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> i
     let dlift = dex * dex + dey * dey + dez * dez;
 
     let det = (dlift * abc - clift * dab) + (blift * cda - alift * bcd);
+    // Shewchuk's insphere is positive for "inside" when (a, b, c, d) has *his*
+    // positive orientation, which is CGAL's negative one: negate.
+    if det > static_bound {
+        return -1;
+    }
+    if -det > static_bound {
+        return 1;
+    }
 
     // Semi-static filter: Shewchuk's bound is ISP_ERRBOUND_A times the
     // permanent, and the permanent is at most 72·M²·X·Y·Z where X, Y, Z
@@ -335,8 +370,6 @@ pub fn insphere(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> i
     let mz = fmax(fmax(aez.abs(), bez.abs()), fmax(cez.abs(), dez.abs()));
     let m = fmax(fmax(mx, my), mz);
     let eps = 1.28e-13 * (mx * my * mz) * (m * m);
-    // Shewchuk's insphere is positive for "inside" when (a, b, c, d) has *his*
-    // positive orientation, which is CGAL's negative one: negate.
     if (det > eps || -det > eps) && eps < f64::MAX && eps > f64::MIN_POSITIVE {
         return -sign(det);
     }
@@ -498,14 +531,7 @@ impl Kernel for Filtered {
         d: &Point3,
         filter: &StaticFilter,
     ) -> i32 {
-        let det = orient_det(&diffs3(a, b, c, d));
-        if det > filter.orient {
-            -1
-        } else if -det > filter.orient {
-            1
-        } else {
-            orient3d(a, b, c, d)
-        }
+        orient3d_with(a, b, c, d, filter.orient)
     }
     #[inline(always)]
     fn insphere_static(
@@ -516,14 +542,7 @@ impl Kernel for Filtered {
         e: &Point3,
         filter: &StaticFilter,
     ) -> i32 {
-        let det = insphere_det(&diffs4(a, b, c, d, e));
-        if det > filter.insphere {
-            -1
-        } else if -det > filter.insphere {
-            1
-        } else {
-            insphere(a, b, c, d, e)
-        }
+        insphere_with(a, b, c, d, e, filter.insphere)
     }
 }
 
