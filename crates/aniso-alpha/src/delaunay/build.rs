@@ -380,7 +380,9 @@ fn build_with_max_cells(
         }
     }
     // (-0.0 == 0.0 for every comparison below, so signed zeros are one point.)
-    let order = brio_order(points, 0x5EED_0A11_A1FA_u64);
+    // The bounding box orders the points and gives the static filter.
+    let bbox = crate::geometry::bounding_box(points);
+    let order = brio_order(points, &bbox, 0x5EED_0A11_A1FA_u64);
     let init = match initial_simplex(points, &order) {
         Ok(s) => s,
         Err(dim) => return Ok(lower_dimensional(points, dim)),
@@ -389,10 +391,11 @@ fn build_with_max_cells(
     // Uniform points give about 6.8 tets per point; untouched capacity costs
     // address space, not resident memory.
     let expected_tets = (7 * n + n / 2 + 64).min(max_cells);
+    let filter = StaticFilter::for_box(&bbox.0, &bbox.1);
     if SmallGrid::applies(points) {
-        run::<SmallGrid>(points, &order, init, expected_tets, max_cells)
+        run::<SmallGrid>(points, &order, init, expected_tets, max_cells, filter)
     } else {
-        run::<Filtered>(points, &order, init, expected_tets, max_cells)
+        run::<Filtered>(points, &order, init, expected_tets, max_cells, filter)
     }
 }
 
@@ -403,12 +406,13 @@ fn run<K: Kernel>(
     init: [u32; 4],
     expected_tets: usize,
     max_cells: usize,
+    filter: StaticFilter,
 ) -> Result<Triangulation, DelaunayError> {
     let n = points.len();
     let too_many = |_: TetLimit| DelaunayError::TooManyTets(n);
     let mut b = Builder::<K> {
         kernel: std::marker::PhantomData,
-        filter: StaticFilter::for_points(points),
+        filter,
         pts: Vec::with_capacity(n),
         cells: Vec::with_capacity(expected_tets),
         free: Vec::new(),
