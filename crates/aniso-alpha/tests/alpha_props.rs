@@ -11,7 +11,9 @@
 //! * The oriented α-shape surface is closed: every directed edge of a
 //!   regular triangle is matched by the opposite directed edge.
 
+mod common;
 use aniso_alpha::alpha::{q_matrix, AlphaComplex};
+use common::Rng;
 use proptest::prelude::*;
 use std::collections::HashMap;
 
@@ -108,14 +110,10 @@ proptest! {
 /// and several edge runs per thread.
 #[test]
 fn intervals_do_not_depend_on_thread_count() {
-    let mut s = 0x5151_u64;
-    let mut unif = || {
-        s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (s >> 11) as f64 / (1u64 << 53) as f64
-    };
-    let mut pts: Vec<[f64; 3]> = (0..60_000).map(|_| [unif(), unif(), unif()]).collect();
+    let mut r = Rng(0x5151);
+    let mut pts: Vec<[f64; 3]> = (0..60_000)
+        .map(|_| [r.uniform(), r.uniform(), r.uniform()])
+        .collect();
     // And a degenerate part: an integer grid (many equal radii, ties).
     for i in 0..20 {
         for j in 0..20 {

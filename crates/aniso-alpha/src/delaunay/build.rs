@@ -572,17 +572,12 @@ fn compact<K: Kernel>(b: Builder<K>, vert_input: Vec<u32>, input_vert: Vec<u32>)
 
 #[cfg(test)]
 mod tests {
-    use super::{build_with_max_cells, DelaunayError, FACE};
+    use super::{build_with_max_cells, DelaunayError, SplitMix64, FACE};
 
     #[test]
     fn tet_limit_is_a_typed_error() {
-        let mut s = 99u64;
-        let mut unif = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = SplitMix64::new(99);
+        let mut unif = || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
         let pts: Vec<[f64; 3]> = (0..2000).map(|_| [unif(), unif(), unif()]).collect();
         // About 13k finite tets plus the hull's: limits below that stop the
         // build at the first tet too many, whether during the first five
