@@ -274,6 +274,22 @@ pub fn read_las_bytes(
 }
 
 /// Fails with [`IoError::NoPoints`] on an empty cloud.
+/// The next `\n`-terminated line of a binary file's text header, starting
+/// at `*pos` (without its `\n`; the last line may lack one), advancing
+/// `*pos` past it; `None` at the end of `bytes`.
+pub(crate) fn next_header_line<'a>(bytes: &'a [u8], pos: &mut usize) -> Option<&'a [u8]> {
+    if *pos >= bytes.len() {
+        return None;
+    }
+    let end = bytes[*pos..]
+        .iter()
+        .position(|&b| b == b'\n')
+        .map_or(bytes.len(), |k| *pos + k);
+    let raw = &bytes[*pos..end];
+    *pos = (end + 1).min(bytes.len());
+    Some(raw)
+}
+
 pub(crate) fn non_empty(path: &Path, cloud: PointCloud) -> Result<PointCloud, IoError> {
     if cloud.points.is_empty() {
         Err(IoError::NoPoints {

@@ -60,15 +60,9 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header, IoError> {
     let mut pos = 0usize;
     let mut line = 0usize;
     let data = loop {
-        if pos >= bytes.len() {
+        let Some(raw) = super::next_header_line(bytes, &mut pos) else {
             return Err(IoError::format(path, "PCD header has no DATA line"));
-        }
-        let end = bytes[pos..]
-            .iter()
-            .position(|&b| b == b'\n')
-            .map_or(bytes.len(), |k| pos + k);
-        let raw = &bytes[pos..end];
-        pos = (end + 1).min(bytes.len());
+        };
         line += 1;
         let bad = |msg: String| IoError::parse(path, line, msg);
         let text = std::str::from_utf8(raw)

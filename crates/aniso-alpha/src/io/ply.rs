@@ -123,15 +123,9 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header, IoError> {
     let mut pos = 0usize;
     let mut line = 0usize;
     loop {
-        if pos >= bytes.len() {
+        let Some(raw) = super::next_header_line(bytes, &mut pos) else {
             return Err(IoError::format(path, "PLY header has no 'end_header' line"));
-        }
-        let end = bytes[pos..]
-            .iter()
-            .position(|&b| b == b'\n')
-            .map_or(bytes.len(), |k| pos + k);
-        let raw = &bytes[pos..end];
-        pos = (end + 1).min(bytes.len());
+        };
         line += 1;
         if line == 1 {
             continue; // "ply"
