@@ -781,6 +781,15 @@ pub fn coplanar_incircle_perturbed(p0: &Point3, p1: &Point3, p2: &Point3, p: &Po
 mod tests {
     use super::*;
 
+    /// One step of Knuth's MMIX linear congruential generator (the tests'
+    /// deterministic source of coordinates).
+    fn lcg(s: &mut u64) -> u64 {
+        *s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        *s
+    }
+
     fn det3(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
         a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
             + a[2] * (b[0] * c[1] - b[1] * c[0])
@@ -790,12 +799,7 @@ mod tests {
     fn orient_matches_naive_on_small_integers() {
         // Small integers: the naive determinant is exact.
         let mut s = 12345u64;
-        let mut next = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((s >> 33) % 7) as f64 - 3.0
-        };
+        let mut next = || ((lcg(&mut s) >> 33) % 7) as f64 - 3.0;
         for _ in 0..5000 {
             let p: Vec<[f64; 3]> = (0..5).map(|_| [next(), next(), next()]).collect();
             let sub = |u: [f64; 3], v: [f64; 3]| [u[0] - v[0], u[1] - v[1], u[2] - v[2]];
@@ -835,12 +839,7 @@ mod tests {
     #[test]
     fn integer_stage_agrees_with_robust() {
         let mut s = 99u64;
-        let mut next = |range: u64| {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 33) % range
-        };
+        let mut next = |range: u64| (lcg(&mut s) >> 33) % range;
         let mut used = 0;
         for round in 0..20000 {
             // Dyadic grids of various scales and offsets, some near the
@@ -943,12 +942,7 @@ mod tests {
     #[test]
     fn small_grid_kernel_agrees_with_filtered() {
         let mut s = 5u64;
-        let mut next = |m: u64| {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 33) % m
-        };
+        let mut next = |m: u64| (lcg(&mut s) >> 33) % m;
         for round in 0..20000 {
             let step = [1.0, 0.25, 8.0][round % 3];
             let offset = [0.0, 1024.0, -3.0 * 1024.0 * 1024.0][round % 3];
@@ -981,12 +975,7 @@ mod tests {
         // answer must be the exact one. The plain determinant gets many of
         // these wrong (counted), so a bound that is too small fails here.
         let mut s = 77u64;
-        let mut unif = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut unif = || (lcg(&mut s) >> 11) as f64 / (1u64 << 53) as f64;
         let mut plain_wrong = 0;
         for (scale, offset) in [
             (1.0, 0.0),
