@@ -37,6 +37,35 @@ pub(crate) const FACE: [[usize; 3]; 4] = [[1, 3, 2], [0, 2, 3], [0, 3, 1], [0, 1
 /// For each face index, the other three.
 const OTHER: [[usize; 3]; 4] = [[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]];
 
+/// For each face index `f`, each other index `g` with the two indices that
+/// are neither: the edge shared by faces `f` and `g`.
+const EDGE_OF: [[(usize, [usize; 2]); 3]; 4] = [
+    [(1, [2, 3]), (2, [1, 3]), (3, [1, 2])],
+    [(0, [2, 3]), (2, [0, 3]), (3, [0, 2])],
+    [(0, [1, 3]), (1, [0, 3]), (3, [0, 1])],
+    [(0, [1, 2]), (1, [0, 2]), (2, [0, 1])],
+];
+
+/// Cavities with more boundary vertices than this are linked by rotation
+/// (a power of two; their pair table would pass 4k slots).
+const MAX_LOCAL: usize = 64;
+/// Pairs of local numbers (at least MAX_LOCAL·(MAX_LOCAL−1)/2, a power of two).
+const PAIRS: usize = 2048;
+/// New tets whose faces can be filed (at least 2·MAX_LOCAL − 4, the facets
+/// of a boundary with MAX_LOCAL vertices; a power of two).
+const FACES: usize = 128;
+
+/// Scratch of the table linking of new tets: the boundary vertices with a
+/// local number; per pair of local numbers, how many of its two faces are
+/// filed and the faces; per new tet, the partner slots of its inner faces.
+struct PairTable {
+    nloc: usize,
+    bverts: [u32; MAX_LOCAL],
+    fill: [u8; PAIRS],
+    slots: [u32; 2 * PAIRS],
+    faces: [[u32; 3]; FACES],
+}
+
 #[inline(always)]
 fn pack(t: u32, i: usize) -> u32 {
     (t << 2) | i as u32
@@ -80,6 +109,16 @@ struct Builder<K: Kernel> {
     /// New tets of the current insertion: each packed with the face index
     /// of its outer neighbour, and the conflict tet it replaces.
     new_tets: Vec<(u32, u32)>,
+    /// Local number of each vertex on the current cavity's boundary
+    /// ([`UNSET`] otherwise); the last slot stands for the infinite vertex.
+    loc: Vec<u32>,
+    /// Scratch of [`Builder::link_by_table`].
+    table: Box<PairTable>,
+    /// Cavities with more boundary vertices are linked by rotation.
+    max_local: usize,
+    /// Whether the current insertion's new tets are being filed in
+    /// `table` (until the cavity proves too large for it).
+    filing: bool,
     last: u32,
     /// The most cells (live or free) the build may hold: [`MAX_CELLS`]
     /// (lower in tests of the limit).
@@ -212,29 +251,151 @@ impl<K: Kernel> Builder<K> {
                 }
                 self.cells[n].v[1] |= CLEAR;
                 let nt = self.alloc()?;
+                // Written in place: building the cell on the stack with
+                // `v[f] = vid` and copying it whole stalls store forwarding.
+                let new = &mut self.cells[nt as usize];
                 let mut v = cell.v;
                 v[0] &= !IN_CONFLICT;
-                v[f] = vid;
-                let mut nn = [UNSET; 4];
-                nn[f] = outer;
-                self.cells[nt as usize] = Cell { v, n: nn };
+                new.v = v;
+                new.v[f] = vid;
+                new.n = [UNSET; 4];
+                new.n[f] = outer;
                 self.cells[n].n[(outer & 3) as usize] = pack(nt, f);
                 self.cells[c as usize].n[f] = pack(nt, f);
+                if self.filing {
+                    self.file_faces(nt, f, &v);
+                }
                 self.new_tets.push((pack(nt, f), c));
             }
         }
 
+        if self.filing {
+            self.link_filed();
+        } else {
+            self.unfile();
+            // The outer tets were marked CLEAR; reset them.
+            for &(packed, _) in &self.new_tets {
+                let (nt, f) = ((packed >> 2) as usize, (packed & 3) as usize);
+                let outer = (self.cells[nt].n[f] >> 2) as usize;
+                self.cells[outer].v[1] &= !CLEAR;
+            }
+            self.link_by_rotation(vid);
+        }
+        self.filing = self.max_local > 0;
+
+        // Free the cavity (dead cells are only marked DEAD at compaction:
+        // they are exactly the free list then; their flags do not matter,
+        // as a reused cell is overwritten whole).
+        self.free.extend_from_slice(&self.conflicts);
+        let cells = &self.cells[..];
+        // Start the next walk from a new finite tet if there is one.
+        let mut last = self.new_tets[0].0 >> 2;
+        for &(p, _) in self.new_tets.iter().rev() {
+            if cells[(p >> 2) as usize].v[3] != INFINITE {
+                last = p >> 2;
+                break;
+            }
+        }
+        self.last = last;
+        Ok(None)
+    }
+    /// Files the three inner faces of new tet `nt` (built on facet `f` of
+    /// a conflict tet whose vertices, flags cleared, are `v`) in the pair
+    /// table; on a cavity too large for it, stops filing for this
+    /// insertion.
+    ///
+    /// Every face of a new tet other than its outer one holds `q` and an
+    /// edge (a, b) of the cavity boundary, a closed triangulated sphere,
+    /// so each edge is on exactly two such faces, which are then
+    /// neighbours. The boundary vertices get local numbers 0..K (the
+    /// infinite vertex too, at slot `loc.len() - 1`); each face is filed
+    /// in one of the two slots of its edge's pair and later reads its
+    /// partner from the other ([`Builder::link_filed`]). Unlike a rotation
+    /// around the edge, the lookups are independent of each other, so
+    /// their latencies overlap, and the vertices are already loaded.
+    #[inline(always)]
+    fn file_faces(&mut self, nt: u32, f: usize, v: &[u32; 4]) {
+        let i = self.new_tets.len();
+        let t = &mut *self.table;
+        if i >= FACES || t.nloc + 3 > self.max_local {
+            self.filing = false;
+            return;
+        }
+        let top = self.loc.len() - 1;
+        let mut lv = [0usize; 4];
+        for h in OTHER[f] {
+            let w = (v[h] as usize).min(top);
+            let mut l = self.loc[w];
+            if l == UNSET {
+                l = t.nloc as u32;
+                self.loc[w] = l;
+                // (The masks are no-ops that drop bounds checks.)
+                t.bverts[t.nloc & (MAX_LOCAL - 1)] = w as u32;
+                t.nloc += 1;
+            }
+            lv[h] = l as usize;
+        }
+        for (j, &(g, [h1, h2])) in EDGE_OF[f].iter().enumerate() {
+            let (a, b) = (lv[h1], lv[h2]);
+            let (lo, hi) = (a.min(b), a.max(b));
+            let pair = (hi * hi.wrapping_sub(1) / 2 + lo) & (PAIRS - 1);
+            let fill = t.fill[pair] as usize;
+            t.fill[pair] = fill as u8 + 1;
+            t.slots[(2 * pair + fill) & (2 * PAIRS - 1)] = pack(nt, g);
+            t.faces[i & (FACES - 1)][j] = (2 * pair + 1 - fill) as u32;
+        }
+    }
+
+    /// Links the new tets, all filed by [`Builder::file_faces`], to each
+    /// other, resets the CLEAR flags of their outer tets and empties the
+    /// table.
+    fn link_filed(&mut self) {
+        let t = &mut *self.table;
+        let cells = &mut self.cells[..];
+        for (i, &(packed, _)) in self.new_tets.iter().enumerate() {
+            let (nt, f) = ((packed >> 2) as usize, (packed & 3) as usize);
+            let fc = t.faces[i & (FACES - 1)];
+            let cn = &mut cells[nt].n;
+            let outer = (cn[f] >> 2) as usize;
+            for (j, &(g, _)) in EDGE_OF[f].iter().enumerate() {
+                let other = fc[j] as usize & (2 * PAIRS - 1);
+                cn[g] = t.slots[other];
+                t.fill[other >> 1] = 0;
+            }
+            cells[outer].v[1] &= !CLEAR;
+        }
+        for &w in &t.bverts[..t.nloc] {
+            self.loc[w as usize] = UNSET;
+        }
+        t.nloc = 0;
+    }
+
+    /// Empties the table after filing stopped part way.
+    fn unfile(&mut self) {
+        let t = &mut *self.table;
+        for fc in &t.faces[..self.new_tets.len().min(FACES)] {
+            for &other in fc {
+                t.fill[(other as usize >> 1) & (PAIRS - 1)] = 0;
+            }
+        }
+        for &w in &t.bverts[..t.nloc] {
+            self.loc[w as usize] = UNSET;
+        }
+        t.nloc = 0;
+    }
+
+    /// Links the new tets of an insertion to each other by turning around
+    /// the cavity's boundary edges (any cavity size).
+    fn link_by_rotation(&mut self, vid: u32) {
+        let cells = &mut self.cells[..];
         // Link the new tets to each other. The face of new tet nt (built
         // on facet f of conflict tet c) opposite g != f holds q and an edge
         // (a, b) of the cavity boundary. Its neighbour is the new tet of
         // the next boundary facet met when turning around (a, b) from c
         // across its face g, through conflict tets only: every cell
         // visited is part of this insertion and already in cache.
-        let cells = &mut self.cells[..];
         for &(packed, c) in &self.new_tets {
             let (nt, f) = ((packed >> 2) as usize, (packed & 3) as usize);
-            // The outer tet was marked CLEAR; reset it.
-            cells[(cells[nt].n[f] >> 2) as usize].v[1] &= !CLEAR;
             for g in OTHER[f] {
                 if cells[nt].n[g] != UNSET {
                     continue;
@@ -268,21 +429,6 @@ impl<K: Kernel> Builder<K> {
                 }
             }
         }
-
-        // Free the cavity (dead cells are only marked DEAD at compaction:
-        // they are exactly the free list then; their flags do not matter,
-        // as a reused cell is overwritten whole).
-        self.free.extend_from_slice(&self.conflicts);
-        // Start the next walk from a new finite tet if there is one.
-        let mut last = self.new_tets[0].0 >> 2;
-        for &(p, _) in self.new_tets.iter().rev() {
-            if cells[(p >> 2) as usize].v[3] != INFINITE {
-                last = p >> 2;
-                break;
-            }
-        }
-        self.last = last;
-        Ok(None)
     }
 }
 
@@ -344,15 +490,27 @@ fn lower_dimensional(points: &[Point3], dim: usize) -> Triangulation {
 }
 
 pub(super) fn build(points: &[[f64; 3]]) -> Result<Triangulation, DelaunayError> {
-    build_with_max_cells(points, MAX_CELLS)
+    build_with(points, Limits::DEFAULT)
 }
 
-/// [`build`] with a given tet limit (at most [`MAX_CELLS`]; lower only to
-/// test the limit).
-fn build_with_max_cells(
-    points: &[[f64; 3]],
+/// Build limits that tests lower to reach rare paths.
+#[derive(Clone, Copy, Debug)]
+struct Limits {
+    /// The most cells the build may hold (at most [`MAX_CELLS`]).
     max_cells: usize,
-) -> Result<Triangulation, DelaunayError> {
+    /// The largest cavity (in boundary vertices) linked by table.
+    max_local: usize,
+}
+
+impl Limits {
+    const DEFAULT: Limits = Limits {
+        max_cells: MAX_CELLS,
+        max_local: MAX_LOCAL,
+    };
+}
+
+/// [`build`] with given limits (lower than the defaults only in tests).
+fn build_with(points: &[[f64; 3]], limits: Limits) -> Result<Triangulation, DelaunayError> {
     let n = points.len();
     if n == 0 {
         return Err(DelaunayError::Empty);
@@ -390,12 +548,12 @@ fn build_with_max_cells(
 
     // Uniform points give about 6.8 tets per point; untouched capacity costs
     // address space, not resident memory.
-    let expected_tets = (7 * n + n / 2 + 64).min(max_cells);
+    let expected_tets = (7 * n + n / 2 + 64).min(limits.max_cells);
     let filter = StaticFilter::for_box(&bbox.0, &bbox.1);
     if SmallGrid::applies(points) {
-        run::<SmallGrid>(points, &order, init, expected_tets, max_cells, filter)
+        run::<SmallGrid>(points, &order, init, expected_tets, limits, filter)
     } else {
-        run::<Filtered>(points, &order, init, expected_tets, max_cells, filter)
+        run::<Filtered>(points, &order, init, expected_tets, limits, filter)
     }
 }
 
@@ -405,7 +563,7 @@ fn run<K: Kernel>(
     order: &[u32],
     init: [u32; 4],
     expected_tets: usize,
-    max_cells: usize,
+    limits: Limits,
     filter: StaticFilter,
 ) -> Result<Triangulation, DelaunayError> {
     let n = points.len();
@@ -419,8 +577,18 @@ fn run<K: Kernel>(
         rng: SplitMix64::new(0xC0FFEE),
         conflicts: Vec::new(),
         new_tets: Vec::new(),
+        loc: vec![UNSET; n + 1],
+        table: Box::new(PairTable {
+            nloc: 0,
+            bverts: [0; MAX_LOCAL],
+            fill: [0; PAIRS],
+            slots: [0; 2 * PAIRS],
+            faces: [[0; 3]; FACES],
+        }),
+        max_local: limits.max_local,
+        filing: limits.max_local > 0,
         last: 0,
-        max_cells: max_cells.min(MAX_CELLS),
+        max_cells: limits.max_cells.min(MAX_CELLS),
     };
     let mut vert_input: Vec<u32> = Vec::with_capacity(n);
     let mut input_vert = vec![u32::MAX; n];
@@ -572,7 +740,7 @@ fn compact<K: Kernel>(b: Builder<K>, vert_input: Vec<u32>, input_vert: Vec<u32>)
 
 #[cfg(test)]
 mod tests {
-    use super::{build_with_max_cells, DelaunayError, SplitMix64, FACE};
+    use super::{build_with, DelaunayError, Limits, SplitMix64, FACE};
 
     #[test]
     fn tet_limit_is_a_typed_error() {
@@ -584,14 +752,78 @@ mod tests {
         // tets or in the middle of an insertion, without a panic.
         for max in [0, 4, 5, 6, 100, 5000, 12_000] {
             assert_eq!(
-                build_with_max_cells(&pts, max).err(),
+                build_with(
+                    &pts,
+                    Limits {
+                        max_cells: max,
+                        ..Limits::DEFAULT
+                    }
+                )
+                .err(),
                 Some(DelaunayError::TooManyTets(2000)),
                 "limit {max}"
             );
         }
-        let tri = build_with_max_cells(&pts, 1 << 20).unwrap();
+        let tri = build_with(
+            &pts,
+            Limits {
+                max_cells: 1 << 20,
+                ..Limits::DEFAULT
+            },
+        )
+        .unwrap();
         tri.validate().unwrap();
         assert_eq!(tri.num_vertices(), 2000);
+    }
+
+    /// The pair table and the rotation link the new tets identically, also
+    /// when a cavity outgrows the table part way through an insertion
+    /// (small `max_local`) and on cospherical points, where inserting the
+    /// centre late makes one cavity of every tet.
+    #[test]
+    fn table_and_rotation_linking_agree() {
+        let mut rng = SplitMix64::new(7);
+        let mut unif = || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+        let uniform: Vec<[f64; 3]> = (0..3000).map(|_| [unif(), unif(), unif()]).collect();
+        let grid: Vec<[f64; 3]> = (0..512)
+            .map(|i| [(i % 8) as f64, (i / 8 % 8) as f64, (i / 64) as f64])
+            .collect();
+        // The 672 integer points with x² + y² + z² = 1154, and the centre.
+        let mut sphere = vec![[0.0; 3]];
+        for x in -34i32..=34 {
+            for y in -34i32..=34 {
+                for z in -34i32..=34 {
+                    if x * x + y * y + z * z == 1154 {
+                        sphere.push([x as f64, y as f64, z as f64]);
+                    }
+                }
+            }
+        }
+        assert_eq!(sphere.len(), 673);
+        for pts in [&uniform, &grid, &sphere] {
+            let tets = |max_local| {
+                let limits = Limits {
+                    max_local,
+                    ..Limits::DEFAULT
+                };
+                let tri = build_with(pts, limits).unwrap();
+                tri.validate().unwrap();
+                let mut t: Vec<[u32; 4]> = tri
+                    .finite_tets_input()
+                    .map(|mut t| {
+                        t.sort_unstable();
+                        t
+                    })
+                    .collect();
+                t.sort_unstable();
+                t
+            };
+            let reference = tets(0);
+            assert!(reference.len() > pts.len());
+            for max_local in [5, 12, 30, Limits::DEFAULT.max_local] {
+                assert!(tets(max_local) == reference, "max_local {max_local}");
+            }
+        }
     }
 
     #[test]
