@@ -73,23 +73,22 @@ fn hilbert_key(mut x: [u32; 3], bits: u32) -> u64 {
     key
 }
 
-/// Sorts `idx` in place along a Hilbert curve of the bounding box `[lo, hi]`.
-fn hilbert_sort(points: &[[f64; 3]], idx: &mut [u32], lo: [f64; 3], scale: [f64; 3]) {
-    // About 8 grid cells per point are enough to order a round.
-    let n = idx.len().max(2) as f64;
-    let bits = ((n.log2() / 3.0).ceil() as u32 + 1).clamp(2, HILBERT_BITS);
-    let shift = HILBERT_BITS - bits;
-    let max = ((1u64 << HILBERT_BITS) - 1) as f64;
+/// Grid resolution (bits per axis) that orders a round of `n` points:
+/// about 8 grid cells per point.
+fn round_bits(n: usize) -> u32 {
+    let n = n.max(2) as f64;
+    ((n.log2() / 3.0).ceil() as u32 + 1).clamp(2, HILBERT_BITS)
+}
+
+/// Sorts `idx` in place by the Hilbert keys `keys` (of `bits` per axis)
+/// cut to `round_bits(idx.len())` bits per axis: a Hilbert index's leading
+/// 3b bits are the index of its cell on the grid of b bits per axis, so
+/// one key per point, computed once, serves every round.
+fn hilbert_sort(keys: &[u64], bits: u32, idx: &mut [u32]) {
+    let shift = 3 * (bits - round_bits(idx.len()).min(bits));
     let mut keyed: Vec<(u64, u32)> = idx
         .iter()
-        .map(|&i| {
-            let p = &points[i as usize];
-            let mut q = [0u32; 3];
-            for k in 0..3 {
-                q[k] = ((p[k] - lo[k]) * scale[k]).clamp(0.0, max) as u32;
-            }
-            (hilbert_key(q.map(|c| c >> shift), bits), i)
-        })
+        .map(|&i| (keys[i as usize] >> shift, i))
         .collect();
     keyed.sort_unstable();
     for (slot, (_, i)) in idx.iter_mut().zip(keyed) {
@@ -133,8 +132,22 @@ pub(crate) fn brio_order(points: &[[f64; 3]], bbox: &([f64; 3], [f64; 3]), seed:
         end = start;
     }
     bounds.push((0, end));
+    // One key per point, in input order (no random reads), at the
+    // resolution of the largest round.
+    let bits = round_bits(bounds[0].1 - bounds[0].0);
+    let shift = HILBERT_BITS - bits;
+    let keys: Vec<u64> = points
+        .iter()
+        .map(|p| {
+            let mut q = [0u32; 3];
+            for k in 0..3 {
+                q[k] = ((p[k] - lo[k]) * scale[k]).clamp(0.0, max) as u32 >> shift;
+            }
+            hilbert_key(q, bits)
+        })
+        .collect();
     for (s, e) in bounds {
-        hilbert_sort(points, &mut idx[s..e], lo, scale);
+        hilbert_sort(&keys, bits, &mut idx[s..e]);
     }
     idx
 }
@@ -163,6 +176,30 @@ mod tests {
         // (keys 0..511) and consecutive cells are face neighbours.
         assert_eq!(cells.last().unwrap().0, 511);
         for w in cells.windows(2) {
+            let d: u32 = (0..3).map(|k| w[0].1[k].abs_diff(w[1].1[k])).sum();
+            assert_eq!(d, 1, "{:?} -> {:?}", w[0], w[1]);
+        }
+    }
+
+    /// The rounds sort by cut keys: on a 16³ grid (4 bits), the keys cut
+    /// to 3 bits are constant on each 2×2×2 block and visit the blocks
+    /// along a continuous curve.
+    #[test]
+    fn cut_hilbert_keys_order_the_coarse_grid() {
+        let mut blocks: Vec<(u64, [u32; 3])> = Vec::new();
+        for x in 0..16u32 {
+            for y in 0..16u32 {
+                for z in 0..16u32 {
+                    let cut = hilbert_key([x, y, z], 4) >> 3;
+                    blocks.push((cut, [x >> 1, y >> 1, z >> 1]));
+                }
+            }
+        }
+        blocks.sort();
+        blocks.dedup();
+        assert_eq!(blocks.len(), 512, "a cut key spans two blocks");
+        for w in blocks.windows(2) {
+            assert_eq!(w[1].0, w[0].0 + 1);
             let d: u32 = (0..3).map(|k| w[0].1[k].abs_diff(w[1].1[k])).sum();
             assert_eq!(d, 1, "{:?} -> {:?}", w[0], w[1]);
         }
