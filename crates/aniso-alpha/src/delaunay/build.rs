@@ -237,6 +237,10 @@ impl<K: Kernel> Builder<K> {
             let c = self.conflicts[k];
             k += 1;
             let cell = self.cells[c as usize];
+            // The vertices without the conflict flag (cleared in a
+            // register: a byte-wide clear in memory followed by a wide
+            // copy stalls store forwarding).
+            let v = [cell.v[0] & !IN_CONFLICT, cell.v[1], cell.v[2], cell.v[3]];
             for f in 0..4 {
                 let outer = cell.n[f];
                 let n = (outer >> 2) as usize;
@@ -254,8 +258,6 @@ impl<K: Kernel> Builder<K> {
                 // Written in place: building the cell on the stack with
                 // `v[f] = vid` and copying it whole stalls store forwarding.
                 let new = &mut self.cells[nt as usize];
-                let mut v = cell.v;
-                v[0] &= !IN_CONFLICT;
                 new.v = v;
                 new.v[f] = vid;
                 new.n = [UNSET; 4];
