@@ -48,11 +48,11 @@
 //!    over its triangles.
 //!
 //! With the `parallel` feature (default), steps 1 and 3 overlap step 2,
-//! and steps 3 and 4 run on rayon's threads: cells are independent; triangles are computed in parallel per
-//! block of cells, and their edge updates (min, max and "refuted", which
-//! commute) are applied by threads that each own interleaved runs of edge
-//! ids. Ids, order and every bit of the result are the same for any
-//! number of threads (tested).
+//! and steps 3 and 4 run on rayon's threads: cells are independent;
+//! triangles are computed in parallel per block of cells, and one thread
+//! applies a block's edge updates, in order, while the others compute the
+//! next block's triangles. Ids, order and every bit of the result are the
+//! same for any number of threads (tested).
 //!
 //! Memory: the complex adds about 8 bytes per cell, 20 per triangle and 24
 //! per edge to the triangulation (≈ 0.5 GB for 1M uniform points), plus
@@ -148,10 +148,11 @@ pub struct AlphaComplex {
     tri: Triangulation,
     /// Cell id -> circumradius (`+∞` for infinite cells).
     cell_r: Vec<f64>,
-    /// Edge id -> vertex ids `(a, b)`, `a < b`, grouped by `a`, and
-    /// `[α_min, α_max]` (one record, so that a lookup and an update touch
-    /// the same cache line).
-    edges: Vec<EdgeRec>,
+    /// Edge id -> vertex ids `(a, b)`, `a < b`, grouped by `a` (apart from
+    /// the intervals: lookups read the one while updates write the other).
+    edge_v: Vec<[u32; 2]>,
+    /// Edge id -> `[α_min, α_max]`.
+    edge_iv: Vec<[f64; 2]>,
     /// Vertex id `a` -> first edge `(a, _)`; `num_vertices + 1` entries.
     edge_start: Vec<u32>,
     /// Triangle id -> owning face, packed `4 * cell + local face`, where
@@ -173,7 +174,8 @@ impl AlphaComplex {
             return AlphaComplex {
                 tri,
                 cell_r: Vec::new(),
-                edges: Vec::new(),
+                edge_v: Vec::new(),
+                edge_iv: Vec::new(),
                 edge_start: vec![0; nv + 1],
                 tri_face: Vec::new(),
                 tri_iv: Vec::new(),
@@ -195,14 +197,15 @@ impl AlphaComplex {
             (order, posmask, cell_r)
         };
         #[cfg(feature = "parallel")]
-        let ((order, posmask, cell_r), (edges, edge_start)) =
+        let ((order, posmask, cell_r), (edge_v, edge_start)) =
             rayon::join(cells, || number_edges(&tri));
         #[cfg(not(feature = "parallel"))]
-        let ((order, posmask, cell_r), (edges, edge_start)) = (cells(), number_edges(&tri));
+        let ((order, posmask, cell_r), (edge_v, edge_start)) = (cells(), number_edges(&tri));
         let mut ac = AlphaComplex {
             tri,
             cell_r,
-            edges,
+            edge_iv: vec![[f64::INFINITY, 0.0]; edge_v.len()],
+            edge_v,
             edge_start,
             tri_face: Vec::new(),
             tri_iv: Vec::new(),
@@ -265,7 +268,7 @@ impl AlphaComplex {
 
     /// Number of finite edges.
     pub fn num_edges(&self) -> usize {
-        self.edges.len()
+        self.edge_v.len()
     }
 
     /// Number of finite triangles.
@@ -276,13 +279,13 @@ impl AlphaComplex {
     /// Vertex ids `(a, b)`, `a < b`, of edge `e`.
     #[inline]
     pub fn edge_vertices(&self, e: usize) -> [u32; 2] {
-        self.edges[e].v
+        self.edge_v[e]
     }
 
     /// `(α_min, α_max)` of edge `e`.
     #[inline]
     pub fn edge_interval(&self, e: usize) -> (f64, f64) {
-        (self.edges[e].iv[0], self.edges[e].iv[1])
+        (self.edge_iv[e][0], self.edge_iv[e][1])
     }
 
     /// The id of the edge between vertex ids `a` and `b`, if it exists.
@@ -290,9 +293,9 @@ impl AlphaComplex {
         let (a, b) = if a < b { (a, b) } else { (b, a) };
         let s = *self.edge_start.get(a as usize)? as usize;
         let e = *self.edge_start.get(a as usize + 1)? as usize;
-        self.edges[s..e]
+        self.edge_v[s..e]
             .iter()
-            .position(|x| x.v[1] == b)
+            .position(|x| x[1] == b)
             .map(|k| s + k)
     }
 
@@ -348,11 +351,11 @@ impl AlphaComplex {
     /// Every edge with its interval, vertices as ascending input indices.
     pub fn edges(&self) -> impl Iterator<Item = EdgeInterval> + '_ {
         (0..self.num_edges()).map(move |e| {
-            let [a, b] = self.edges[e].v.map(|x| self.tri.input_index(x));
+            let [a, b] = self.edge_v[e].map(|x| self.tri.input_index(x));
             EdgeInterval {
                 vertices: if a < b { [a, b] } else { [b, a] },
-                alpha_min: self.edges[e].iv[0],
-                alpha_max: self.edges[e].iv[1],
+                alpha_min: self.edge_iv[e][0],
+                alpha_max: self.edge_iv[e][1],
             }
         })
     }
@@ -370,7 +373,7 @@ impl AlphaComplex {
     /// Ids of the edges of `F_{1,α}`: `α_min ≤ α ≤ α_max`.
     pub fn edge_ids_at(&self, alpha: f64) -> impl Iterator<Item = usize> + '_ {
         (0..self.num_edges())
-            .filter(move |&e| self.edges[e].iv[0] <= alpha && alpha <= self.edges[e].iv[1])
+            .filter(move |&e| self.edge_iv[e][0] <= alpha && alpha <= self.edge_iv[e][1])
     }
 
     /// Ids of the triangles of `F_{2,α}`: `α_min ≤ α ≤ α_max`.
@@ -382,7 +385,7 @@ impl AlphaComplex {
     /// `F_{1,α}` as ascending input-index pairs.
     pub fn edges_at(&self, alpha: f64) -> impl Iterator<Item = [u32; 2]> + '_ {
         self.edge_ids_at(alpha).map(move |e| {
-            let [a, b] = self.edges[e].v.map(|x| self.tri.input_index(x));
+            let [a, b] = self.edge_v[e].map(|x| self.tri.input_index(x));
             if a < b {
                 [a, b]
             } else {
@@ -403,9 +406,8 @@ impl AlphaComplex {
     /// α-complex or `F_α` changes).
     pub fn spectrum(&self) -> Vec<f64> {
         let mut v: Vec<f64> = self
-            .edges
+            .edge_iv
             .iter()
-            .map(|r| &r.iv)
             .chain(&self.tri_iv)
             .flatten()
             .chain(&self.cell_r)
@@ -516,8 +518,11 @@ impl AlphaComplex {
     /// The work goes by blocks of cells. Within a block, the per-triangle
     /// part (intervals, edge lookups, the edges' Gabriel tests against the
     /// third vertex) only reads shared data and runs in parallel with the
-    /// `parallel` feature; the edge updates are then applied in order, so
-    /// the result is identical for any number of threads.
+    /// `parallel` feature; the block's triangles are then stored and its
+    /// edge updates applied in order on one thread, overlapping the next
+    /// block's triangle part, so the result is identical for any number
+    /// of threads. (Edge vertex ids and intervals are separate arrays so
+    /// that the two can overlap.)
     #[inline(never)]
     fn compute_triangles_edges(&mut self, order: &[u32], posmask: &[u32]) {
         let nt = self.tri.num_triangles();
@@ -528,40 +533,70 @@ impl AlphaComplex {
         // once a third vertex is found inside its diametral ball.
         const BLOCK: usize = 1 << 14;
         const SUB: usize = 1024;
-        for (b, block) in order.chunks(BLOCK).enumerate() {
+        let ctx = TriangleCtx {
+            tri: &self.tri,
+            cell_r: &self.cell_r,
+            posmask,
+            edge_v: &self.edge_v,
+            edge_start: &self.edge_start,
+        };
+        let edge_iv = &mut self.edge_iv;
+        // The triangles of a block, in visiting order.
+        let block_triangles = |b: usize, block: &[u32]| -> Vec<Vec<TriangleOut>> {
             let base = b * BLOCK;
-            let ctx = TriangleCtx {
-                tri: &self.tri,
-                cell_r: &self.cell_r,
-                posmask,
-                edges: &self.edges,
-                edge_start: &self.edge_start,
-            };
             #[cfg(feature = "parallel")]
-            let parts: Vec<Vec<TriangleOut>> = {
+            {
                 use rayon::prelude::*;
                 block
                     .par_chunks(SUB)
                     .enumerate()
                     .map(|(k, sub)| ctx.triangles_of(sub, base + k * SUB))
                     .collect()
-            };
+            }
             #[cfg(not(feature = "parallel"))]
-            let parts: Vec<Vec<TriangleOut>> = block
+            block
                 .chunks(SUB)
                 .enumerate()
                 .map(|(k, sub)| ctx.triangles_of(sub, base + k * SUB))
-                .collect();
+                .collect()
+        };
+        // Stores a block's triangles and applies its edge updates, in order.
+        let mut apply = |parts: Vec<Vec<TriangleOut>>| {
             for out in parts.iter().flatten() {
                 tri_face.push(out.face);
                 tri_iv.push(out.iv);
+                for k in 0..3 {
+                    update_edge(&mut edge_iv[out.edges[k] as usize], out, k);
+                }
             }
-            apply_edge_updates(&mut self.edges, &parts);
+        };
+        // Pipelined: one thread applies block b while the others compute
+        // the triangles of block b + 1 (with the `parallel` feature).
+        let mut pending: Option<Vec<Vec<TriangleOut>>> = None;
+        for (b, block) in order.chunks(BLOCK).enumerate() {
+            #[cfg(feature = "parallel")]
+            let (parts, ()) = rayon::join(
+                || block_triangles(b, block),
+                || {
+                    if let Some(p) = pending.take() {
+                        apply(p);
+                    }
+                },
+            );
+            #[cfg(not(feature = "parallel"))]
+            let parts = {
+                if let Some(p) = pending.take() {
+                    apply(p);
+                }
+                block_triangles(b, block)
+            };
+            pending = Some(parts);
+        }
+        if let Some(p) = pending.take() {
+            apply(p);
         }
         let pts = self.tri.points();
-        for rec in self.edges.iter_mut() {
-            let [a, b] = rec.v;
-            let slot = &mut rec.iv;
+        for (&[a, b], slot) in self.edge_v.iter().zip(self.edge_iv.iter_mut()) {
             if slot[0].is_sign_negative() {
                 slot[0] = -slot[0];
             } else {
@@ -575,60 +610,21 @@ impl AlphaComplex {
     }
 }
 
-/// Edges per ownership run in [`apply_edge_updates`].
-#[cfg(feature = "parallel")]
-const EDGE_RUN: usize = 1024;
-
-/// Pushes the triangles' intervals and Gabriel refutations to their edges:
-/// an edge's `iv` keeps [min of α_min, max of α_max] with the sign bit of
-/// the first set once refuted. The update commutes, so with the `parallel`
-/// feature the edges are dealt to the threads in runs of [`EDGE_RUN`] ids
-/// (each thread reads every triangle and applies the updates of its own
-/// runs) and the result does not depend on the split.
-fn apply_edge_updates(edges: &mut [EdgeRec], parts: &[Vec<TriangleOut>]) {
-    #[inline(always)]
-    fn update(slot: &mut [f64; 2], out: &TriangleOut, k: usize) {
-        if out.iv[1] > slot[1] {
-            slot[1] = out.iv[1];
-        }
-        let m = slot[0].abs().min(out.iv[0]);
-        let refuted = (out.refuted >> k) & 1 == 1;
-        slot[0] = if refuted || slot[0].is_sign_negative() {
-            -m
-        } else {
-            m
-        };
+/// Pushes a triangle's interval and Gabriel refutation of its edge `k` to
+/// the edge's `iv`, which keeps [min of α_min, max of α_max] with the sign
+/// bit of the first set once refuted.
+#[inline(always)]
+fn update_edge(slot: &mut [f64; 2], out: &TriangleOut, k: usize) {
+    if out.iv[1] > slot[1] {
+        slot[1] = out.iv[1];
     }
-    #[cfg(feature = "parallel")]
-    {
-        use rayon::prelude::*;
-        // A power of two, so that the owner of a run is a mask away.
-        let shift = rayon::current_num_threads().clamp(1, 8).ilog2();
-        let t = 1usize << shift;
-        if t > 1 {
-            let mut lists: Vec<Vec<&mut [EdgeRec]>> = (0..t).map(|_| Vec::new()).collect();
-            for (k, run) in edges.chunks_mut(EDGE_RUN).enumerate() {
-                lists[k & (t - 1)].push(run);
-            }
-            lists.into_par_iter().enumerate().for_each(|(w, mut runs)| {
-                for out in parts.iter().flatten() {
-                    for k in 0..3 {
-                        let e = out.edges[k] as usize;
-                        let run = e / EDGE_RUN;
-                        if run & (t - 1) == w {
-                            update(&mut runs[run >> shift][e % EDGE_RUN].iv, out, k);
-                        }
-                    }
-                }
-            });
-            return;
-        }
-    }
-    for out in parts.iter().flatten() {
-        for k in 0..3 {
-            update(&mut edges[out.edges[k] as usize].iv, out, k);
-        }
-    }
+    let m = slot[0].abs().min(out.iv[0]);
+    let refuted = (out.refuted >> k) & 1 == 1;
+    slot[0] = if refuted || slot[0].is_sign_negative() {
+        -m
+    } else {
+        m
+    };
 }
 
 /// Read-only data of the triangle pass.
@@ -636,7 +632,7 @@ struct TriangleCtx<'a> {
     tri: &'a Triangulation,
     cell_r: &'a [f64],
     posmask: &'a [u32],
-    edges: &'a [EdgeRec],
+    edge_v: &'a [[u32; 2]],
     edge_start: &'a [u32],
 }
 
@@ -695,7 +691,7 @@ impl TriangleCtx<'_> {
                     .into_iter()
                     .enumerate()
                 {
-                    edges[e] = find_edge_id(self.edges, self.edge_start, x, y);
+                    edges[e] = find_edge_id(self.edge_v, self.edge_start, x, y);
                     let inside = exact::edge_diametral_side(
                         &pts[x as usize],
                         &pts[y as usize],
@@ -715,20 +711,13 @@ impl TriangleCtx<'_> {
     }
 }
 
-/// An edge: vertex ids `(a, b)`, `a < b`, and `[α_min, α_max]`.
-#[derive(Clone, Copy, Debug)]
-struct EdgeRec {
-    v: [u32; 2],
-    iv: [f64; 2],
-}
-
 /// The id of edge `(x, y)` (which must exist), by a scan of the smaller
 /// vertex's bucket.
 #[inline]
-fn find_edge_id(edges: &[EdgeRec], start: &[u32], x: u32, y: u32) -> u32 {
+fn find_edge_id(edges: &[[u32; 2]], start: &[u32], x: u32, y: u32) -> u32 {
     let (a, b) = if x < y { (x, y) } else { (y, x) };
     let mut e = start[a as usize] as usize;
-    while edges[e].v[1] != b {
+    while edges[e][1] != b {
         e += 1;
     }
     e as u32
@@ -789,7 +778,7 @@ fn cell_masks(pts: &[Point3], v: &[u32; 4]) -> (f64, u8) {
 /// Numbers the finite edges `(a, b)`, `a < b` (vertex ids), grouped by
 /// `a`: a counting sort of the 6 edges of every finite tet on `a`, then a
 /// per-vertex deduplication. Returns the edges and the per-vertex offsets.
-fn number_edges(tri: &Triangulation) -> (Vec<EdgeRec>, Vec<u32>) {
+fn number_edges(tri: &Triangulation) -> (Vec<[u32; 2]>, Vec<u32>) {
     let nv = tri.num_vertices();
     let mut start = vec![0u32; nv + 1];
     for t in 0..tri.num_tets() as u32 {
@@ -826,7 +815,7 @@ fn number_edges(tri: &Triangulation) -> (Vec<EdgeRec>, Vec<u32>) {
     // Euler: V − E + F − T = 1 for the (ball-shaped) finite complex.
     let nf = tri.num_triangles();
     let ne_guess = (nv + nf).saturating_sub(tri.num_finite_tets() + 1);
-    let mut edges: Vec<EdgeRec> = Vec::with_capacity(ne_guess);
+    let mut edges: Vec<[u32; 2]> = Vec::with_capacity(ne_guess);
     let mut estart = vec![0u32; nv + 1];
     // Deduplicate each bucket with a stamp per vertex (no sort: within a
     // vertex the edges stay in first-seen order, lookups scan the bucket).
@@ -835,10 +824,7 @@ fn number_edges(tri: &Triangulation) -> (Vec<EdgeRec>, Vec<u32>) {
         for &b in &buf[start[a] as usize..start[a + 1] as usize] {
             if stamp[b as usize] != a as u32 {
                 stamp[b as usize] = a as u32;
-                edges.push(EdgeRec {
-                    v: [a as u32, b],
-                    iv: [f64::INFINITY, 0.0],
-                });
+                edges.push([a as u32, b]);
             }
         }
         estart[a + 1] = edges.len() as u32;
