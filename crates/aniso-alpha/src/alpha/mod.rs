@@ -197,14 +197,15 @@ impl AlphaComplex {
             (order, posmask, cell_r)
         };
         #[cfg(feature = "parallel")]
-        let ((order, posmask, cell_r), (edge_v, edge_start)) =
+        let ((order, posmask, cell_r), (edge_v, edge_start, edge_iv)) =
             rayon::join(cells, || number_edges(&tri));
         #[cfg(not(feature = "parallel"))]
-        let ((order, posmask, cell_r), (edge_v, edge_start)) = (cells(), number_edges(&tri));
+        let ((order, posmask, cell_r), (edge_v, edge_start, edge_iv)) =
+            (cells(), number_edges(&tri));
         let mut ac = AlphaComplex {
             tri,
             cell_r,
-            edge_iv: vec![[f64::INFINITY, 0.0]; edge_v.len()],
+            edge_iv,
             edge_v,
             edge_start,
             tri_face: Vec::new(),
@@ -775,10 +776,14 @@ fn cell_masks(pts: &[Point3], v: &[u32; 4]) -> (f64, u8) {
     (r2.sqrt(), m)
 }
 
+/// Edge vertex ids, per-vertex offsets and intervals (see [`AlphaComplex`]).
+type EdgeTables = (Vec<[u32; 2]>, Vec<u32>, Vec<[f64; 2]>);
+
 /// Numbers the finite edges `(a, b)`, `a < b` (vertex ids), grouped by
 /// `a`: a counting sort of the 6 edges of every finite tet on `a`, then a
-/// per-vertex deduplication. Returns the edges and the per-vertex offsets.
-fn number_edges(tri: &Triangulation) -> (Vec<[u32; 2]>, Vec<u32>) {
+/// per-vertex deduplication. Returns the edges, the per-vertex offsets
+/// and the edges' initial intervals (allocated here, off the cell pass).
+fn number_edges(tri: &Triangulation) -> EdgeTables {
     let nv = tri.num_vertices();
     let mut start = vec![0u32; nv + 1];
     for t in 0..tri.num_tets() as u32 {
@@ -829,7 +834,8 @@ fn number_edges(tri: &Triangulation) -> (Vec<[u32; 2]>, Vec<u32>) {
         }
         estart[a + 1] = edges.len() as u32;
     }
-    (edges, estart)
+    let iv = vec![[f64::INFINITY, 0.0]; edges.len()];
+    (edges, estart, iv)
 }
 
 /// The finite cells grouped by their smallest vertex id (a counting sort).
