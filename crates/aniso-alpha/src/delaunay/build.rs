@@ -8,7 +8,7 @@ use crate::geometry::predicates::{
 };
 use crate::geometry::Point3;
 
-/// Marks a dead (freed) tetrahedron in `tets[t][0]`.
+/// The vertices of a cell just allocated, before it is written.
 const DEAD: u32 = u32::MAX - 1;
 /// An adjacency slot not yet linked.
 const UNSET: u32 = u32::MAX;
@@ -285,9 +285,9 @@ impl<K: Kernel> Builder<K> {
         }
         self.filing = self.max_local > 0;
 
-        // Free the cavity (dead cells are only marked DEAD at compaction:
-        // they are exactly the free list then; their flags do not matter,
-        // as a reused cell is overwritten whole).
+        // Free the cavity (the dead cells are exactly the free list, which
+        // is how compaction finds them; their flags do not matter, as a
+        // reused cell is overwritten whole).
         self.free.extend_from_slice(&self.conflicts);
         let cells = &self.cells[..];
         // Start the next walk from a new finite tet if there is one.
@@ -683,7 +683,7 @@ fn link_by_faces(cells: &mut [Cell], ids: &[u32]) {
 }
 
 /// Drops dead tets by moving live tets from the end into the holes (only
-/// the cells on the free list move; the rest stay where they are).
+/// live cells above the final length move; the rest stay where they are).
 fn compact<K: Kernel>(b: Builder<K>, vert_input: Vec<u32>, input_vert: Vec<u32>) -> Triangulation {
     let Builder {
         pts,
@@ -691,38 +691,39 @@ fn compact<K: Kernel>(b: Builder<K>, vert_input: Vec<u32>, input_vert: Vec<u32>)
         free,
         ..
     } = b;
-    for &t in &free {
-        cells[t as usize].v[0] = DEAD;
-    }
-    drop(free);
-    let dead = |c: &Cell| c.v[0] == DEAD;
-    let mut end = cells.len();
-    let mut i = 0;
-    loop {
-        while end > 0 && dead(&cells[end - 1]) {
-            end -= 1;
-        }
-        while i < end && !dead(&cells[i]) {
-            i += 1;
-        }
-        if i >= end {
+    // The dead cells are exactly the free list: fill the holes below the
+    // final length with the live cells above it (no scan of the cells).
+    let mut holes = free;
+    holes.sort_unstable();
+    let len = cells.len() - holes.len();
+    let mut tail_holes = holes.len();
+    let mut src = cells.len();
+    for &h in &holes {
+        let h = h as usize;
+        if h >= len {
             break;
         }
-        // Move the live cell at end - 1 into the hole at i.
-        let src = end - 1;
-        cells[i] = cells[src];
-        for k in 0..4 {
-            let p = cells[i].n[k];
-            let (n, j) = ((p >> 2) as usize, (p & 3) as usize);
-            cells[n].n[j] = pack(i as u32, k);
+        // The last live cell not yet moved.
+        loop {
+            src -= 1;
+            if tail_holes > 0 && holes[tail_holes - 1] as usize == src {
+                tail_holes -= 1;
+            } else {
+                break;
+            }
         }
-        cells[src].v[0] = DEAD;
-        end -= 1;
+        cells[h] = cells[src];
+        for k in 0..4 {
+            let p = cells[h].n[k];
+            let (n, j) = ((p >> 2) as usize, (p & 3) as usize);
+            cells[n].n[j] = pack(h as u32, k);
+        }
     }
-    cells.truncate(end);
-    let num_finite = cells.iter().filter(|c| c.v[3] != INFINITE).count();
+    cells.truncate(len);
+    let mut num_finite = 0;
     let mut vert_tet = vec![u32::MAX; pts.len()];
     for (t, c) in cells.iter().enumerate() {
+        num_finite += (c.v[3] != INFINITE) as usize;
         for &w in &c.v {
             if w != INFINITE {
                 vert_tet[w as usize] = t as u32;
