@@ -225,9 +225,7 @@ impl<K: Kernel> Builder<K> {
         // Conflict region by graph search; `conflicts` doubles as the stack.
         // Each boundary facet found (conflict tet c, face f, outer tet
         // not in conflict) immediately gets its new tet: c with vertex f
-        // replaced by q, keeping c's outer neighbour. The slot `f` of c
-        // (c is about to die) then points to the new tet, which is how the
-        // linking below recognises boundary facets.
+        // replaced by q, keeping c's outer neighbour.
         self.conflicts.clear();
         self.new_tets.clear();
         self.conflicts.push(start);
@@ -263,7 +261,6 @@ impl<K: Kernel> Builder<K> {
                 new.n = [UNSET; 4];
                 new.n[f] = outer;
                 self.cells[n].n[(outer & 3) as usize] = pack(nt, f);
-                self.cells[c as usize].n[f] = pack(nt, f);
                 if self.filing {
                     self.file_faces(nt, f, &v);
                 }
@@ -275,11 +272,15 @@ impl<K: Kernel> Builder<K> {
             self.link_filed();
         } else {
             self.unfile();
-            // The outer tets were marked CLEAR; reset them.
-            for &(packed, _) in &self.new_tets {
+            // The outer tets were marked CLEAR; reset them. Point slot f
+            // of each conflict tet with a boundary facet f at its new tet
+            // (c is about to die), which is how the rotation recognises
+            // boundary facets.
+            for &(packed, c) in &self.new_tets {
                 let (nt, f) = ((packed >> 2) as usize, (packed & 3) as usize);
                 let outer = (self.cells[nt].n[f] >> 2) as usize;
                 self.cells[outer].v[1] &= !CLEAR;
+                self.cells[c as usize].n[f] = packed;
             }
             self.link_by_rotation(vid);
         }
