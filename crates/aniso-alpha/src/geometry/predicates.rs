@@ -720,19 +720,21 @@ pub fn insphere_perturbed_k<K: Kernel>(
 #[inline(never)]
 fn insphere_tie<K: Kernel>(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> i32 {
     let pts: [&Point3; 5] = [a, b, c, d, e];
-    let mut idx = [0usize, 1, 2, 3, 4];
-    // Sort descending by lexicographic order (insertion sort on 5 items).
-    for i in 1..5 {
-        let mut j = i;
-        while j > 0 && lex_less(pts[idx[j - 1]], pts[idx[j]]) {
-            idx.swap(j - 1, j);
-            j -= 1;
+    // Visit the points from the lexicographically largest down (picking
+    // the largest left each time: the first orientation almost always
+    // decides, so a full sort would be wasted).
+    let mut left = [true; 5];
+    for _ in 0..5 {
+        let mut i = usize::MAX;
+        for k in 0..5 {
+            if left[k] && (i == usize::MAX || lex_less(pts[i], pts[k])) {
+                i = k;
+            }
         }
-    }
-    for &i in &idx {
         if i == 4 {
             return -1;
         }
+        left[i] = false;
         let mut q = [a, b, c, d];
         q[i] = e;
         let o = K::orient3d(q[0], q[1], q[2], q[3]);
