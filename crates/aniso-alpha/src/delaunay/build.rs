@@ -46,8 +46,9 @@ const EDGE_OF: [[(usize, [usize; 2]); 3]; 4] = [
     [(0, [1, 2]), (1, [0, 2]), (2, [0, 1])],
 ];
 
-/// Cavities with more boundary vertices than this are linked by rotation
-/// (a power of two; their pair table would pass 4k slots).
+/// Bound on the local numbers of the pair table (a power of two): filing
+/// stops, and the cavity is linked by rotation, when a new tet could take
+/// the count past it, i.e. for cavities of more than 61 boundary vertices.
 const MAX_LOCAL: usize = 64;
 /// Pairs of local numbers (at least MAX_LOCAL·(MAX_LOCAL−1)/2, a power of two).
 const PAIRS: usize = 2048;
@@ -112,9 +113,10 @@ struct Builder<K: Kernel> {
     /// Local number of each vertex on the current cavity's boundary
     /// ([`UNSET`] otherwise); the last slot stands for the infinite vertex.
     loc: Vec<u32>,
-    /// Scratch of [`Builder::link_by_table`].
+    /// Scratch of [`Builder::file_faces`] and [`Builder::link_filed`].
     table: Box<PairTable>,
-    /// Cavities with more boundary vertices are linked by rotation.
+    /// The bound on local numbers ([`MAX_LOCAL`]; lower in tests, 0 to
+    /// link every cavity by rotation).
     max_local: usize,
     /// Whether the current insertion's new tets are being filed in
     /// `table` (until the cavity proves too large for it).
