@@ -196,12 +196,8 @@ impl AlphaComplex {
             cell_pass(&tri, &mut cell_r, &mut posmask);
             (order, posmask, cell_r)
         };
-        #[cfg(feature = "parallel")]
         let ((order, posmask, cell_r), (edge_v, edge_start, edge_iv)) =
-            rayon::join(cells, || number_edges(&tri));
-        #[cfg(not(feature = "parallel"))]
-        let ((order, posmask, cell_r), (edge_v, edge_start, edge_iv)) =
-            (cells(), number_edges(&tri));
+            join(cells, || number_edges(&tri));
         let mut ac = AlphaComplex {
             tri,
             cell_r,
@@ -575,8 +571,7 @@ impl AlphaComplex {
         // the triangles of block b + 1 (with the `parallel` feature).
         let mut pending: Option<Vec<Vec<TriangleOut>>> = None;
         for (b, block) in order.chunks(BLOCK).enumerate() {
-            #[cfg(feature = "parallel")]
-            let (parts, ()) = rayon::join(
+            let (parts, ()) = join(
                 || block_triangles(b, block),
                 || {
                     if let Some(p) = pending.take() {
@@ -584,13 +579,6 @@ impl AlphaComplex {
                     }
                 },
             );
-            #[cfg(not(feature = "parallel"))]
-            let parts = {
-                if let Some(p) = pending.take() {
-                    apply(p);
-                }
-                block_triangles(b, block)
-            };
             pending = Some(parts);
         }
         if let Some(p) = pending.take() {
@@ -774,6 +762,18 @@ fn cell_pass(tri: &Triangulation, cell_r: &mut [f64], posmask: &mut [u32]) {
 fn cell_masks(pts: &[Point3], v: &[u32; 4]) -> (f64, u8) {
     let (r2, m) = exact::cell_radius2_and_mask(v.map(|k| &pts[k as usize]));
     (r2.sqrt(), m)
+}
+
+/// `rayon::join` with the `parallel` feature; otherwise `a` then `b`.
+fn join<RA, RB>(a: impl FnOnce() -> RA + Send, b: impl FnOnce() -> RB + Send) -> (RA, RB)
+where
+    RA: Send,
+    RB: Send,
+{
+    #[cfg(feature = "parallel")]
+    return rayon::join(a, b);
+    #[cfg(not(feature = "parallel"))]
+    (a(), b())
 }
 
 /// Edge vertex ids, per-vertex offsets and intervals (see [`AlphaComplex`]).
