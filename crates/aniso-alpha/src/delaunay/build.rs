@@ -304,6 +304,7 @@ impl<K: Kernel> Builder<K> {
         self.last = last;
         Ok(None)
     }
+
     /// Files the three inner faces of new tet `nt` (built on facet `f` of
     /// a conflict tet whose vertices, flags cleared, are `v`) in the pair
     /// table; on a cavity too large for it, stops filing for this
@@ -369,13 +370,12 @@ impl<K: Kernel> Builder<K> {
             }
             cells[outer].v[1] &= !CLEAR;
         }
-        for &w in &t.bverts[..t.nloc] {
-            self.loc[w as usize] = UNSET;
-        }
-        t.nloc = 0;
+        self.forget_local_numbers();
     }
 
-    /// Empties the table after filing stopped part way.
+    /// Empties the table after filing stopped part way (the entries of
+    /// the new tets not filed are stale, and clearing their pairs too is
+    /// harmless).
     fn unfile(&mut self) {
         let t = &mut *self.table;
         for fc in &t.faces[..self.new_tets.len().min(FACES)] {
@@ -383,6 +383,12 @@ impl<K: Kernel> Builder<K> {
                 t.fill[(other as usize >> 1) & (PAIRS - 1)] = 0;
             }
         }
+        self.forget_local_numbers();
+    }
+
+    /// Resets the local numbers given during this insertion.
+    fn forget_local_numbers(&mut self) {
+        let t = &mut *self.table;
         for &w in &t.bverts[..t.nloc] {
             self.loc[w as usize] = UNSET;
         }
