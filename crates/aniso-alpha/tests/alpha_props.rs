@@ -134,20 +134,19 @@ fn intervals_do_not_depend_on_thread_count() {
         let other = run(threads);
         assert_eq!(one.num_edges(), other.num_edges());
         assert_eq!(one.num_triangles(), other.num_triangles());
+        let iv_bits = |(lo, hi): (f64, f64)| (lo.to_bits(), hi.to_bits());
         for e in 0..one.num_edges() {
             assert_eq!(one.edge_vertices(e), other.edge_vertices(e));
-            let (a, b) = (one.edge_interval(e), other.edge_interval(e));
             assert_eq!(
-                (a.0.to_bits(), a.1.to_bits()),
-                (b.0.to_bits(), b.1.to_bits())
+                iv_bits(one.edge_interval(e)),
+                iv_bits(other.edge_interval(e))
             );
         }
         for f in 0..one.num_triangles() {
             assert_eq!(one.triangle_vertices(f), other.triangle_vertices(f));
-            let (a, b) = (one.triangle_interval(f), other.triangle_interval(f));
             assert_eq!(
-                (a.0.to_bits(), a.1.to_bits()),
-                (b.0.to_bits(), b.1.to_bits())
+                iv_bits(one.triangle_interval(f)),
+                iv_bits(other.triangle_interval(f))
             );
         }
         let bits = |ac: &AlphaComplex| {
