@@ -67,6 +67,33 @@ struct PairTable {
     faces: [[u32; 3]; FACES],
 }
 
+/// Asks the cache to start fetching `cells[i]`, which the conflict search
+/// is about to read: a tet found in conflict has its four neighbours
+/// prefetched when it is queued, so their cache misses overlap with the
+/// tests of the tets queued before it (about 8% of the build at 1M
+/// points, see BENCHMARKS.md). No effect on results; a no-op off x86_64.
+///
+/// This is the crate's only `unsafe`: `_mm_prefetch` is a `#[target_feature
+/// (enable = "sse")]` function, and SSE is part of the x86_64 baseline. A
+/// prefetch is a hint that never dereferences in the language's sense and
+/// never faults, whatever the address (`prefetch_never_faults` passes
+/// addresses far outside the slice), and the pointer is formed with
+/// `wrapping_add`, which is defined for any offset.
+#[inline(always)]
+#[allow(unsafe_code)]
+fn prefetch(cells: &[Cell], i: usize) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        let p = cells.as_ptr().wrapping_add(i) as *const i8;
+        // SAFETY: SSE is enabled on every x86_64 target, and a prefetch
+        // has no memory-safety requirement on its address (see above).
+        unsafe { _mm_prefetch::<_MM_HINT_T0>(p) };
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (cells, i);
+}
+
 #[inline(always)]
 fn pack(t: u32, i: usize) -> u32 {
     (t << 2) | i as u32
@@ -232,6 +259,9 @@ impl<K: Kernel> Builder<K> {
         self.new_tets.clear();
         self.conflicts.push(start);
         self.cells[start as usize].v[0] |= IN_CONFLICT;
+        for x in self.cells[start as usize].n {
+            prefetch(&self.cells, (x >> 2) as usize);
+        }
         let mut k = 0;
         while k < self.conflicts.len() {
             let c = self.conflicts[k];
@@ -250,6 +280,9 @@ impl<K: Kernel> Builder<K> {
                 }
                 if nv[1] & CLEAR == 0 && tet_in_conflict::<K>(&self.pts, &nv, &q, &self.filter) {
                     self.cells[n].v[0] |= IN_CONFLICT;
+                    for x in self.cells[n].n {
+                        prefetch(&self.cells, (x >> 2) as usize);
+                    }
                     self.conflicts.push(n as u32);
                     continue;
                 }
@@ -752,7 +785,25 @@ fn compact<K: Kernel>(b: Builder<K>, vert_input: Vec<u32>, input_vert: Vec<u32>)
 
 #[cfg(test)]
 mod tests {
-    use super::{build_with, DelaunayError, Limits, SplitMix64, FACE};
+    use super::{build_with, prefetch, Cell, DelaunayError, Limits, SplitMix64, FACE};
+
+    #[test]
+    fn prefetch_never_faults() {
+        // The hint may be given for any index: inside, just past, far past
+        // the slice, and on an empty slice.
+        let cells = vec![
+            Cell {
+                v: [0; 4],
+                n: [0; 4]
+            };
+            3
+        ];
+        for i in [0, 2, 3, 1 << 20, 1 << 40, usize::MAX / 64, usize::MAX] {
+            prefetch(&cells, i);
+            prefetch(&[], i);
+        }
+        assert_eq!(cells[2].v, [0; 4]);
+    }
 
     #[test]
     fn tet_limit_is_a_typed_error() {

@@ -683,6 +683,12 @@ pub fn lex_less(a: &Point3, b: &Point3) -> bool {
     a[2] < b[2]
 }
 
+/// [`lex_less`] evaluated without branches (the points must be finite).
+#[inline(always)]
+fn lex_less_branchless(a: &Point3, b: &Point3) -> bool {
+    (a[0] < b[0]) | ((a[0] == b[0]) & ((a[1] < b[1]) | ((a[1] == b[1]) & (a[2] < b[2]))))
+}
+
 /// In-sphere test with CGAL's symbolic perturbation (Devillers & Teillaud):
 /// never returns 0 for five distinct points with `(a, b, c, d)` positively
 /// oriented. `1` means `e` is (perturbed-)inside.
@@ -720,21 +726,28 @@ pub fn insphere_perturbed_k<K: Kernel>(
 #[inline(never)]
 fn insphere_tie<K: Kernel>(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> i32 {
     let pts: [&Point3; 5] = [a, b, c, d, e];
-    // Visit the points from the lexicographically largest down (picking
-    // the largest left each time: the first orientation almost always
-    // decides, so a full sort would be wasted).
-    let mut left = [true; 5];
-    for _ in 0..5 {
-        let mut i = usize::MAX;
-        for k in 0..5 {
-            if left[k] && (i == usize::MAX || lex_less(pts[i], pts[k])) {
-                i = k;
-            }
+    // Visit the points from the lexicographically largest down. The rank
+    // of each point (how many of the others are larger) is counted without
+    // branches: on degenerate inputs such as grids nearly every in-sphere
+    // test is a tie, and comparisons of equal coordinates mispredict.
+    let mut above = [0usize; 5];
+    for i in 0..5 {
+        for j in i + 1..5 {
+            let lt = lex_less_branchless(pts[i], pts[j]) as usize;
+            above[i] += lt;
+            above[j] += 1 - lt;
         }
+    }
+    // (Distinct points have distinct ranks 0..5; the mask only drops the
+    // bounds check.)
+    let mut by_rank = [4usize; 8];
+    for (i, &r) in above.iter().enumerate() {
+        by_rank[r & 7] = i;
+    }
+    for &i in &by_rank[..5] {
         if i == 4 {
             return -1;
         }
-        left[i] = false;
         let mut q = [a, b, c, d];
         q[i] = e;
         let o = K::orient3d(q[0], q[1], q[2], q[3]);
@@ -1097,5 +1110,98 @@ mod tests {
         }
         // (1,1,1) is lexicographically the largest: it is outside.
         assert_eq!(insphere_perturbed(&a, &b, &c, &d, &cube[7]), -1);
+    }
+
+    /// The symbolic rule written the plain way: sort the five points
+    /// lexicographically, then apply the rule from the largest down.
+    fn insphere_tie_by_sorting(pts: [&Point3; 5]) -> i32 {
+        let mut idx = [0usize, 1, 2, 3, 4];
+        idx.sort_by(|&i, &j| {
+            if lex_less(pts[j], pts[i]) {
+                std::cmp::Ordering::Less
+            } else {
+                std::cmp::Ordering::Greater
+            }
+        });
+        for i in idx {
+            if i == 4 {
+                return -1;
+            }
+            let mut q = [pts[0], pts[1], pts[2], pts[3]];
+            q[i] = pts[4];
+            let o = orient3d(q[0], q[1], q[2], q[3]);
+            if o != 0 {
+                return o;
+            }
+        }
+        -1
+    }
+
+    #[test]
+    fn branchless_tie_ranking_matches_sorting() {
+        // Points of a small grid with negative coordinates and -0.0, so
+        // that many 5-tuples are cospherical and share coordinates at
+        // every level of the lexicographic order.
+        let vals: [f64; 5] = [-1.0, -0.0, 0.0, 1.0, 2.0];
+        let mut grid: Vec<Point3> = Vec::new();
+        for x in vals {
+            for y in vals {
+                for z in vals {
+                    // (-0.0 == 0.0: the first of equal points is kept.)
+                    if !grid.contains(&[x, y, z]) {
+                        grid.push([x, y, z]);
+                    }
+                }
+            }
+        }
+        let mut state = 0x1234_5678_9abc_def0_u64;
+        let mut next = |n: usize| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((state >> 33) as usize) % n
+        };
+        let (mut ties, mut decided_late) = (0, 0);
+        while ties < 3000 {
+            let mut t = [0usize; 5];
+            for k in 0..5 {
+                t[k] = next(grid.len());
+            }
+            let p: Vec<&Point3> = t.iter().map(|&k| &grid[k]).collect();
+            if (0..5).any(|i| (i + 1..5).any(|j| p[i] == p[j])) {
+                continue;
+            }
+            let (mut a, mut b) = (p[0], p[1]);
+            match orient3d(a, b, p[2], p[3]) {
+                0 => continue,
+                o if o < 0 => std::mem::swap(&mut a, &mut b),
+                _ => {}
+            }
+            if insphere(a, b, p[2], p[3], p[4]) != 0 {
+                continue;
+            }
+            ties += 1;
+            let want = insphere_tie_by_sorting([a, b, p[2], p[3], p[4]]);
+            let mut first = [a, b, p[2], p[3]];
+            let largest = (0..4).fold(0, |m, k| if lex_less(first[m], first[k]) { k } else { m });
+            if !lex_less(p[4], first[largest]) {
+                // decided by the query being the largest
+            } else {
+                first[largest] = p[4];
+                if orient3d(first[0], first[1], first[2], first[3]) == 0 {
+                    decided_late += 1;
+                }
+            }
+            assert_eq!(
+                insphere_perturbed(a, b, p[2], p[3], p[4]),
+                want,
+                "{a:?} {b:?} {:?} {:?} {:?}",
+                p[2],
+                p[3],
+                p[4]
+            );
+        }
+        // The sample reaches the rule's later steps, not only the first.
+        assert!(decided_late > 20, "{decided_late}");
     }
 }
