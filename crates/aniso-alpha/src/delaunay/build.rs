@@ -37,34 +37,41 @@ pub(crate) const FACE: [[usize; 3]; 4] = [[1, 3, 2], [0, 2, 3], [0, 3, 1], [0, 1
 /// For each face index, the other three.
 const OTHER: [[usize; 3]; 4] = [[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]];
 
-/// For each face index `f`, each other index `g` with the two indices that
-/// are neither: the edge shared by faces `f` and `g`.
-const EDGE_OF: [[(usize, [usize; 2]); 3]; 4] = [
-    [(1, [2, 3]), (2, [1, 3]), (3, [1, 2])],
-    [(0, [2, 3]), (2, [0, 3]), (3, [0, 2])],
-    [(0, [1, 3]), (1, [0, 3]), (3, [0, 1])],
-    [(0, [1, 2]), (1, [0, 2]), (2, [0, 1])],
-];
+/// For each face index `f`, the three directed edges of the facet opposite
+/// vertex `f`, in the cyclic order of [`FACE`]`[f]`, each as `(g, a, b)`:
+/// the edge goes from vertex `a` to vertex `b`, and `g` is the third
+/// vertex of the facet (the face opposite `g` holds the edge and vertex `f`).
+const DIRECTED: [[(usize, usize, usize); 3]; 4] = {
+    let mut d = [[(0, 0, 0); 3]; 4];
+    let mut f = 0;
+    while f < 4 {
+        let c = FACE[f];
+        d[f] = [(c[2], c[0], c[1]), (c[0], c[1], c[2]), (c[1], c[2], c[0])];
+        f += 1;
+    }
+    d
+};
 
-/// Bound on the local numbers of the pair table (a power of two): filing
+/// Bound on the local numbers of the edge table (a power of two): filing
 /// stops, and the cavity is linked by rotation, when a new tet could take
 /// the count past it, i.e. for cavities of more than 61 boundary vertices.
 const MAX_LOCAL: usize = 64;
-/// Pairs of local numbers (at least MAX_LOCAL·(MAX_LOCAL−1)/2, a power of two).
-const PAIRS: usize = 2048;
+/// Local number of a vertex not on the current cavity's boundary.
+const NO_LOCAL: u8 = u8::MAX;
 /// New tets whose faces can be filed (at least 2·MAX_LOCAL − 4, the facets
 /// of a boundary with MAX_LOCAL vertices; a power of two).
 const FACES: usize = 128;
 
 /// Scratch of the table linking of new tets: the boundary vertices with a
-/// local number; per pair of local numbers, how many of its two faces are
-/// filed and the faces; per new tet, the partner slots of its inner faces.
-struct PairTable {
+/// local number; per directed edge (a, b) of local numbers, the new tet's
+/// face that holds it; per new tet, the local numbers of its vertices.
+/// Entries are never cleared: every entry read was written during the
+/// same insertion.
+struct EdgeTable {
     nloc: usize,
     bverts: [u32; MAX_LOCAL],
-    fill: [u8; PAIRS],
-    slots: [u32; 2 * PAIRS],
-    faces: [[u32; 3]; FACES],
+    faces: [u32; MAX_LOCAL * MAX_LOCAL],
+    local: [[u8; 4]; FACES],
 }
 
 /// Asks the cache to start fetching `cells[i]`, which the conflict search
@@ -138,10 +145,11 @@ struct Builder<K: Kernel> {
     /// of its outer neighbour, and the conflict tet it replaces.
     new_tets: Vec<(u32, u32)>,
     /// Local number of each vertex on the current cavity's boundary
-    /// ([`UNSET`] otherwise); the last slot stands for the infinite vertex.
-    loc: Vec<u32>,
+    /// ([`NO_LOCAL`] otherwise); the last slot stands for the infinite
+    /// vertex. One byte per vertex keeps this mostly in cache.
+    loc: Vec<u8>,
     /// Scratch of [`Builder::file_faces`] and [`Builder::link_filed`].
-    table: Box<PairTable>,
+    table: Box<EdgeTable>,
     /// The bound on local numbers ([`MAX_LOCAL`]; lower in tests, 0 to
     /// link every cavity by rotation).
     max_local: usize,
@@ -293,7 +301,7 @@ impl<K: Kernel> Builder<K> {
                 let new = &mut self.cells[nt as usize];
                 new.v = v;
                 new.v[f] = vid;
-                new.n = [UNSET; 4];
+                // (Its other neighbours are set by the linking.)
                 new.n[f] = outer;
                 self.cells[n].n[(outer & 3) as usize] = pack(nt, f);
                 if self.filing {
@@ -306,13 +314,16 @@ impl<K: Kernel> Builder<K> {
         if self.filing {
             self.link_filed();
         } else {
-            self.unfile();
+            self.forget_local_numbers();
             // The outer tets were marked CLEAR; reset them. Point slot f
             // of each conflict tet with a boundary facet f at its new tet
             // (c is about to die), which is how the rotation recognises
-            // boundary facets.
+            // boundary facets, and mark the new tets' inner faces unlinked.
             for &(packed, c) in &self.new_tets {
                 let (nt, f) = ((packed >> 2) as usize, (packed & 3) as usize);
+                for g in OTHER[f] {
+                    self.cells[nt].n[g] = UNSET;
+                }
                 let outer = (self.cells[nt].n[f] >> 2) as usize;
                 self.cells[outer].v[1] &= !CLEAR;
                 self.cells[c as usize].n[f] = packed;
@@ -339,19 +350,23 @@ impl<K: Kernel> Builder<K> {
     }
 
     /// Files the three inner faces of new tet `nt` (built on facet `f` of
-    /// a conflict tet whose vertices, flags cleared, are `v`) in the pair
+    /// a conflict tet whose vertices, flags cleared, are `v`) in the edge
     /// table; on a cavity too large for it, stops filing for this
     /// insertion.
     ///
     /// Every face of a new tet other than its outer one holds `q` and an
     /// edge (a, b) of the cavity boundary, a closed triangulated sphere,
     /// so each edge is on exactly two such faces, which are then
-    /// neighbours. The boundary vertices get local numbers 0..K (the
-    /// infinite vertex too, at slot `loc.len() - 1`); each face is filed
-    /// in one of the two slots of its edge's pair and later reads its
-    /// partner from the other ([`Builder::link_filed`]). Unlike a rotation
-    /// around the edge, the lookups are independent of each other, so
-    /// their latencies overlap, and the vertices are already loaded.
+    /// neighbours. All new tets are positively oriented with `q` at the
+    /// slot of their outer facet, so walking each outer facet in the order
+    /// of [`FACE`] orients the boundary consistently: the two facets on an
+    /// edge traverse it in opposite directions. The boundary vertices get
+    /// local numbers 0..K (the infinite vertex too, at slot `loc.len() -
+    /// 1`); the face holding directed edge a → b is filed at (a, b), and
+    /// its partner is later read at (b, a) ([`Builder::link_filed`]).
+    /// Unlike a rotation around the edge, the lookups are independent of
+    /// each other, so their latencies overlap, and the vertices are
+    /// already loaded.
     #[inline(always)]
     fn file_faces(&mut self, nt: u32, f: usize, v: &[u32; 4]) {
         let i = self.new_tets.len();
@@ -361,60 +376,42 @@ impl<K: Kernel> Builder<K> {
             return;
         }
         let top = self.loc.len() - 1;
-        let mut lv = [0usize; 4];
+        let mut lv = [0u8; 4];
         for h in OTHER[f] {
             let w = (v[h] as usize).min(top);
             let mut l = self.loc[w];
-            if l == UNSET {
-                l = t.nloc as u32;
+            if l == NO_LOCAL {
+                l = t.nloc as u8;
                 self.loc[w] = l;
                 // (The masks are no-ops that drop bounds checks.)
                 t.bverts[t.nloc & (MAX_LOCAL - 1)] = w as u32;
                 t.nloc += 1;
             }
-            lv[h] = l as usize;
+            lv[h] = l;
         }
-        for (j, &(g, [h1, h2])) in EDGE_OF[f].iter().enumerate() {
-            let (a, b) = (lv[h1], lv[h2]);
-            let (lo, hi) = (a.min(b), a.max(b));
-            let pair = (hi * hi.wrapping_sub(1) / 2 + lo) & (PAIRS - 1);
-            let fill = t.fill[pair] as usize;
-            t.fill[pair] = fill as u8 + 1;
-            t.slots[(2 * pair + fill) & (2 * PAIRS - 1)] = pack(nt, g);
-            t.faces[i & (FACES - 1)][j] = (2 * pair + 1 - fill) as u32;
+        for &(g, a, b) in &DIRECTED[f] {
+            let e = lv[a] as usize * MAX_LOCAL + lv[b] as usize;
+            t.faces[e & (MAX_LOCAL * MAX_LOCAL - 1)] = pack(nt, g);
         }
+        t.local[i & (FACES - 1)] = lv;
     }
 
     /// Links the new tets, all filed by [`Builder::file_faces`], to each
-    /// other, resets the CLEAR flags of their outer tets and empties the
-    /// table.
+    /// other, resets the CLEAR flags of their outer tets and forgets the
+    /// local numbers.
     fn link_filed(&mut self) {
         let t = &mut *self.table;
         let cells = &mut self.cells[..];
         for (i, &(packed, _)) in self.new_tets.iter().enumerate() {
             let (nt, f) = ((packed >> 2) as usize, (packed & 3) as usize);
-            let fc = t.faces[i & (FACES - 1)];
+            let lv = t.local[i & (FACES - 1)];
             let cn = &mut cells[nt].n;
             let outer = (cn[f] >> 2) as usize;
-            for (j, &(g, _)) in EDGE_OF[f].iter().enumerate() {
-                let other = fc[j] as usize & (2 * PAIRS - 1);
-                cn[g] = t.slots[other];
-                t.fill[other >> 1] = 0;
+            for &(g, a, b) in &DIRECTED[f] {
+                let e = lv[b] as usize * MAX_LOCAL + lv[a] as usize;
+                cn[g] = t.faces[e & (MAX_LOCAL * MAX_LOCAL - 1)];
             }
             cells[outer].v[1] &= !CLEAR;
-        }
-        self.forget_local_numbers();
-    }
-
-    /// Empties the table after filing stopped part way (the entries of
-    /// the new tets not filed are stale, and clearing their pairs too is
-    /// harmless).
-    fn unfile(&mut self) {
-        let t = &mut *self.table;
-        for fc in &t.faces[..self.new_tets.len().min(FACES)] {
-            for &other in fc {
-                t.fill[(other as usize >> 1) & (PAIRS - 1)] = 0;
-            }
         }
         self.forget_local_numbers();
     }
@@ -423,7 +420,7 @@ impl<K: Kernel> Builder<K> {
     fn forget_local_numbers(&mut self) {
         let t = &mut *self.table;
         for &w in &t.bverts[..t.nloc] {
-            self.loc[w as usize] = UNSET;
+            self.loc[w as usize] = NO_LOCAL;
         }
         t.nloc = 0;
     }
@@ -621,13 +618,12 @@ fn run<K: Kernel>(
         rng: SplitMix64::new(0xC0FFEE),
         conflicts: Vec::new(),
         new_tets: Vec::new(),
-        loc: vec![UNSET; n + 1],
-        table: Box::new(PairTable {
+        loc: vec![NO_LOCAL; n + 1],
+        table: Box::new(EdgeTable {
             nloc: 0,
             bverts: [0; MAX_LOCAL],
-            fill: [0; PAIRS],
-            slots: [0; 2 * PAIRS],
-            faces: [[0; 3]; FACES],
+            faces: [0; MAX_LOCAL * MAX_LOCAL],
+            local: [[0; 4]; FACES],
         }),
         max_local: limits.max_local,
         filing: limits.max_local > 0,
@@ -679,19 +675,23 @@ fn run<K: Kernel>(
             let vid = b.pts.len() as u32;
             b.pts.push(*p);
             match b.insert(vid).map_err(too_many)? {
-                None => {
-                    vert_input.push(i);
-                    input_vert[i as usize] = vid;
-                }
+                None => vert_input.push(i),
                 Some(w) => {
                     b.pts.pop();
                     input_vert[i as usize] = w;
-                    if i < vert_input[w as usize] {
+                    let first = vert_input[w as usize];
+                    if i < first {
                         vert_input[w as usize] = i;
+                        input_vert[first as usize] = w;
                     }
                 }
             }
         }
+    }
+    // The inputs that became vertices, in one pass after the build (these
+    // scattered stores stalled the insertion loop).
+    for (v, &i) in vert_input.iter().enumerate() {
+        input_vert[i as usize] = v as u32;
     }
     Ok(compact(b, vert_input, input_vert))
 }
