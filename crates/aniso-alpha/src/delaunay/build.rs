@@ -106,19 +106,45 @@ fn pack(t: u32, i: usize) -> u32 {
     (t << 2) | i as u32
 }
 
+/// A point of the build, padded to 32 bytes and aligned so that it never
+/// straddles two cache lines (24-byte points straddle one time in four).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, align(32))]
+pub(crate) struct Slot(pub(crate) Point3);
+
+/// Points indexed by vertex id.
+pub(crate) trait Points {
+    /// The point of vertex `w`.
+    fn at(&self, w: u32) -> &Point3;
+}
+
+impl Points for [Point3] {
+    #[inline(always)]
+    fn at(&self, w: u32) -> &Point3 {
+        &self[w as usize]
+    }
+}
+
+impl Points for [Slot] {
+    #[inline(always)]
+    fn at(&self, w: u32) -> &Point3 {
+        &self[w as usize].0
+    }
+}
+
 /// Whether inserting `q` destroys the tetrahedron with vertices `v` (an
 /// infinite tet has the infinite vertex at index 3), under
 /// CGAL's symbolic perturbation: for a finite tet, `q` is inside its
 /// circumsphere; for an infinite tet, `q` is strictly beyond its hull facet,
 /// or in the facet's plane and inside its circumcircle.
 #[inline(always)]
-pub(crate) fn tet_in_conflict<K: Kernel>(
-    pts: &[Point3],
+pub(crate) fn tet_in_conflict<K: Kernel, P: Points + ?Sized>(
+    pts: &P,
     v: &[u32; 4],
     q: &Point3,
     filter: &StaticFilter,
 ) -> bool {
-    let p = |w: u32| &pts[w as usize];
+    let p = |w: u32| pts.at(w);
     if v[3] == INFINITE {
         let o = K::orient3d_static(p(v[0]), p(v[1]), p(v[2]), q, filter);
         if o != 0 {
@@ -135,7 +161,7 @@ struct Builder<K: Kernel> {
     kernel: std::marker::PhantomData<K>,
     /// Static bounds for the predicates over the whole input.
     filter: StaticFilter,
-    pts: Vec<Point3>,
+    pts: Vec<Slot>,
     cells: Vec<Cell>,
     free: Vec<u32>,
     rng: SplitMix64,
@@ -179,7 +205,7 @@ const GATHER: usize = 1024;
 impl<K: Kernel> Builder<K> {
     #[inline(always)]
     fn p(&self, v: u32) -> &Point3 {
-        &self.pts[v as usize]
+        &self.pts[v as usize].0
     }
 
     /// A free cell: a recycled one, or a new one unless that would pass
@@ -250,11 +276,11 @@ impl<K: Kernel> Builder<K> {
     /// if any (then nothing changes), or [`TetLimit`].
     #[inline(never)]
     fn insert(&mut self, vid: u32) -> Result<Option<u32>, TetLimit> {
-        let q = self.pts[vid as usize];
+        let q = self.pts[vid as usize].0;
         let start = self.locate(&q);
         // A duplicate lies on a vertex of the located (finite) tet.
         for &w in &self.cells[start as usize].v {
-            if w != INFINITE && self.pts[w as usize] == q {
+            if w != INFINITE && self.pts[w as usize].0 == q {
                 return Ok(Some(w));
             }
         }
@@ -286,7 +312,9 @@ impl<K: Kernel> Builder<K> {
                 if nv[0] & IN_CONFLICT != 0 {
                     continue;
                 }
-                if nv[1] & CLEAR == 0 && tet_in_conflict::<K>(&self.pts, &nv, &q, &self.filter) {
+                if nv[1] & CLEAR == 0
+                    && tet_in_conflict::<K, _>(&self.pts[..], &nv, &q, &self.filter)
+                {
                     self.cells[n].v[0] |= IN_CONFLICT;
                     for x in self.cells[n].n {
                         prefetch(&self.cells, (x >> 2) as usize);
@@ -645,7 +673,7 @@ fn run<K: Kernel>(
         s.swap(0, 1);
     }
     for (v, &i) in s.iter().enumerate() {
-        b.pts.push(points[i as usize]);
+        b.pts.push(Slot(points[i as usize]));
         vert_input.push(i);
         input_vert[i as usize] = v as u32;
     }
@@ -673,7 +701,7 @@ fn run<K: Kernel>(
                 continue; // one of the initial four
             }
             let vid = b.pts.len() as u32;
-            b.pts.push(*p);
+            b.pts.push(Slot(*p));
             match b.insert(vid).map_err(too_many)? {
                 None => vert_input.push(i),
                 Some(w) => {
@@ -763,6 +791,7 @@ fn compact<K: Kernel>(b: Builder<K>, vert_input: Vec<u32>, input_vert: Vec<u32>)
     }
     cells.truncate(len);
     let mut num_finite = 0;
+    let pts: Vec<Point3> = pts.iter().map(|s| s.0).collect();
     let mut vert_tet = vec![u32::MAX; pts.len()];
     for (t, c) in cells.iter().enumerate() {
         num_finite += (c.v[3] != INFINITE) as usize;

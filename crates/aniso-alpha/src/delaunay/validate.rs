@@ -129,8 +129,8 @@ impl Triangulation {
                 }
                 let w = self.cells[n as usize].v[j];
                 if w != INFINITE
-                    && tet_in_conflict::<Filtered>(
-                        &self.pts,
+                    && tet_in_conflict::<Filtered, _>(
+                        &self.pts[..],
                         &v,
                         self.point(w),
                         &StaticFilter::NONE,
