@@ -156,6 +156,23 @@ pub(crate) fn tet_in_conflict<K: Kernel, P: Points + ?Sized>(
     }
 }
 
+/// [`tet_in_conflict`] when the kernel's quick stage settles it: `1` in
+/// conflict, `-1` not, `0` undecided.
+#[inline(always)]
+fn conflict_quick<K: Kernel, P: Points + ?Sized>(
+    pts: &P,
+    v: &[u32; 4],
+    q: &Point3,
+    filter: &StaticFilter,
+) -> i32 {
+    let p = |w: u32| pts.at(w);
+    if v[3] == INFINITE {
+        K::orient3d_quick(p(v[0]), p(v[1]), p(v[2]), q, filter)
+    } else {
+        K::insphere_quick(p(v[0]), p(v[1]), p(v[2]), p(v[3]), q, filter)
+    }
+}
+
 /// Working state of the incremental construction.
 struct Builder<K: Kernel> {
     kernel: std::marker::PhantomData<K>,
@@ -167,6 +184,8 @@ struct Builder<K: Kernel> {
     rng: SplitMix64,
     // Scratch, reused across insertions.
     conflicts: Vec<u32>,
+    /// Tets marked CLEAR during the current insertion.
+    cleared: Vec<u32>,
     /// New tets of the current insertion: each packed with the face index
     /// of its outer neighbour, and the conflict tet it replaces.
     new_tets: Vec<(u32, u32)>,
@@ -312,9 +331,7 @@ impl<K: Kernel> Builder<K> {
                 if nv[0] & IN_CONFLICT != 0 {
                     continue;
                 }
-                if nv[1] & CLEAR == 0
-                    && tet_in_conflict::<K, _>(&self.pts[..], &nv, &q, &self.filter)
-                {
+                if nv[1] & CLEAR == 0 && self.in_conflict(n, &nv, &q) {
                     self.cells[n].v[0] |= IN_CONFLICT;
                     for x in self.cells[n].n {
                         prefetch(&self.cells, (x >> 2) as usize);
@@ -322,7 +339,6 @@ impl<K: Kernel> Builder<K> {
                     self.conflicts.push(n as u32);
                     continue;
                 }
-                self.cells[n].v[1] |= CLEAR;
                 let nt = self.alloc()?;
                 // Written in place: building the cell on the stack with
                 // `v[f] = vid` and copying it whole stalls store forwarding.
@@ -343,22 +359,24 @@ impl<K: Kernel> Builder<K> {
             self.link_filed();
         } else {
             self.forget_local_numbers();
-            // The outer tets were marked CLEAR; reset them. Point slot f
-            // of each conflict tet with a boundary facet f at its new tet
-            // (c is about to die), which is how the rotation recognises
-            // boundary facets, and mark the new tets' inner faces unlinked.
+            // Point slot f of each conflict tet with a boundary facet f at
+            // its new tet (c is about to die), which is how the rotation
+            // recognises boundary facets, and mark the new tets' inner
+            // faces unlinked.
             for &(packed, c) in &self.new_tets {
                 let (nt, f) = ((packed >> 2) as usize, (packed & 3) as usize);
                 for g in OTHER[f] {
                     self.cells[nt].n[g] = UNSET;
                 }
-                let outer = (self.cells[nt].n[f] >> 2) as usize;
-                self.cells[outer].v[1] &= !CLEAR;
                 self.cells[c as usize].n[f] = packed;
             }
             self.link_by_rotation(vid);
         }
         self.filing = self.max_local > 0;
+        for &n in &self.cleared {
+            self.cells[n as usize].v[1] &= !CLEAR;
+        }
+        self.cleared.clear();
 
         // Free the cavity (the dead cells are exactly the free list, which
         // is how compaction finds them; their flags do not matter, as a
@@ -375,6 +393,26 @@ impl<K: Kernel> Builder<K> {
         }
         self.last = last;
         Ok(None)
+    }
+
+    /// Whether inserting `q` destroys tet `n` (vertices `nv`). A tet found
+    /// not in conflict only after the kernel's slow stages (a tie, or a
+    /// determinant the static filter cannot settle) is marked CLEAR and
+    /// remembered, so that the other conflict tets next to it do not test
+    /// it again; the usual quick answers are cheaper to repeat than to
+    /// mark and unmark.
+    #[inline(always)]
+    fn in_conflict(&mut self, n: usize, nv: &[u32; 4], q: &Point3) -> bool {
+        let quick = conflict_quick::<K, _>(&self.pts[..], nv, q, &self.filter);
+        if quick != 0 {
+            return quick > 0;
+        }
+        let conflict = tet_in_conflict::<K, _>(&self.pts[..], nv, q, &self.filter);
+        if !conflict {
+            self.cells[n].v[1] |= CLEAR;
+            self.cleared.push(n as u32);
+        }
+        conflict
     }
 
     /// Files the three inner faces of new tet `nt` (built on facet `f` of
@@ -425,8 +463,7 @@ impl<K: Kernel> Builder<K> {
     }
 
     /// Links the new tets, all filed by [`Builder::file_faces`], to each
-    /// other, resets the CLEAR flags of their outer tets and forgets the
-    /// local numbers.
+    /// other and forgets the local numbers.
     fn link_filed(&mut self) {
         let t = &mut *self.table;
         let cells = &mut self.cells[..];
@@ -434,12 +471,10 @@ impl<K: Kernel> Builder<K> {
             let (nt, f) = ((packed >> 2) as usize, (packed & 3) as usize);
             let lv = t.local[i & (FACES - 1)];
             let cn = &mut cells[nt].n;
-            let outer = (cn[f] >> 2) as usize;
             for &(g, a, b) in &DIRECTED[f] {
                 let e = lv[b] as usize * MAX_LOCAL + lv[a] as usize;
                 cn[g] = t.faces[e & (MAX_LOCAL * MAX_LOCAL - 1)];
             }
-            cells[outer].v[1] &= !CLEAR;
         }
         self.forget_local_numbers();
     }
@@ -645,6 +680,7 @@ fn run<K: Kernel>(
         free: Vec::new(),
         rng: SplitMix64::new(0xC0FFEE),
         conflicts: Vec::new(),
+        cleared: Vec::new(),
         new_tets: Vec::new(),
         loc: vec![NO_LOCAL; n + 1],
         table: Box::new(EdgeTable {

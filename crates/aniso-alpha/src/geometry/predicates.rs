@@ -258,6 +258,25 @@ pub fn orient3d(a: &Point3, b: &Point3, c: &Point3, d: &Point3) -> i32 {
 /// determinant (see [`StaticFilter`]; `+∞` skips that step).
 #[inline(always)]
 fn orient3d_with(a: &Point3, b: &Point3, c: &Point3, d: &Point3, static_bound: f64) -> i32 {
+    orient3d_stages::<true>(a, b, c, d, static_bound)
+}
+
+/// Only the static stage of [`orient3d_with`]: its sign, or `0` if the
+/// static bound does not settle it.
+#[inline(always)]
+fn orient3d_static_stage(a: &Point3, b: &Point3, c: &Point3, d: &Point3, static_bound: f64) -> i32 {
+    orient3d_stages::<false>(a, b, c, d, static_bound)
+}
+
+/// [`orient3d_with`] (`FULL`) or its static stage alone.
+#[inline(always)]
+fn orient3d_stages<const FULL: bool>(
+    a: &Point3,
+    b: &Point3,
+    c: &Point3,
+    d: &Point3,
+    static_bound: f64,
+) -> i32 {
     // Shewchuk's orient3d(a, b, c, d) = det[a − d, b − d, c − d] = −det[b − a, c − a, d − a].
     let adx = a[0] - d[0];
     let bdx = b[0] - d[0];
@@ -277,6 +296,9 @@ fn orient3d_with(a: &Point3, b: &Point3, c: &Point3, d: &Point3, static_bound: f
     }
     if -det > static_bound {
         return 1;
+    }
+    if !FULL {
+        return 0;
     }
     // Semi-static filter: Shewchuk's bound is O3D_ERRBOUND_A times the
     // permanent, and the permanent is at most 6·X·Y·Z where X, Y, Z bound
@@ -313,6 +335,33 @@ pub fn insphere(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> i
 /// determinant (see [`StaticFilter`]; `+∞` skips that step).
 #[inline(always)]
 fn insphere_with(
+    a: &Point3,
+    b: &Point3,
+    c: &Point3,
+    d: &Point3,
+    e: &Point3,
+    static_bound: f64,
+) -> i32 {
+    insphere_stages::<true>(a, b, c, d, e, static_bound)
+}
+
+/// Only the static stage of [`insphere_with`]: its sign, or `0` if the
+/// static bound does not settle it.
+#[inline(always)]
+fn insphere_static_stage(
+    a: &Point3,
+    b: &Point3,
+    c: &Point3,
+    d: &Point3,
+    e: &Point3,
+    static_bound: f64,
+) -> i32 {
+    insphere_stages::<false>(a, b, c, d, e, static_bound)
+}
+
+/// [`insphere_with`] (`FULL`) or its static stage alone.
+#[inline(always)]
+fn insphere_stages<const FULL: bool>(
     a: &Point3,
     b: &Point3,
     c: &Point3,
@@ -358,6 +407,9 @@ fn insphere_with(
     }
     if -det > static_bound {
         return 1;
+    }
+    if !FULL {
+        return 0;
     }
 
     // Semi-static filter: Shewchuk's bound is ISP_ERRBOUND_A times the
@@ -453,6 +505,34 @@ pub trait Kernel: Copy + Send + Sync {
         let _ = filter;
         Self::insphere(a, b, c, d, e)
     }
+    /// The sign of [`Kernel::orient3d_static`] when the kernel's cheap
+    /// first stage settles it (the static bound), else `0`: `0` does not
+    /// mean the points are coplanar.
+    #[inline(always)]
+    fn orient3d_quick(
+        a: &Point3,
+        b: &Point3,
+        c: &Point3,
+        d: &Point3,
+        filter: &StaticFilter,
+    ) -> i32 {
+        let _ = (a, b, c, d, filter);
+        0
+    }
+    /// The sign of [`Kernel::insphere_static`] when the kernel's cheap
+    /// first stage settles it, else `0` (not necessarily a tie).
+    #[inline(always)]
+    fn insphere_quick(
+        a: &Point3,
+        b: &Point3,
+        c: &Point3,
+        d: &Point3,
+        e: &Point3,
+        filter: &StaticFilter,
+    ) -> i32 {
+        let _ = (a, b, c, d, e, filter);
+        0
+    }
 }
 
 /// Static error bounds for the two determinants, valid for every tuple of
@@ -544,6 +624,27 @@ impl Kernel for Filtered {
     ) -> i32 {
         insphere_with(a, b, c, d, e, filter.insphere)
     }
+    #[inline(always)]
+    fn orient3d_quick(
+        a: &Point3,
+        b: &Point3,
+        c: &Point3,
+        d: &Point3,
+        filter: &StaticFilter,
+    ) -> i32 {
+        orient3d_static_stage(a, b, c, d, filter.orient)
+    }
+    #[inline(always)]
+    fn insphere_quick(
+        a: &Point3,
+        b: &Point3,
+        c: &Point3,
+        d: &Point3,
+        e: &Point3,
+        filter: &StaticFilter,
+    ) -> i32 {
+        insphere_static_stage(a, b, c, d, e, filter.insphere)
+    }
 }
 
 /// A kernel for points on a small dyadic grid (e.g. integer grids up to
@@ -606,6 +707,23 @@ impl Kernel for SmallGrid {
     #[inline(always)]
     fn insphere(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> i32 {
         -sign(insphere_det(&diffs4(a, b, c, d, e)))
+    }
+    // Both determinants are exact here, so the quick stage is the whole
+    // predicate (a tie gives 0).
+    #[inline(always)]
+    fn orient3d_quick(a: &Point3, b: &Point3, c: &Point3, d: &Point3, _: &StaticFilter) -> i32 {
+        Self::orient3d(a, b, c, d)
+    }
+    #[inline(always)]
+    fn insphere_quick(
+        a: &Point3,
+        b: &Point3,
+        c: &Point3,
+        d: &Point3,
+        e: &Point3,
+        _: &StaticFilter,
+    ) -> i32 {
+        Self::insphere(a, b, c, d, e)
     }
 }
 
@@ -1203,5 +1321,68 @@ mod tests {
         }
         // The sample reaches the rule's later steps, not only the first.
         assert!(decided_late > 20, "{decided_late}");
+    }
+
+    #[test]
+    fn quick_stages_agree_with_the_full_predicates() {
+        // Random points, and points near a common sphere and plane, where
+        // the static stage must often abstain. Whenever a quick stage
+        // answers, it equals the full predicate.
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut unif = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let filter = StaticFilter::for_box(&[-2.0; 3], &[2.0; 3]);
+        let (mut decided, mut abstained) = (0, 0);
+        for round in 0..20_000 {
+            let mut p = [[0.0; 3]; 5];
+            for q in &mut p {
+                if round % 2 == 0 {
+                    *q = [unif() * 2.0 - 1.0, unif() * 2.0 - 1.0, unif() * 2.0 - 1.0];
+                } else {
+                    // Near the unit sphere's equator, in the plane z ≈ 0.
+                    let t = unif() * std::f64::consts::TAU;
+                    *q = [t.cos(), t.sin(), (unif() - 0.5) * 1e-15];
+                }
+            }
+            let [a, b, c, d, e] = &p;
+            let o = Filtered::orient3d_quick(a, b, c, d, &filter);
+            if o != 0 {
+                assert_eq!(o, Filtered::orient3d_static(a, b, c, d, &filter));
+                assert_eq!(o, orient3d(a, b, c, d));
+            }
+            let s = Filtered::insphere_quick(a, b, c, d, e, &filter);
+            if s != 0 {
+                decided += 1;
+                assert_eq!(s, Filtered::insphere_static(a, b, c, d, e, &filter));
+                assert_eq!(s, insphere(a, b, c, d, e));
+            } else {
+                abstained += 1;
+            }
+        }
+        assert!(decided > 5000 && abstained > 5000, "{decided} {abstained}");
+        // On a small grid the quick stage is exact: it answers 0 only on
+        // ties.
+        let g = |i: u32| [(i % 3) as f64, ((i / 3) % 3) as f64, (i / 9) as f64];
+        for i in 0..27u32 {
+            let (a, b, c, d, e) = (
+                g(i),
+                g((i * 7 + 1) % 27),
+                g((i * 11 + 5) % 27),
+                g((i * 5 + 3) % 27),
+                g((i * 13 + 2) % 27),
+            );
+            assert_eq!(
+                SmallGrid::insphere_quick(&a, &b, &c, &d, &e, &filter),
+                insphere(&a, &b, &c, &d, &e)
+            );
+            assert_eq!(
+                SmallGrid::orient3d_quick(&a, &b, &c, &d, &filter),
+                orient3d(&a, &b, &c, &d)
+            );
+        }
     }
 }
