@@ -31,40 +31,59 @@ impl SplitMix64 {
 
 const HILBERT_BITS: u32 = 21;
 
+/// Points whose Hilbert keys are computed together, lane by lane (the
+/// compiler turns each lane loop into vector instructions, and the four
+/// dependency chains overlap).
+const LANES: usize = 4;
+
 /// Hilbert index of a point with integer coordinates below `2^bits`
-/// (`bits` ≤ [`HILBERT_BITS`]; Skilling's transpose algorithm: undo excess
-/// work, Gray-encode, then interleave the bits with x most significant).
-/// Written without data-dependent branches, which mispredicted about half
-/// the time (the reference form is kept in the tests).
+/// (`bits` ≤ [`HILBERT_BITS`]).
+#[cfg(test)]
+fn hilbert_key(x: [u32; 3], bits: u32) -> u64 {
+    hilbert_keys([[x[0]; LANES], [x[1]; LANES], [x[2]; LANES]], bits)[0]
+}
+
+/// Hilbert indices of [`LANES`] points, coordinate `k` of lane `l` at
+/// `x[k][l]`, each below `2^bits` (`bits` ≤ [`HILBERT_BITS`]). Skilling's
+/// transpose algorithm: undo excess work, Gray-encode, then interleave the
+/// bits with x most significant. Written without data-dependent branches,
+/// which mispredicted about half the time (the plain form is kept in the
+/// tests as the reference).
 #[inline]
-fn hilbert_key(mut x: [u32; 3], bits: u32) -> u64 {
-    let m: u32 = 1 << (bits - 1);
-    let mut q = m;
+fn hilbert_keys(mut x: [[u32; LANES]; 3], bits: u32) -> [u64; LANES] {
     let mut level = bits - 1;
-    while q > 1 {
-        let p = q - 1;
+    while level > 0 {
+        let p = (1u32 << level) - 1;
         for i in 0..3 {
-            // All ones if bit `level` of x[i] is set: then x[0] ^= p,
-            // else the low bits of x[0] and x[i] are exchanged.
-            let set = 0u32.wrapping_sub((x[i] >> level) & 1);
-            let t = (x[0] ^ x[i]) & p & !set;
-            x[0] ^= (p & set) | t;
-            x[i] ^= t;
+            for l in 0..LANES {
+                // All ones if bit `level` of x[i] is set: then x[0] ^= p,
+                // else the low bits of x[0] and x[i] are exchanged.
+                let set = 0u32.wrapping_sub((x[i][l] >> level) & 1);
+                let t = (x[0][l] ^ x[i][l]) & p & !set;
+                x[0][l] ^= (p & set) | t;
+                x[i][l] ^= t;
+            }
         }
-        q >>= 1;
         level -= 1;
     }
-    x[1] ^= x[0];
-    x[2] ^= x[1];
-    let mut t = 0u32;
-    q = m;
-    level = bits - 1;
-    while q > 1 {
-        t ^= (q - 1) & 0u32.wrapping_sub((x[2] >> level) & 1);
-        q >>= 1;
+    let mut t = [0u32; LANES];
+    for l in 0..LANES {
+        x[1][l] ^= x[0][l];
+        x[2][l] ^= x[1][l];
+    }
+    let mut level = bits - 1;
+    while level > 0 {
+        for l in 0..LANES {
+            t[l] ^= ((1u32 << level) - 1) & 0u32.wrapping_sub((x[2][l] >> level) & 1);
+        }
         level -= 1;
     }
-    spread3(x[0] ^ t) << 2 | spread3(x[1] ^ t) << 1 | spread3(x[2] ^ t)
+    let mut keys = [0u64; LANES];
+    for l in 0..LANES {
+        keys[l] =
+            spread3(x[0][l] ^ t[l]) << 2 | spread3(x[1][l] ^ t[l]) << 1 | spread3(x[2][l] ^ t[l]);
+    }
+    keys
 }
 
 /// The low 21 bits of `v` moved to bits 0, 3, 6, …, 60.
@@ -142,16 +161,16 @@ pub(crate) fn brio_order(points: &[[f64; 3]], bbox: &([f64; 3], [f64; 3]), seed:
     // resolution of the largest round.
     let bits = round_bits(bounds[0].1 - bounds[0].0);
     let shift = HILBERT_BITS - bits;
-    let keys: Vec<u64> = points
-        .iter()
-        .map(|p| {
-            let mut q = [0u32; 3];
+    let mut keys: Vec<u64> = Vec::with_capacity(n);
+    for chunk in points.chunks(LANES) {
+        let mut x = [[0u32; LANES]; 3];
+        for (l, p) in chunk.iter().enumerate() {
             for k in 0..3 {
-                q[k] = ((p[k] - lo[k]) * scale[k]).clamp(0.0, max) as u32 >> shift;
+                x[k][l] = ((p[k] - lo[k]) * scale[k]).clamp(0.0, max) as u32 >> shift;
             }
-            hilbert_key(q, bits)
-        })
-        .collect();
+        }
+        keys.extend_from_slice(&hilbert_keys(x, bits)[..chunk.len()]);
+    }
     for (s, e) in bounds {
         hilbert_sort(&keys, bits, &mut idx[s..e]);
     }
