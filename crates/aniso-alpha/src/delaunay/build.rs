@@ -310,48 +310,33 @@ impl<K: Kernel> Builder<K> {
         // replaced by q, keeping c's outer neighbour.
         self.conflicts.clear();
         self.new_tets.clear();
-        self.conflicts.push(start);
+        self.conflicts.push(start << 2);
         self.cells[start as usize].v[0] |= IN_CONFLICT;
         for x in self.cells[start as usize].n {
             prefetch(&self.cells, (x >> 2) as usize);
         }
-        let mut k = 0;
+        // The stack holds each conflict tet packed with the face through
+        // which it was found (its parent, in conflict): only the other
+        // three faces are visited.
+        {
+            let cell = self.cells[start as usize];
+            let v = [cell.v[0] & !IN_CONFLICT, cell.v[1], cell.v[2], cell.v[3]];
+            for f in 0..4 {
+                self.visit(start, &v, cell.n[f], f, vid, &q)?;
+            }
+        }
+        let mut k = 1;
         while k < self.conflicts.len() {
-            let c = self.conflicts[k];
+            let entry = self.conflicts[k];
             k += 1;
+            let c = entry >> 2;
             let cell = self.cells[c as usize];
             // The vertices without the conflict flag (cleared in a
             // register: a byte-wide clear in memory followed by a wide
             // copy stalls store forwarding).
             let v = [cell.v[0] & !IN_CONFLICT, cell.v[1], cell.v[2], cell.v[3]];
-            for f in 0..4 {
-                let outer = cell.n[f];
-                let n = (outer >> 2) as usize;
-                let nv = self.cells[n].v;
-                if nv[0] & IN_CONFLICT != 0 {
-                    continue;
-                }
-                if nv[1] & CLEAR == 0 && self.in_conflict(n, &nv, &q) {
-                    self.cells[n].v[0] |= IN_CONFLICT;
-                    for x in self.cells[n].n {
-                        prefetch(&self.cells, (x >> 2) as usize);
-                    }
-                    self.conflicts.push(n as u32);
-                    continue;
-                }
-                let nt = self.alloc()?;
-                // Written in place: building the cell on the stack with
-                // `v[f] = vid` and copying it whole stalls store forwarding.
-                let new = &mut self.cells[nt as usize];
-                new.v = v;
-                new.v[f] = vid;
-                // (Its other neighbours are set by the linking.)
-                new.n[f] = outer;
-                self.cells[n].n[(outer & 3) as usize] = pack(nt, f);
-                if self.filing {
-                    self.file_faces(nt, f, &v);
-                }
-                self.new_tets.push((pack(nt, f), c));
+            for f in OTHER[(entry & 3) as usize] {
+                self.visit(c, &v, cell.n[f], f, vid, &q)?;
             }
         }
 
@@ -381,7 +366,7 @@ impl<K: Kernel> Builder<K> {
         // Free the cavity (the dead cells are exactly the free list, which
         // is how compaction finds them; their flags do not matter, as a
         // reused cell is overwritten whole).
-        self.free.extend_from_slice(&self.conflicts);
+        self.free.extend(self.conflicts.iter().map(|&e| e >> 2));
         let cells = &self.cells[..];
         // Start the next walk from a new finite tet if there is one.
         let mut last = self.new_tets[0].0 >> 2;
@@ -393,6 +378,49 @@ impl<K: Kernel> Builder<K> {
         }
         self.last = last;
         Ok(None)
+    }
+
+    /// Visits face `f` (packed neighbour `outer`) of conflict tet `c`
+    /// (vertices `v`, flags cleared) while inserting `q` as vertex `vid`:
+    /// queues the neighbour if it is in conflict too, else builds the new
+    /// tet on the boundary facet.
+    #[inline(always)]
+    fn visit(
+        &mut self,
+        c: u32,
+        v: &[u32; 4],
+        outer: u32,
+        f: usize,
+        vid: u32,
+        q: &Point3,
+    ) -> Result<(), TetLimit> {
+        let n = (outer >> 2) as usize;
+        let nv = self.cells[n].v;
+        if nv[0] & IN_CONFLICT != 0 {
+            return Ok(());
+        }
+        if nv[1] & CLEAR == 0 && self.in_conflict(n, &nv, q) {
+            self.cells[n].v[0] |= IN_CONFLICT;
+            for x in self.cells[n].n {
+                prefetch(&self.cells, (x >> 2) as usize);
+            }
+            self.conflicts.push(outer);
+            return Ok(());
+        }
+        let nt = self.alloc()?;
+        // Written in place: building the cell on the stack with
+        // `v[f] = vid` and copying it whole stalls store forwarding.
+        let new = &mut self.cells[nt as usize];
+        new.v = *v;
+        new.v[f] = vid;
+        // (Its other neighbours are set by the linking.)
+        new.n[f] = outer;
+        self.cells[n].n[(outer & 3) as usize] = pack(nt, f);
+        if self.filing {
+            self.file_faces(nt, f, v);
+        }
+        self.new_tets.push((pack(nt, f), c));
+        Ok(())
     }
 
     /// Whether inserting `q` destroys tet `n` (vertices `nv`). A tet found
