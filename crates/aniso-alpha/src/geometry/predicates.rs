@@ -844,10 +844,24 @@ pub fn insphere_perturbed_k<K: Kernel>(
 #[inline(never)]
 fn insphere_tie<K: Kernel>(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> i32 {
     let pts: [&Point3; 5] = [a, b, c, d, e];
-    // Visit the points from the lexicographically largest down. The rank
-    // of each point (how many of the others are larger) is counted without
-    // branches: on degenerate inputs such as grids nearly every in-sphere
-    // test is a tie, and comparisons of equal coordinates mispredict.
+    // Visit the points from the lexicographically largest down. The
+    // largest usually decides alone, so it is found first by a
+    // tournament; the full ranking is only computed when its orientation
+    // is zero. Comparisons are without branches: on degenerate inputs such
+    // as grids nearly every in-sphere test is a tie, and comparisons of
+    // equal coordinates mispredict.
+    let larger = |i: usize, j: usize| if lex_less_branchless(pts[i], pts[j]) { j } else { i };
+    let top = larger(larger(larger(0, 1), larger(2, 3)), 4);
+    if top == 4 {
+        return -1;
+    }
+    let mut q = [a, b, c, d];
+    q[top] = e;
+    let o = K::orient3d(q[0], q[1], q[2], q[3]);
+    if o != 0 {
+        return o;
+    }
+    // The rank of each point (how many of the others are larger).
     let mut above = [0usize; 5];
     for i in 0..5 {
         for j in i + 1..5 {
@@ -862,7 +876,7 @@ fn insphere_tie<K: Kernel>(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &P
     for (i, &r) in above.iter().enumerate() {
         by_rank[r & 7] = i;
     }
-    for &i in &by_rank[..5] {
+    for &i in &by_rank[1..5] {
         if i == 4 {
             return -1;
         }
