@@ -850,7 +850,13 @@ fn insphere_tie<K: Kernel>(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &P
     // is zero. Comparisons are without branches: on degenerate inputs such
     // as grids nearly every in-sphere test is a tie, and comparisons of
     // equal coordinates mispredict.
-    let larger = |i: usize, j: usize| if lex_less_branchless(pts[i], pts[j]) { j } else { i };
+    let larger = |i: usize, j: usize| {
+        if lex_less_branchless(pts[i], pts[j]) {
+            j
+        } else {
+            i
+        }
+    };
     let top = larger(larger(larger(0, 1), larger(2, 3)), 4);
     if top == 4 {
         return -1;
