@@ -1292,13 +1292,8 @@ mod tests {
                 }
             }
         }
-        let mut state = 0x1234_5678_9abc_def0_u64;
-        let mut next = |n: usize| {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((state >> 33) as usize) % n
-        };
+        let mut rng = crate::synth::Rng::new(0x1234_5678);
+        let mut next = |n: usize| (rng.next_u64() % n as u64) as usize;
         let (mut ties, mut decided_late) = (0, 0);
         while ties < 3000 {
             let mut t = [0usize; 5];
@@ -1348,13 +1343,8 @@ mod tests {
         // Random points, and points near a common sphere and plane, where
         // the static stage must often abstain. Whenever a quick stage
         // answers, it equals the full predicate.
-        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut unif = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::synth::Rng::new(0x9e37_79b9);
+        let mut unif = || rng.uniform();
         let filter = StaticFilter::for_box(&[-2.0; 3], &[2.0; 3]);
         let (mut decided, mut abstained) = (0, 0);
         for round in 0..20_000 {
