@@ -109,7 +109,7 @@ fn round_bits(n: usize) -> u32 {
 /// Indices `0..keys.len()` sorted by `keys`, ties in index order: a
 /// comparison sort for short inputs, else a least-significant-digit radix
 /// sort (stable, 11-bit digits, as many passes as the largest key needs).
-fn sort_by_keys(keys: &[u64]) -> Vec<u32> {
+fn sort_by_keys(keys: Vec<u64>) -> Vec<u32> {
     let n = keys.len();
     if n < 4096 {
         let mut keyed: Vec<(u64, u32)> = keys.iter().zip(0..).map(|(&k, i)| (k, i)).collect();
@@ -119,7 +119,7 @@ fn sort_by_keys(keys: &[u64]) -> Vec<u32> {
     const DIGIT: u32 = 11;
     const BUCKETS: usize = 1 << DIGIT;
     let width = 64 - keys.iter().fold(0, |m, &k| m | k).leading_zeros();
-    let mut k0: Vec<u64> = keys.to_vec();
+    let mut k0 = keys;
     let mut i0: Vec<u32> = (0..n as u32).collect();
     let mut k1 = vec![0u64; n];
     let mut i1 = vec![0u32; n];
@@ -209,7 +209,7 @@ pub(crate) fn brio_order(points: &[[f64; 3]], bbox: &([f64; 3], [f64; 3]), seed:
             keys.push(((top - level) as u64) << round_shift | cell);
         }
     }
-    sort_by_keys(&keys)
+    sort_by_keys(keys)
 }
 
 #[cfg(test)]
@@ -339,7 +339,7 @@ mod tests {
             let keys: Vec<u64> = (0..n).map(|_| rng.next_u64() >> (64 - width)).collect();
             let mut want: Vec<(u64, u32)> = keys.iter().zip(0..).map(|(&k, i)| (k, i)).collect();
             want.sort();
-            let got = sort_by_keys(&keys);
+            let got = sort_by_keys(keys);
             assert!(
                 want.iter().map(|w| w.1).eq(got.iter().copied()),
                 "{n} {width}"
