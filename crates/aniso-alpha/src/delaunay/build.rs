@@ -310,14 +310,11 @@ impl<K: Kernel> Builder<K> {
         // replaced by q, keeping c's outer neighbour.
         self.conflicts.clear();
         self.new_tets.clear();
-        self.conflicts.push(start << 2);
-        self.cells[start as usize].v[0] |= IN_CONFLICT;
-        for x in self.cells[start as usize].n {
-            prefetch(&self.cells, (x >> 2) as usize);
-        }
         // The stack holds each conflict tet packed with the face through
         // which it was found (its parent, in conflict): only the other
-        // three faces are visited.
+        // three faces are visited. The start has no parent: its face
+        // field is unused, and all four faces are visited.
+        self.enqueue(start << 2);
         {
             let cell = self.cells[start as usize];
             let v = [cell.v[0] & !IN_CONFLICT, cell.v[1], cell.v[2], cell.v[3]];
@@ -380,6 +377,19 @@ impl<K: Kernel> Builder<K> {
         Ok(None)
     }
 
+    /// Queues tet `packed >> 2`, found in conflict through its face
+    /// `packed & 3`: flags it and prefetches its four neighbours, which
+    /// it will visit.
+    #[inline(always)]
+    fn enqueue(&mut self, packed: u32) {
+        let t = (packed >> 2) as usize;
+        self.cells[t].v[0] |= IN_CONFLICT;
+        for x in self.cells[t].n {
+            prefetch(&self.cells, (x >> 2) as usize);
+        }
+        self.conflicts.push(packed);
+    }
+
     /// Visits face `f` (packed neighbour `outer`) of conflict tet `c`
     /// (vertices `v`, flags cleared) while inserting `q` as vertex `vid`:
     /// queues the neighbour if it is in conflict too, else builds the new
@@ -400,11 +410,7 @@ impl<K: Kernel> Builder<K> {
             return Ok(());
         }
         if nv[1] & CLEAR == 0 && self.in_conflict(n, &nv, q) {
-            self.cells[n].v[0] |= IN_CONFLICT;
-            for x in self.cells[n].n {
-                prefetch(&self.cells, (x >> 2) as usize);
-            }
-            self.conflicts.push(outer);
+            self.enqueue(outer);
             return Ok(());
         }
         let nt = self.alloc()?;
