@@ -1292,8 +1292,8 @@ mod tests {
                 }
             }
         }
-        let mut rng = crate::synth::Rng::new(0x1234_5678);
-        let mut next = |n: usize| (rng.next_u64() % n as u64) as usize;
+        let mut s = 0x1234_5678u64;
+        let mut next = |n: usize| ((lcg(&mut s) >> 33) % n as u64) as usize;
         let (mut ties, mut decided_late) = (0, 0);
         while ties < 3000 {
             let mut t = [0usize; 5];
@@ -1317,9 +1317,8 @@ mod tests {
             let want = insphere_tie_by_sorting([a, b, p[2], p[3], p[4]]);
             let mut first = [a, b, p[2], p[3]];
             let largest = (0..4).fold(0, |m, k| if lex_less(first[m], first[k]) { k } else { m });
-            if !lex_less(p[4], first[largest]) {
-                // decided by the query being the largest
-            } else {
+            // (When the query is the largest, the first step decides.)
+            if lex_less(p[4], first[largest]) {
                 first[largest] = p[4];
                 if orient3d(first[0], first[1], first[2], first[3]) == 0 {
                     decided_late += 1;
@@ -1343,8 +1342,8 @@ mod tests {
         // Random points, and points near a common sphere and plane, where
         // the static stage must often abstain. Whenever a quick stage
         // answers, it equals the full predicate.
-        let mut rng = crate::synth::Rng::new(0x9e37_79b9);
-        let mut unif = || rng.uniform();
+        let mut s = 0x9e37_79b9u64;
+        let mut unif = || (lcg(&mut s) >> 11) as f64 / (1u64 << 53) as f64;
         let filter = StaticFilter::for_box(&[-2.0; 3], &[2.0; 3]);
         let (mut decided, mut abstained) = (0, 0);
         for round in 0..20_000 {
