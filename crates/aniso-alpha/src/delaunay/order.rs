@@ -216,9 +216,10 @@ pub(crate) fn brio_order(points: &[[f64; 3]], bbox: &([f64; 3], [f64; 3]), seed:
 mod tests {
     use super::*;
 
-    /// The plain form of [`hilbert_key`]: the Hilbert index of a point with integer coordinates below `2^HILBERT_BITS`
-    /// (Skilling's transpose algorithm: undo excess work, Gray-encode, then
-    /// interleave the bits with x most significant).
+    /// The plain form of [`hilbert_key`]: the Hilbert index of a point
+    /// with integer coordinates below `2^bits` (Skilling's transpose
+    /// algorithm: undo excess work, Gray-encode, then interleave the bits
+    /// with x most significant).
     fn hilbert_key_reference(mut x: [u32; 3], bits: u32) -> u64 {
         let m: u32 = 1 << (bits - 1);
         let mut q = m;
