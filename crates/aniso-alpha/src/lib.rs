@@ -29,8 +29,10 @@
 //! assert_eq!(tri.num_finite_tets(), 2);
 //! tri.validate().unwrap();
 //! ```
-// `unsafe` is denied everywhere but one cache-prefetch hint in the
-// Delaunay build (`delaunay::build::prefetch`, documented there).
+// `unsafe` is denied everywhere but in the Delaunay build: one
+// cache-prefetch hint (`delaunay::build::prefetch`) and the two calls into
+// the x86-64-v3 copies of the hot loops, made after run-time feature
+// detection (`delaunay::isa`), each documented and tested where it is.
 #![deny(unsafe_code)]
 #![deny(missing_docs)]
 // Index loops over the 4 vertices / faces of a tetrahedron read better than

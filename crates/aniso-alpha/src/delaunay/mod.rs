@@ -27,6 +27,7 @@
 //! translate to and from indices into the caller's slice.
 
 mod build;
+mod isa;
 mod order;
 mod queries;
 mod validate;

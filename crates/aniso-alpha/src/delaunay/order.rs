@@ -6,6 +6,8 @@
 //! point-location walk from the last created tetrahedron is short and the
 //! memory it touches is hot. The order is deterministic (fixed seed).
 
+use super::isa::Isa;
+
 /// A tiny deterministic PRNG (SplitMix64), good enough for drawing BRIO
 /// rounds and walk directions.
 #[derive(Clone, Debug)]
@@ -45,7 +47,7 @@ fn hilbert_key(x: [u32; 3], bits: u32) -> u64 {
 /// bits with x most significant. Written without data-dependent branches,
 /// which mispredicted about half the time (the plain form is kept in the
 /// tests as the reference).
-#[inline]
+#[inline(always)]
 fn hilbert_keys(x: [[u32; LANES]; 3], bits: u32) -> [u64; LANES] {
     let [mut x0, mut x1, mut x2] = x;
     let mut level = bits - 1;
@@ -88,7 +90,7 @@ fn hilbert_keys(x: [[u32; LANES]; 3], bits: u32) -> [u64; LANES] {
 }
 
 /// The low 21 bits of `v` moved to bits 0, 3, 6, …, 60.
-#[inline]
+#[inline(always)]
 fn spread3(v: u32) -> u64 {
     let mut x = (v & 0x1f_ffff) as u64;
     x = (x | x << 32) & 0x001f_0000_0000_ffff;
@@ -159,7 +161,37 @@ fn sort_by_keys(keys: Vec<u64>) -> Vec<u32> {
 /// time at 1M points (a longer final sweep keeps the cells it touches in
 /// cache); eighths, +2.4% instructions and no faster. `bbox` is the
 /// points' bounding box ([`crate::geometry::bounding_box`]).
-pub(crate) fn brio_order(points: &[[f64; 3]], bbox: &([f64; 3], [f64; 3]), seed: u64) -> Vec<u32> {
+///
+/// The keys are computed by a copy compiled for x86-64-v3 when `isa`
+/// allows and the CPU has it (see [`super::isa`]); the order is the same.
+#[allow(unsafe_code)]
+pub(crate) fn brio_order(
+    points: &[[f64; 3]],
+    bbox: &([f64; 3], [f64; 3]),
+    seed: u64,
+    isa: Isa,
+) -> Vec<u32> {
+    #[cfg(target_arch = "x86_64")]
+    if isa.use_v3() {
+        // SAFETY: a `#[target_feature]` function may be called only on a
+        // CPU with the features it enables, which `use_v3` checked.
+        return sort_by_keys(unsafe { brio_keys_v3(points, bbox, seed) });
+    }
+    let _ = isa;
+    sort_by_keys(brio_keys(points, bbox, seed))
+}
+
+/// [`brio_keys`] compiled for x86-64-v3 (see [`super::isa`]).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
+fn brio_keys_v3(points: &[[f64; 3]], bbox: &([f64; 3], [f64; 3]), seed: u64) -> Vec<u64> {
+    brio_keys(points, bbox, seed)
+}
+
+/// The key of each point of [`brio_order`]: its round, then its Hilbert
+/// cell at the round's resolution.
+#[inline(always)]
+fn brio_keys(points: &[[f64; 3]], bbox: &([f64; 3], [f64; 3]), seed: u64) -> Vec<u64> {
     let n = points.len();
     let (lo, hi) = *bbox;
     let max = ((1u64 << HILBERT_BITS) - 1) as f64;
@@ -209,7 +241,7 @@ pub(crate) fn brio_order(points: &[[f64; 3]], bbox: &([f64; 3], [f64; 3]), seed:
             keys.push(((top - level) as u64) << round_shift | cell);
         }
     }
-    sort_by_keys(keys)
+    keys
 }
 
 #[cfg(test)]
@@ -355,7 +387,7 @@ mod tests {
         let pts: Vec<[f64; 3]> = (0..n)
             .map(|_| [0; 3].map(|_| (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64))
             .collect();
-        let order = brio_order(&pts, &crate::geometry::bounding_box(&pts), 1);
+        let order = brio_order(&pts, &crate::geometry::bounding_box(&pts), 1, Isa::Detect);
         let step = |w: &[u32]| {
             let (p, q) = (pts[w[0] as usize], pts[w[1] as usize]);
             ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
@@ -383,8 +415,28 @@ mod tests {
                 ]
             })
             .collect();
-        let mut o = brio_order(&pts, &crate::geometry::bounding_box(&pts), 1);
+        let mut o = brio_order(&pts, &crate::geometry::bounding_box(&pts), 1, Isa::Detect);
         o.sort();
         assert!(o.iter().enumerate().all(|(i, &v)| i as u32 == v));
+    }
+
+    /// The x86-64-v3 copy of the keys gives the baseline's order.
+    #[test]
+    fn instruction_sets_give_one_order() {
+        let mut rng = SplitMix64::new(5);
+        for n in [1, 3, 100, 5000, 70_000] {
+            let pts: Vec<[f64; 3]> = (0..n)
+                .map(|_| {
+                    let mut c = || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+                    [c(), c() * 1e-3, c() * 1e6]
+                })
+                .collect();
+            let bbox = crate::geometry::bounding_box(&pts);
+            let order = brio_order(&pts, &bbox, 9, Isa::Detect);
+            assert_eq!(order, brio_order(&pts, &bbox, 9, Isa::Baseline), "n = {n}");
+            let mut seen = order.clone();
+            seen.sort_unstable();
+            assert!(seen.iter().copied().eq(0..n as u32));
+        }
     }
 }
