@@ -4,8 +4,8 @@ use super::isa::Isa;
 use super::order::{brio_order, SplitMix64};
 use super::{DelaunayError, Triangulation, INFINITE};
 use crate::geometry::predicates::{
-    collinear, coplanar_incircle_perturbed, insphere_perturbed_k, orient3d, Filtered, Kernel,
-    SmallGrid, StaticFilter,
+    collinear, coplanar_incircle_perturbed, insphere_perturbed_k, insphere_tie_keyed, orient3d,
+    Filtered, Kernel, SmallGrid, StaticFilter,
 };
 use crate::geometry::Point3;
 
@@ -108,10 +108,12 @@ fn pack(t: u32, i: usize) -> u32 {
 }
 
 /// A point of the build, padded to 32 bytes and aligned so that it never
-/// straddles two cache lines (24-byte points straddle one time in four).
+/// straddles two cache lines (24-byte points straddle one time in four),
+/// with its lexicographic key in the padding when the set has one
+/// ([`SmallGrid::lex_key`]; else 0).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(32))]
-pub(crate) struct Slot(pub(crate) Point3);
+pub(crate) struct Slot(pub(crate) Point3, u64);
 
 /// Points indexed by vertex id.
 pub(crate) trait Points {
@@ -179,6 +181,9 @@ struct Builder<K: Kernel> {
     kernel: std::marker::PhantomData<K>,
     /// Static bounds for the predicates over the whole input.
     filter: StaticFilter,
+    /// The [`SmallGrid::frame`] of the input when its lexicographic keys
+    /// are kept in the point slots and break in-sphere ties.
+    grid: Option<([f64; 3], f64)>,
     pts: Vec<Slot>,
     cells: Vec<Cell>,
     free: Vec<u32>,
@@ -466,7 +471,7 @@ impl<K: Kernel> Builder<K> {
         if nv[0] & IN_CONFLICT != 0 {
             return Ok(());
         }
-        if nv[1] & CLEAR == 0 && self.in_conflict(n, &nv, q) {
+        if nv[1] & CLEAR == 0 && self.in_conflict(n, &nv, vid, q) {
             self.enqueue(outer);
             return Ok(());
         }
@@ -493,17 +498,43 @@ impl<K: Kernel> Builder<K> {
     /// it again; the usual quick answers are cheaper to repeat than to
     /// mark and unmark.
     #[inline(always)]
-    fn in_conflict(&mut self, n: usize, nv: &[u32; 4], q: &Point3) -> bool {
+    fn in_conflict(&mut self, n: usize, nv: &[u32; 4], vid: u32, q: &Point3) -> bool {
         let quick = conflict_quick::<K, _>(&self.pts[..], nv, q, &self.filter);
         if quick != 0 {
             return quick > 0;
         }
-        let conflict = tet_in_conflict::<K, _>(&self.pts[..], nv, q, &self.filter);
+        let conflict = if K::QUICK_IS_EXACT && self.grid.is_some() && nv[3] != INFINITE {
+            // An exact quick stage answered 0: a tie.
+            self.tie_keyed(nv, vid) > 0
+        } else {
+            tet_in_conflict::<K, _>(&self.pts[..], nv, q, &self.filter)
+        };
         if !conflict {
             self.cells[n].v[1] |= CLEAR;
             self.cleared.push(n as u32);
         }
         conflict
+    }
+
+    /// The symbolic perturbation of an exact in-sphere tie between finite
+    /// tet `v` and vertex `vid`, ranking the points by the lexicographic
+    /// keys in their slots (only when `self.grid` is set): one integer
+    /// compare per comparison instead of up to three float compares (the
+    /// grid's ties are a sixth of its build).
+    #[inline(always)]
+    fn tie_keyed(&self, v: &[u32; 4], vid: u32) -> i32 {
+        let s = |w: u32| &self.pts[w as usize];
+        let pts = [s(v[0]), s(v[1]), s(v[2]), s(v[3]), s(vid)];
+        insphere_tie_keyed::<K>(pts.map(|slot| &slot.0), pts.map(|slot| slot.1))
+    }
+
+    /// The point slot of `p`, with its key if the build keeps them.
+    #[inline(always)]
+    fn slot(&self, p: &Point3) -> Slot {
+        match &self.grid {
+            Some((lo, step)) => Slot(*p, SmallGrid::lex_key(p, lo, *step)),
+            None => Slot(*p, 0),
+        }
     }
 
     /// Files the three inner faces of new tet `nt` (built on facet `f` of
@@ -698,6 +729,8 @@ struct Limits {
     max_local: usize,
     /// The instruction set of the insertion loop.
     isa: Isa,
+    /// Whether a [`SmallGrid`] input keeps lexicographic keys for ties.
+    grid_keys: bool,
 }
 
 impl Limits {
@@ -705,6 +738,7 @@ impl Limits {
         max_cells: MAX_CELLS,
         max_local: MAX_LOCAL,
         isa: Isa::Detect,
+        grid_keys: true,
     };
 }
 
@@ -749,10 +783,12 @@ fn build_with(points: &[[f64; 3]], limits: Limits) -> Result<Triangulation, Dela
     // address space, not resident memory.
     let expected_tets = (7 * n + n / 2 + 64).min(limits.max_cells);
     let filter = StaticFilter::for_box(&bbox.0, &bbox.1);
-    if SmallGrid::applies(points) {
-        run::<SmallGrid>(points, &order, init, expected_tets, limits, filter)
-    } else {
-        run::<Filtered>(points, &order, init, expected_tets, limits, filter)
+    match SmallGrid::frame(points) {
+        Some(frame) => {
+            let grid = limits.grid_keys.then_some(frame);
+            run::<SmallGrid>(points, &order, init, expected_tets, limits, filter, grid)
+        }
+        None => run::<Filtered>(points, &order, init, expected_tets, limits, filter, None),
     }
 }
 
@@ -764,12 +800,14 @@ fn run<K: Kernel>(
     expected_tets: usize,
     limits: Limits,
     filter: StaticFilter,
+    grid: Option<([f64; 3], f64)>,
 ) -> Result<Triangulation, DelaunayError> {
     let n = points.len();
     let too_many = |_: TetLimit| DelaunayError::TooManyTets(n);
     let mut b = Builder::<K> {
         kernel: std::marker::PhantomData,
         filter,
+        grid,
         pts: Vec::with_capacity(n),
         cells: Vec::with_capacity(expected_tets),
         free: Vec::new(),
@@ -805,7 +843,7 @@ fn run<K: Kernel>(
         s.swap(0, 1);
     }
     for (v, &i) in s.iter().enumerate() {
-        b.pts.push(Slot(points[i as usize]));
+        b.pts.push(b.slot(&points[i as usize]));
         vert_input.push(i);
         input_vert[i as usize] = v as u32;
     }
@@ -860,7 +898,7 @@ fn insert_loop<K: Kernel>(
                 continue; // one of the initial four
             }
             let vid = b.pts.len() as u32;
-            b.pts.push(Slot(*p));
+            b.pts.push(b.slot(p));
             match b.insert(vid)? {
                 None => vert_input.push(i),
                 Some(w) => {
@@ -1124,6 +1162,46 @@ mod tests {
                 assert!(v3.input_vert == base.input_vert, "{name}");
                 assert!(v3.vert_input == base.vert_input, "{name}");
             }
+        }
+    }
+
+    /// Breaking in-sphere ties on a small grid by the keys kept in the
+    /// point slots gives the triangulation the plain tie-break gives, on
+    /// a grid (where most tests tie) and on cospherical integer points.
+    #[test]
+    fn grid_keys_agree() {
+        let grid: Vec<[f64; 3]> = (0..1728)
+            .map(|i| {
+                [
+                    (i % 12) as f64 * 0.5,
+                    (i / 12 % 12) as f64,
+                    (i / 144) as f64 - 7.0,
+                ]
+            })
+            .collect();
+        let mut sphere = vec![[0.0; 3]];
+        for x in -29i32..=29 {
+            for y in -29i32..=29 {
+                for z in -29i32..=29 {
+                    if x * x + y * y + z * z == 841 {
+                        sphere.push([x as f64, y as f64, z as f64]);
+                    }
+                }
+            }
+        }
+        for pts in [&grid, &sphere] {
+            let run = |grid_keys| {
+                let limits = Limits {
+                    grid_keys,
+                    ..Limits::DEFAULT
+                };
+                build_with(pts, limits).unwrap()
+            };
+            let (keyed, plain) = (run(true), run(false));
+            keyed.validate().unwrap();
+            assert!(keyed.cells.len() > pts.len());
+            assert!(keyed.cells == plain.cells);
+            assert!(keyed.input_vert == plain.input_vert);
         }
     }
 

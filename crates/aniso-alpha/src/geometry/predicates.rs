@@ -519,6 +519,9 @@ pub trait Kernel: Copy + Send + Sync {
         let _ = (a, b, c, d, filter);
         0
     }
+    /// Whether the quick stages are exact, so that their `0` is a tie
+    /// (only for the inputs the kernel is valid for).
+    const QUICK_IS_EXACT: bool = false;
     /// The sign of [`Kernel::insphere_static`] when the kernel's cheap
     /// first stage settles it, else `0` (not necessarily a tie).
     #[inline(always)]
@@ -660,6 +663,12 @@ pub struct SmallGrid;
 impl SmallGrid {
     /// Whether the points satisfy the condition of [`SmallGrid`].
     pub fn applies(points: &[Point3]) -> bool {
+        Self::frame(points).is_some()
+    }
+
+    /// The grid of a set [`SmallGrid::applies`] to: the lowest coordinate
+    /// per axis and the step `2^L` (1 for a set of zeros), else `None`.
+    pub(crate) fn frame(points: &[Point3]) -> Option<([f64; 3], f64)> {
         let mut lo = [f64::INFINITY; 3];
         let mut hi = [f64::NEG_INFINITY; 3];
         let mut low_bit = i32::MAX;
@@ -667,7 +676,7 @@ impl SmallGrid {
             for k in 0..3 {
                 let x = p[k];
                 if !x.is_finite() {
-                    return false;
+                    return None;
                 }
                 lo[k] = lo[k].min(x);
                 hi[k] = hi[k].max(x);
@@ -675,7 +684,7 @@ impl SmallGrid {
                     let bits = x.to_bits();
                     let exp = ((bits >> 52) & 0x7ff) as i32;
                     if exp == 0 {
-                        return false; // subnormal
+                        return None; // subnormal
                     }
                     let mant = (bits & ((1u64 << 52) - 1)) | (1u64 << 52);
                     low_bit = low_bit.min(exp - 1075 + mant.trailing_zeros() as i32);
@@ -683,19 +692,30 @@ impl SmallGrid {
             }
         }
         if low_bit == i32::MAX {
-            return true; // all zero
+            return Some(([0.0; 3], 1.0)); // all zero
         }
         let step = 2f64.powi(low_bit);
         if step == 0.0 || !step.is_normal() {
-            return false;
+            return None;
         }
-        (0..3).all(|k| {
+        let fits = (0..3).all(|k| {
             // Every coordinate is k·step with |k| < 2^52 (so differences of
             // coordinates are exact) and the extent is below 2^9 steps.
             (hi[k] - lo[k]) / step < 512.0
                 && lo[k].abs() / step < 4.5e15
                 && hi[k].abs() / step < 4.5e15
-        })
+        });
+        fits.then_some((lo, step))
+    }
+
+    /// A key of point `p` of a set with [`SmallGrid::frame`] `(lo, step)`
+    /// that orders the set lexicographically: its grid coordinates, each
+    /// below 2^9 and exact (`p − lo` is a multiple of `step` below 2^9
+    /// steps, and dividing by a power of two is exact), packed x first.
+    #[inline]
+    pub(crate) fn lex_key(p: &Point3, lo: &[f64; 3], step: f64) -> u64 {
+        let g = |k: usize| ((p[k] - lo[k]) / step) as u64;
+        g(0) << 18 | g(1) << 9 | g(2)
     }
 }
 
@@ -710,6 +730,7 @@ impl Kernel for SmallGrid {
     }
     // Both determinants are exact here, so the quick stage is the whole
     // predicate (a tie gives 0).
+    const QUICK_IS_EXACT: bool = true;
     #[inline(always)]
     fn orient3d_quick(a: &Point3, b: &Point3, c: &Point3, d: &Point3, _: &StaticFilter) -> i32 {
         Self::orient3d(a, b, c, d)
@@ -844,6 +865,23 @@ pub fn insphere_perturbed_k<K: Kernel>(
 #[inline(never)]
 fn insphere_tie<K: Kernel>(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> i32 {
     let pts: [&Point3; 5] = [a, b, c, d, e];
+    tie_by::<K>(pts, |i, j| lex_less_branchless(pts[i], pts[j]))
+}
+
+/// [`insphere_tie`] for points whose lexicographic order is already known
+/// as integer keys: `keys[i] < keys[j]` exactly when point `i` is
+/// lexicographically smaller than point `j` (as [`SmallGrid::lex_key`]
+/// gives), so each comparison is one integer compare. Same result.
+#[inline(never)]
+pub(crate) fn insphere_tie_keyed<K: Kernel>(pts: [&Point3; 5], keys: [u64; 5]) -> i32 {
+    tie_by::<K>(pts, |i, j| keys[i] < keys[j])
+}
+
+/// The tie rule over points `a, b, c, d, e` (`e` the query) given their
+/// lexicographic comparison `less(i, j)`.
+#[inline(always)]
+fn tie_by<K: Kernel>(pts: [&Point3; 5], less: impl Fn(usize, usize) -> bool) -> i32 {
+    let [a, b, c, d, e] = pts;
     // Visit the points from the lexicographically largest down. The
     // largest usually decides alone, so it is found first by a
     // tournament; the full ranking is only computed when its orientation
@@ -851,7 +889,7 @@ fn insphere_tie<K: Kernel>(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &P
     // as grids nearly every in-sphere test is a tie, and comparisons of
     // equal coordinates mispredict.
     let larger = |i: usize, j: usize| {
-        if lex_less_branchless(pts[i], pts[j]) {
+        if less(i, j) {
             j
         } else {
             i
@@ -871,7 +909,7 @@ fn insphere_tie<K: Kernel>(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &P
     let mut above = [0usize; 5];
     for i in 0..5 {
         for j in i + 1..5 {
-            let lt = lex_less_branchless(pts[i], pts[j]) as usize;
+            let lt = less(i, j) as usize;
             above[i] += lt;
             above[j] += 1 - lt;
         }
@@ -1335,6 +1373,56 @@ mod tests {
         }
         // The sample reaches the rule's later steps, not only the first.
         assert!(decided_late > 20, "{decided_late}");
+    }
+
+    /// The grid keys order a small-grid set as `lex_less` does, and the
+    /// keyed tie-break agrees with the plain one on every tie, including
+    /// those decided after the first step.
+    #[test]
+    fn keyed_tie_matches_lex_tie() {
+        // A dyadic grid (step 1/4) shifted to negative and large offsets.
+        let mut s = 0x9e37_79b9u64;
+        let mut next = |n: u64| (lcg(&mut s) >> 33) % n;
+        for offset in [0.0, -3.25, 1e6] {
+            let grid: Vec<Point3> = (0..200)
+                .map(|_| {
+                    let mut c = || offset + 0.25 * next(6) as f64 - 0.5;
+                    [c(), c(), c()]
+                })
+                .collect();
+            let (lo, step) = SmallGrid::frame(&grid).expect("a small grid");
+            let key = |p: &Point3| SmallGrid::lex_key(p, &lo, step);
+            for p in &grid {
+                for q in &grid {
+                    assert_eq!(key(p) < key(q), lex_less(p, q), "{p:?} {q:?}");
+                }
+            }
+            let (mut ties, mut tries) = (0, 0);
+            while ties < 2000 {
+                tries += 1;
+                assert!(tries < 10_000_000);
+                let t: Vec<&Point3> = (0..5).map(|_| &grid[next(200) as usize]).collect();
+                if (0..5).any(|i| (i + 1..5).any(|j| t[i] == t[j])) {
+                    continue;
+                }
+                let (mut a, mut b) = (t[0], t[1]);
+                match orient3d(a, b, t[2], t[3]) {
+                    0 => continue,
+                    o if o < 0 => std::mem::swap(&mut a, &mut b),
+                    _ => {}
+                }
+                if insphere(a, b, t[2], t[3], t[4]) != 0 {
+                    continue;
+                }
+                ties += 1;
+                let pts = [a, b, t[2], t[3], t[4]];
+                assert_eq!(
+                    insphere_tie_keyed::<SmallGrid>(pts, pts.map(key)),
+                    insphere_perturbed(a, b, t[2], t[3], t[4]),
+                    "{pts:?}"
+                );
+            }
+        }
     }
 
     #[test]
