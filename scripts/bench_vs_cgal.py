@@ -20,7 +20,8 @@ Timed regions (in-process, I/O excluded on both sides):
             CGAL = `cgal_alpha` Delaunay + Alpha_shape_3 GENERAL construction.
 Peak RSS is /usr/bin/time's maximum resident set size of the whole process
 (input arrays included on both sides). Repetitions are interleaved; the
-table shows medians. The machine is shared: read the ratios, not the
+table shows medians, the ratio of the two medians ("time ratio") and the
+median of the per-rep ratios (ours / CGAL of the same rep). The machine is shared: read the ratios, not the
 absolute seconds, and note the load average printed with them.
 """
 import argparse
@@ -110,14 +111,15 @@ def main():
     print(f"load average before: {open('/proc/loadavg').read().split()[:3]}")
     print(f"our threads: {args.threads or 'all cores'} (of {os.cpu_count()})")
     print()
-    print(f"| {args.what} | ours (s) | CGAL (s) | time ratio | ours RSS (MiB) | CGAL RSS (MiB) | RSS ratio | counts | all reps ours / CGAL (s) |")
-    print("|---|---:|---:|---:|---:|---:|---:|---|---|")
+    print(f"| {args.what} | ours (s) | CGAL (s) | time ratio | per-rep ratio | ours RSS (MiB) | CGAL RSS (MiB) | RSS ratio | counts | all reps ours / CGAL (s) |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---|---|")
     for s in args.sets:
         data = os.path.join(PEERS, "data", s + ".bin")
         ot, ct, om, cm, ol, cl, info = run_case(args.what, data, args.reps, args.threads)
         counts = ", ".join(f"{k} {v}" for k, v in info.items())
         reps = "; ".join(f"{a:.3f}/{b:.3f}" for a, b in zip(ol, cl))
-        print(f"| {s} | {ot:.3f} | {ct:.3f} | {ot / ct:.2f} | {om:.0f} | {cm:.0f} | {om / cm:.2f} | {counts} | {reps} |")
+        per_rep = statistics.median(a / b for a, b in zip(ol, cl))
+        print(f"| {s} | {ot:.3f} | {ct:.3f} | {ot / ct:.2f} | {per_rep:.2f} | {om:.0f} | {cm:.0f} | {om / cm:.2f} | {counts} | {reps} |")
     print()
     print(f"load average after: {open('/proc/loadavg').read().split()[:3]}")
 
