@@ -1060,6 +1060,23 @@ mod tests {
         assert_eq!(tri.num_vertices(), 2000);
     }
 
+    /// The centre and the integer points on the sphere x² + y² + z² = r2
+    /// (cospherical: in-sphere tests among the points on the sphere tie).
+    fn integer_sphere(r2: i32) -> Vec<[f64; 3]> {
+        let r = (r2 as f64).sqrt() as i32 + 1;
+        let mut sphere = vec![[0.0; 3]];
+        for x in -r..=r {
+            for y in -r..=r {
+                for z in -r..=r {
+                    if x * x + y * y + z * z == r2 {
+                        sphere.push([x as f64, y as f64, z as f64]);
+                    }
+                }
+            }
+        }
+        sphere
+    }
+
     /// The pair table and the rotation link the new tets identically, also
     /// when a cavity outgrows the table part way through an insertion
     /// (small `max_local`) and on cospherical points, where inserting the
@@ -1073,16 +1090,7 @@ mod tests {
             .map(|i| [(i % 8) as f64, (i / 8 % 8) as f64, (i / 64) as f64])
             .collect();
         // The 672 integer points with x² + y² + z² = 1154, and the centre.
-        let mut sphere = vec![[0.0; 3]];
-        for x in -34i32..=34 {
-            for y in -34i32..=34 {
-                for z in -34i32..=34 {
-                    if x * x + y * y + z * z == 1154 {
-                        sphere.push([x as f64, y as f64, z as f64]);
-                    }
-                }
-            }
-        }
+        let sphere = integer_sphere(1154);
         assert_eq!(sphere.len(), 673);
         for pts in [&uniform, &grid, &sphere] {
             let tets = |max_local| {
@@ -1179,16 +1187,7 @@ mod tests {
                 ]
             })
             .collect();
-        let mut sphere = vec![[0.0; 3]];
-        for x in -29i32..=29 {
-            for y in -29i32..=29 {
-                for z in -29i32..=29 {
-                    if x * x + y * y + z * z == 841 {
-                        sphere.push([x as f64, y as f64, z as f64]);
-                    }
-                }
-            }
-        }
+        let sphere = integer_sphere(841);
         for pts in [&grid, &sphere] {
             let run = |grid_keys| {
                 let limits = Limits {

@@ -1288,6 +1288,22 @@ mod tests {
         assert_eq!(insphere_perturbed(&a, &b, &c, &d, &cube[7]), -1);
     }
 
+    /// Five distinct points whose first four are not coplanar, with the
+    /// first two swapped if needed to orient them positively, when the
+    /// fifth is exactly on their sphere (an in-sphere tie); else `None`.
+    fn tie_tuple(p: [&Point3; 5]) -> Option<[&Point3; 5]> {
+        if (0..5).any(|i| (i + 1..5).any(|j| p[i] == p[j])) {
+            return None;
+        }
+        let [mut a, mut b, c, d, e] = p;
+        match orient3d(a, b, c, d) {
+            0 => return None,
+            o if o < 0 => std::mem::swap(&mut a, &mut b),
+            _ => {}
+        }
+        (insphere(a, b, c, d, e) == 0).then_some([a, b, c, d, e])
+    }
+
     /// The symbolic rule written the plain way: sort the five points
     /// lexicographically, then apply the rule from the largest down.
     fn insphere_tie_by_sorting(pts: [&Point3; 5]) -> i32 {
@@ -1338,37 +1354,24 @@ mod tests {
             for k in 0..5 {
                 t[k] = next(grid.len());
             }
-            let p: Vec<&Point3> = t.iter().map(|&k| &grid[k]).collect();
-            if (0..5).any(|i| (i + 1..5).any(|j| p[i] == p[j])) {
+            let Some([a, b, c, d, e]) = tie_tuple(t.map(|k| &grid[k])) else {
                 continue;
-            }
-            let (mut a, mut b) = (p[0], p[1]);
-            match orient3d(a, b, p[2], p[3]) {
-                0 => continue,
-                o if o < 0 => std::mem::swap(&mut a, &mut b),
-                _ => {}
-            }
-            if insphere(a, b, p[2], p[3], p[4]) != 0 {
-                continue;
-            }
+            };
             ties += 1;
-            let want = insphere_tie_by_sorting([a, b, p[2], p[3], p[4]]);
-            let mut first = [a, b, p[2], p[3]];
+            let want = insphere_tie_by_sorting([a, b, c, d, e]);
+            let mut first = [a, b, c, d];
             let largest = (0..4).fold(0, |m, k| if lex_less(first[m], first[k]) { k } else { m });
             // (When the query is the largest, the first step decides.)
-            if lex_less(p[4], first[largest]) {
-                first[largest] = p[4];
+            if lex_less(e, first[largest]) {
+                first[largest] = e;
                 if orient3d(first[0], first[1], first[2], first[3]) == 0 {
                     decided_late += 1;
                 }
             }
             assert_eq!(
-                insphere_perturbed(a, b, p[2], p[3], p[4]),
+                insphere_perturbed(a, b, c, d, e),
                 want,
-                "{a:?} {b:?} {:?} {:?} {:?}",
-                p[2],
-                p[3],
-                p[4]
+                "{a:?} {b:?} {c:?} {d:?} {e:?}"
             );
         }
         // The sample reaches the rule's later steps, not only the first.
@@ -1401,24 +1404,15 @@ mod tests {
             while ties < 2000 {
                 tries += 1;
                 assert!(tries < 10_000_000);
-                let t: Vec<&Point3> = (0..5).map(|_| &grid[next(200) as usize]).collect();
-                if (0..5).any(|i| (i + 1..5).any(|j| t[i] == t[j])) {
+                let drawn = [0; 5].map(|_| &grid[next(200) as usize]);
+                let Some(pts) = tie_tuple(drawn) else {
                     continue;
-                }
-                let (mut a, mut b) = (t[0], t[1]);
-                match orient3d(a, b, t[2], t[3]) {
-                    0 => continue,
-                    o if o < 0 => std::mem::swap(&mut a, &mut b),
-                    _ => {}
-                }
-                if insphere(a, b, t[2], t[3], t[4]) != 0 {
-                    continue;
-                }
+                };
                 ties += 1;
-                let pts = [a, b, t[2], t[3], t[4]];
+                let [a, b, c, d, e] = pts;
                 assert_eq!(
                     insphere_tie_keyed::<SmallGrid>(pts, pts.map(key)),
-                    insphere_perturbed(a, b, t[2], t[3], t[4]),
+                    insphere_perturbed(a, b, c, d, e),
                     "{pts:?}"
                 );
             }
