@@ -1060,6 +1060,20 @@ mod tests {
         assert_eq!(tri.num_vertices(), 2000);
     }
 
+    /// `n` points drawn uniformly in the unit cube (seed `seed`).
+    fn uniform_points(seed: u64, n: usize) -> Vec<[f64; 3]> {
+        let mut rng = SplitMix64::new(seed);
+        let mut unif = || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+        (0..n).map(|_| [unif(), unif(), unif()]).collect()
+    }
+
+    /// The integer grid k × k × k, x fastest.
+    fn int_grid(k: usize) -> Vec<[f64; 3]> {
+        (0..k * k * k)
+            .map(|i| [(i % k) as f64, (i / k % k) as f64, (i / (k * k)) as f64])
+            .collect()
+    }
+
     /// The centre and the integer points on the sphere x² + y² + z² = r2
     /// (cospherical: in-sphere tests among the points on the sphere tie).
     fn integer_sphere(r2: i32) -> Vec<[f64; 3]> {
@@ -1083,12 +1097,8 @@ mod tests {
     /// centre late makes one cavity of every tet.
     #[test]
     fn table_and_rotation_linking_agree() {
-        let mut rng = SplitMix64::new(7);
-        let mut unif = || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
-        let uniform: Vec<[f64; 3]> = (0..3000).map(|_| [unif(), unif(), unif()]).collect();
-        let grid: Vec<[f64; 3]> = (0..512)
-            .map(|i| [(i % 8) as f64, (i / 8 % 8) as f64, (i / 64) as f64])
-            .collect();
+        let uniform = uniform_points(7, 3000);
+        let grid = int_grid(8);
         // The 672 integer points with x² + y² + z² = 1154, and the centre.
         let sphere = integer_sphere(1154);
         assert_eq!(sphere.len(), 673);
@@ -1128,18 +1138,16 @@ mod tests {
         if !crate::delaunay::isa::has_v3() {
             eprintln!("this CPU lacks x86-64-v3: only the baseline copy runs");
         }
-        let mut rng = SplitMix64::new(11);
-        let mut unif = || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
-        let uniform: Vec<[f64; 3]> = (0..20_000).map(|_| [unif(), unif(), unif()]).collect();
-        let grid: Vec<[f64; 3]> = (0..1000)
-            .map(|i| [(i % 10) as f64, (i / 10 % 10) as f64, (i / 100) as f64])
-            .collect();
+        let uniform = uniform_points(11, 20_000);
+        let grid = int_grid(10);
         // A grid under a shear and a non-dyadic scale: the filtered
         // kernel, with exact and near ties.
         let affine: Vec<[f64; 3]> = grid
             .iter()
             .map(|p| [0.1 * p[0] + 0.3 * p[1], 0.7 * p[1], 0.1 * p[2] - 0.2 * p[0]])
             .collect();
+        let mut rng = SplitMix64::new(12);
+        let mut unif = || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
         let sphere: Vec<[f64; 3]> = (0..2000)
             .map(|_| {
                 let (a, b) = (unif() * std::f64::consts::TAU, unif() * 2.0 - 1.0);
