@@ -212,7 +212,7 @@ struct Builder<K: Kernel> {
     /// (lower in tests of the limit).
     max_cells: usize,
     /// Whether insertions run the x86-64-v3 copy of the code (set only
-    /// when [`has_v3`] holds).
+    /// when [`has_v3`](super::isa::has_v3) holds).
     v3: bool,
 }
 
@@ -317,8 +317,9 @@ impl<K: Kernel> Builder<K> {
 
     /// Inserts point `q` as vertex `vid`; returns the vertex it duplicates,
     /// if any (then nothing changes), or [`TetLimit`]. Runs the copy
-    /// compiled for the best instruction set the CPU has (see [`has_v3`]),
-    /// unless the build limits ask for the baseline.
+    /// compiled for the best instruction set the CPU has (see
+    /// [`has_v3`](super::isa::has_v3)), unless the build limits ask for
+    /// the baseline.
     #[inline(always)]
     #[allow(unsafe_code)]
     fn insert(&mut self, vid: u32) -> Result<Option<u32>, TetLimit> {
@@ -337,7 +338,7 @@ impl<K: Kernel> Builder<K> {
     fn insert_baseline(&mut self, vid: u32) -> Result<Option<u32>, TetLimit> {
         let q = self.pts[vid as usize].0;
         let start = self.locate(&q);
-        self.insert_at(vid, &q, start)
+        self.insert_at(vid, q, start)
     }
 
     /// [`Builder::insert`] compiled for x86-64-v3: the same source, and
@@ -351,14 +352,13 @@ impl<K: Kernel> Builder<K> {
     fn insert_v3(&mut self, vid: u32) -> Result<Option<u32>, TetLimit> {
         let q = self.pts[vid as usize].0;
         let start = self.locate_v3(&q);
-        self.insert_at(vid, &q, start)
+        self.insert_at(vid, q, start)
     }
 
     /// Inserts `q`, vertex `vid`, whose walk ended at tet `start` (see
     /// [`Builder::insert`]).
     #[inline(always)]
-    fn insert_at(&mut self, vid: u32, q: &Point3, start: u32) -> Result<Option<u32>, TetLimit> {
-        let q = *q;
+    fn insert_at(&mut self, vid: u32, q: Point3, start: u32) -> Result<Option<u32>, TetLimit> {
         // A duplicate lies on a vertex of the located (finite) tet.
         for &w in &self.cells[start as usize].v {
             if w != INFINITE && self.pts[w as usize].0 == q {

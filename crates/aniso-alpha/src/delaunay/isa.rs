@@ -10,8 +10,8 @@
 //! result bit for bit: Rust never fuses or reorders floating-point
 //! operations, whatever the target features (no FMA instruction is
 //! emitted unless `mul_add` is called, and the crate never calls it on
-//! these paths). The v3 copy executes about 12% fewer instructions on the
-//! 50³ grid and 7% fewer on uniform points (BENCHMARKS.md).
+//! these paths). The v3 copy executes about 13% fewer instructions on the
+//! 50³ grid and 8.5% fewer on uniform points (BENCHMARKS.md).
 
 /// Instruction sets the build's hot loops can run on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
