@@ -672,22 +672,33 @@ impl SmallGrid {
         let mut lo = [f64::INFINITY; 3];
         let mut hi = [f64::NEG_INFINITY; 3];
         let mut low_bit = i32::MAX;
-        for p in points {
-            for k in 0..3 {
-                let x = p[k];
-                if !x.is_finite() {
-                    return None;
-                }
-                lo[k] = lo[k].min(x);
-                hi[k] = hi[k].max(x);
-                if x != 0.0 {
-                    let bits = x.to_bits();
-                    let exp = ((bits >> 52) & 0x7ff) as i32;
-                    if exp == 0 {
-                        return None; // subnormal
+        for chunk in points.chunks(256) {
+            for p in chunk {
+                for k in 0..3 {
+                    let x = p[k];
+                    if !x.is_finite() {
+                        return None;
                     }
-                    let mant = (bits & ((1u64 << 52) - 1)) | (1u64 << 52);
-                    low_bit = low_bit.min(exp - 1075 + mant.trailing_zeros() as i32);
+                    lo[k] = lo[k].min(x);
+                    hi[k] = hi[k].max(x);
+                    if x != 0.0 {
+                        let bits = x.to_bits();
+                        let exp = ((bits >> 52) & 0x7ff) as i32;
+                        if exp == 0 {
+                            return None; // subnormal
+                        }
+                        let mant = (bits & ((1u64 << 52) - 1)) | (1u64 << 52);
+                        low_bit = low_bit.min(exp - 1075 + mant.trailing_zeros() as i32);
+                    }
+                }
+            }
+            // The step only shrinks and the extent only grows: a set that
+            // is already 512 steps wide never becomes a small grid (most
+            // float inputs stop here after their first chunk).
+            if low_bit != i32::MAX {
+                let step = 2f64.powi(low_bit);
+                if !(0..3).all(|k| (hi[k] - lo[k]) / step < 512.0) {
+                    return None;
                 }
             }
         }
@@ -1157,6 +1168,25 @@ mod tests {
             [1e6, 0.0, 0.0],
             [1e6 + 5.0, 0.5, 0.0]
         ]));
+        // Over several chunks of the scan: a coarse first chunk refined
+        // later still fits; a grid spoilt by its last point does not.
+        let coarse_then_fine: Vec<Point3> = (0..600)
+            .map(|i| {
+                let x = if i < 300 {
+                    8 * (i % 32)
+                } else {
+                    2 * (i % 128) + 1
+                };
+                [x as f64, (i % 7) as f64, 0.0]
+            })
+            .collect();
+        assert_eq!(SmallGrid::frame(&coarse_then_fine), Some(([0.0; 3], 1.0)));
+        let mut spoilt = coarse_then_fine.clone();
+        spoilt.push([0.5, 0.0, 700.0]);
+        assert!(!SmallGrid::applies(&spoilt));
+        spoilt.pop();
+        spoilt.push([0.25, 0.0, 0.0]);
+        assert!(!SmallGrid::applies(&spoilt)); // 255 / 0.25 ≥ 512 steps
     }
 
     #[test]
