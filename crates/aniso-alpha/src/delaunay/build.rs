@@ -81,7 +81,8 @@ struct EdgeTable {
 /// tests of the tets queued before it (about 8% of the build at 1M
 /// points, see BENCHMARKS.md). No effect on results; a no-op off x86_64.
 ///
-/// This is the crate's only `unsafe`: `_mm_prefetch` is a `#[target_feature
+/// One of the crate's three `unsafe` calls (the others enter the x86-64-v3
+/// copies, see [`super::isa`]): `_mm_prefetch` is a `#[target_feature
 /// (enable = "sse")]` function, and SSE is part of the x86_64 baseline. A
 /// prefetch is a hint that never dereferences in the language's sense and
 /// never faults, whatever the address (`prefetch_never_faults` passes
@@ -859,35 +860,8 @@ fn run<K: Kernel>(
     link_by_faces(&mut b.cells, &[0, 1, 2, 3, 4]);
     b.last = t0;
 
-    insert_loop(
-        &mut b,
-        points,
-        order,
-        init,
-        &mut vert_input,
-        &mut input_vert,
-    )
-    .map_err(too_many)?;
-    // The inputs that became vertices, in one pass after the build (these
-    // scattered stores stalled the insertion loop).
-    for (v, &i) in vert_input.iter().enumerate() {
-        input_vert[i as usize] = v as u32;
-    }
-    Ok(compact(b, vert_input, input_vert))
-}
-
-/// The insertion loop of [`run`]: inserts every point of `order` but the
-/// initial four, recording which input became which vertex.
-fn insert_loop<K: Kernel>(
-    b: &mut Builder<K>,
-    points: &[Point3],
-    order: &[u32],
-    init: [u32; 4],
-    vert_input: &mut Vec<u32>,
-    input_vert: &mut [u32],
-) -> Result<(), TetLimit> {
     // The points are gathered in insertion order a chunk at a time: the
-    // order is a shuffle of the input, and independent loads overlap their
+    // order jumps around the input, and independent loads overlap their
     // cache misses where loads inside the insertion loop would not.
     let mut chunk: Vec<Point3> = Vec::with_capacity(GATHER);
     for ids in order.chunks(GATHER) {
@@ -899,7 +873,7 @@ fn insert_loop<K: Kernel>(
             }
             let vid = b.pts.len() as u32;
             b.pts.push(b.slot(p));
-            match b.insert(vid)? {
+            match b.insert(vid).map_err(too_many)? {
                 None => vert_input.push(i),
                 Some(w) => {
                     b.pts.pop();
@@ -913,7 +887,12 @@ fn insert_loop<K: Kernel>(
             }
         }
     }
-    Ok(())
+    // The inputs that became vertices, in one pass after the build (these
+    // scattered stores stalled the insertion loop).
+    for (v, &i) in vert_input.iter().enumerate() {
+        input_vert[i as usize] = v as u32;
+    }
+    Ok(compact(b, vert_input, input_vert))
 }
 
 /// Links the faces of a few tets by brute force (used for the first five).
@@ -1091,7 +1070,7 @@ mod tests {
         sphere
     }
 
-    /// The pair table and the rotation link the new tets identically, also
+    /// The edge table and the rotation link the new tets identically, also
     /// when a cavity outgrows the table part way through an insertion
     /// (small `max_local`) and on cospherical points, where inserting the
     /// centre late makes one cavity of every tet.
