@@ -10,6 +10,9 @@
 //!   ties are broken and hence the triangulation itself.
 //! * The oriented α-shape surface is closed: every directed edge of a
 //!   regular triangle is matched by the opposite directed edge.
+//! * Every interval is ordered, and an edge's contains each of its
+//!   triangles' exactly, after rounding too, on degenerate sets where
+//!   radii computed by different formulas tie.
 
 mod common;
 use aniso_alpha::alpha::{q_matrix, AlphaComplex};
@@ -54,6 +57,69 @@ fn points_strategy() -> impl Strategy<Value = Vec<[f64; 3]>> {
     prop::collection::vec(prop::array::uniform3(-10.0f64..10.0), 5..60)
 }
 
+/// Points of a small decimal grid (step 0.1, not dyadic): many ties
+/// between radii computed by different formulas.
+fn decimal_grid_strategy() -> impl Strategy<Value = Vec<[f64; 3]>> {
+    prop::collection::vec(
+        prop::array::uniform3((0u8..16).prop_map(|k| f64::from(k) * 0.1)),
+        4..40,
+    )
+}
+
+/// Asserts that every interval of `ac` is ordered, and that every edge's
+/// interval contains each of its triangles' (exactly, no slack).
+fn assert_nested(ac: &AlphaComplex) {
+    for e in 0..ac.num_edges() {
+        let (lo, hi) = ac.edge_interval(e);
+        assert!(0.0 <= lo && lo <= hi, "edge {e}: [{lo}, {hi}]");
+    }
+    for f in 0..ac.num_triangles() {
+        let (lo, hi) = ac.triangle_interval(f);
+        assert!(0.0 <= lo && lo <= hi, "triangle {f}: [{lo}, {hi}]");
+        let [a, b, c] = ac.triangle_vertices(f);
+        for (x, y) in [(a, b), (b, c), (c, a)] {
+            let (elo, ehi) = ac.edge_interval(ac.find_edge(x, y).unwrap());
+            assert!(
+                elo <= lo && hi <= ehi,
+                "edge [{elo}, {ehi}] vs its triangle [{lo}, {hi}]"
+            );
+        }
+    }
+}
+
+/// Found by the `alpha` fuzz target: a Gabriel triangle whose incident
+/// tet has the triangle's diametral sphere as circumsphere. Its ρ and the
+/// tet's circumradius are the same real number, computed by different
+/// formulas, and rounded one unit apart: the interval came out as
+/// [1.0712142642814275, 1.0712142642814273], empty.
+#[test]
+fn tied_radii_keep_intervals_ordered() {
+    let pts = [
+        [1.0, 1.1, 0.2],
+        [0.0, 0.0, 0.0],
+        [0.30000000000000004, 0.0, 0.0],
+        [0.0, 1.5, 1.5],
+        [1.5, 0.2, 0.0],
+        [0.0, 0.0, 1.5],
+    ];
+    assert_nested(&AlphaComplex::from_points(&pts).unwrap());
+    // Found by `intervals_nest_on_decimal_grids`: one tet, with a right
+    // angle at a vertex, so an edge's half length ties its triangle's ρ.
+    let tet = [
+        [0.1, 0.7000000000000001, 1.2000000000000002],
+        [0.30000000000000004, 0.8, 1.3],
+        [0.9, 0.8, 0.0],
+        [0.5, 0.6000000000000001, 0.5],
+    ];
+    assert_nested(&AlphaComplex::from_points(&tet).unwrap());
+    // Grids tie everywhere: a cube's space diagonal is as long as its
+    // tets' circumdiameter.
+    let grid: Vec<[f64; 3]> = (0..125)
+        .map(|k| [k % 5, k / 5 % 5, k / 25].map(|c| f64::from(c) * 0.1))
+        .collect();
+    assert_nested(&AlphaComplex::from_points(&grid).unwrap());
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(128))]
 
@@ -84,6 +150,13 @@ proptest! {
             let (lo2, hi2) = a.get(k).copied().unwrap_or((f64::NAN, f64::NAN));
             prop_assert!(close(*lo, lo2) && close(*hi, hi2),
                 "{:?}: [{}, {}] vs rotated [{}, {}]", k, lo, hi, lo2, hi2);
+        }
+    }
+
+    #[test]
+    fn intervals_nest_on_decimal_grids(pts in decimal_grid_strategy()) {
+        if let Ok(ac) = AlphaComplex::from_points(&pts) {
+            assert_nested(&ac);
         }
     }
 

@@ -19,6 +19,12 @@
 //!   [`exact`]); otherwise the smallest `α_min` of the simplices one
 //!   dimension up (for a triangle: the smallest circumradius of its finite
 //!   incident tets; for an edge: the smallest `α_min` of its triangles).
+//! * Rounding: a Gabriel simplex's `ρ(σ)` is at most every `α_min` one
+//!   dimension up, and equal when a vertex lies on σ's smallest
+//!   circumsphere, as on grids. The two are computed by different formulas
+//!   and can round one unit apart, so the stored `α_min` of a Gabriel
+//!   simplex is the minimum of the two. Every interval is then ordered,
+//!   and an edge's contains each of its triangles', exactly.
 //!
 //! # Algorithm and storage
 //!
@@ -589,9 +595,14 @@ impl AlphaComplex {
             if slot[0].is_sign_negative() {
                 slot[0] = -slot[0];
             } else {
+                // Half the length is at most each triangle's α_min (equal
+                // when a third vertex is on the diametral sphere); the min
+                // keeps that after rounding, and with it the edge's
+                // interval containing each of its triangles'.
                 let (p, q) = (&pts[a as usize], &pts[b as usize]);
                 let d = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
-                slot[0] = 0.5 * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                let half = 0.5 * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                slot[0] = half.min(slot[0]);
             }
         }
         self.tri_face = tri_face;
@@ -670,7 +681,11 @@ impl TriangleCtx<'_> {
                 let gabriel = (mt >> i) & 1 == 0 && (bn >> j) & 1 == 0;
                 let amax = rt.max(rn);
                 let amin = if gabriel {
-                    triangle_rho_sorted(pts, [ia, ib, ic])
+                    // ρ is at most either circumradius, with equality when
+                    // an apex lies on the diametral sphere; the two are
+                    // computed by different formulas and can round apart,
+                    // so the min keeps the interval ordered.
+                    triangle_rho_sorted(pts, [ia, ib, ic]).min(rt).min(rn)
                 } else {
                     rt.min(rn)
                 };
