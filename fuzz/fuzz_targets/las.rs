@@ -20,5 +20,9 @@ fn check(r: Result<PointCloud, IoError>) {
 }
 
 fuzz_target!(|data: &[u8]| {
-    check(read_las_bytes(Path::new("fuzz.las"), data, &ReadOptions::with_labels(3)));
+    check(read_las_bytes(
+        Path::new("fuzz.las"),
+        data,
+        &ReadOptions::with_labels(3),
+    ));
 });

@@ -25,7 +25,11 @@ fuzz_target!(|data: &[u8]| {
         Some((b, rest)) => (*b & 1 == 1, rest),
         None => (false, data),
     };
-    let options = if labels { ReadOptions::with_labels(3) } else { ReadOptions::default() };
+    let options = if labels {
+        ReadOptions::with_labels(3)
+    } else {
+        ReadOptions::default()
+    };
     check(read_xyz_bytes(Path::new("fuzz.xyz"), bytes, &options));
     let _ = read_labels_bytes(Path::new("fuzz.txt"), bytes);
 });
