@@ -177,3 +177,41 @@ fn progress_and_cancellation() {
         Err(aniso_alpha::detect::detector::DetectError::Cancelled)
     );
 }
+
+/// Found by the `detect` fuzz target: an exact duplicate of a structure's
+/// point had the structure's label but part label −1, because parts list
+/// first occurrences only. Both labels now follow the first occurrence.
+#[test]
+fn duplicates_take_their_first_occurrences_labels() {
+    let id = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    let pts = [[-4.0, -4.0, -4.0], [-4.0, -4.0, -4.0], [-3.0, -2.0, 0.0]];
+    let det = Detector::lines(1000.0, 4.0, 1)
+        .rotations(vec![id])
+        .run(&pts)
+        .unwrap();
+    assert_eq!(det.first_occurrence, [0, 0, 2]);
+    assert_eq!(det.labels, [0, 0, 0]);
+    assert_eq!(det.part_labels(), [0, 0, 0]);
+
+    // A scene with every point repeated (the copies after the originals,
+    // one of them as -0.0): same structures, and each copy labelled as
+    // its original.
+    let scene = SceneOptions::lines().seed(1).generate().unwrap();
+    let n = scene.points.len();
+    let mut pts = scene.points.clone();
+    pts.extend(
+        scene
+            .points
+            .iter()
+            .map(|p| p.map(|c| if c == 0.0 { -0.0 } else { c })),
+    );
+    let once = Detector::lines(1.0, 10.0, 4).run(&scene.points).unwrap();
+    let twice = Detector::lines(1.0, 10.0, 4).run(&pts).unwrap();
+    assert_eq!(twice.structures, once.structures);
+    assert_eq!(twice.labels[..n], once.labels[..]);
+    assert_eq!(twice.labels[n..], once.labels[..]);
+    let (p1, p2) = (once.part_labels(), twice.part_labels());
+    assert_eq!(p2[..n], p1[..]);
+    assert_eq!(p2[n..], p1[..]);
+    assert!(twice.first_occurrence[n..].iter().copied().eq(0..n as u32));
+}

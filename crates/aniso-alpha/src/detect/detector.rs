@@ -592,11 +592,16 @@ impl<'a> Detector<'a> {
             simplices.push(vs.to_vec());
             simplex_structure.push(cand);
         }
-        let mut labels: Vec<i64> = vstruct
+        // Simplices refer to first occurrences only: duplicates take their
+        // first occurrence's label.
+        let first_occurrence = first_occurrences(points);
+        let labels: Vec<i64> = first_occurrence
             .iter()
-            .map(|&s| if s == u32::MAX { -1 } else { s as i64 })
+            .map(|&f| match vstruct[f as usize] {
+                u32::MAX => -1,
+                s => s as i64,
+            })
             .collect();
-        copy_labels_to_duplicates(points, &mut labels);
         let mut stats = stats;
         stats.structure_simplices = simplices.len();
         Detection {
@@ -605,6 +610,7 @@ impl<'a> Detector<'a> {
             simplex_structure,
             structures,
             labels,
+            first_occurrence,
             stats,
         }
     }
@@ -866,34 +872,23 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-/// Gives every exact duplicate of a labelled point the same label.
-fn copy_labels_to_duplicates(points: &[[f64; 3]], labels: &mut [i64]) {
-    let mut idx: Vec<u32> = (0..points.len() as u32).collect();
-    idx.sort_unstable_by(|&a, &b| {
+/// Per point, the index of the first point with the same coordinates
+/// (itself when no earlier point has them).
+fn first_occurrences(points: &[[f64; 3]]) -> Vec<u32> {
+    let mut first: Vec<u32> = (0..points.len() as u32).collect();
+    let mut idx = first.clone();
+    // A stable sort: each run of equal points starts with its first index.
+    idx.sort_by(|&a, &b| {
         points[a as usize]
             .partial_cmp(&points[b as usize])
             .unwrap_or(std::cmp::Ordering::Equal)
     });
-    let mut i = 0;
-    while i < idx.len() {
-        let mut j = i + 1;
-        while j < idx.len() && points[idx[j] as usize] == points[idx[i] as usize] {
-            j += 1;
+    for w in idx.windows(2) {
+        if points[w[1] as usize] == points[w[0] as usize] {
+            first[w[1] as usize] = first[w[0] as usize];
         }
-        if j - i > 1 {
-            let best = idx[i..j]
-                .iter()
-                .map(|&k| labels[k as usize])
-                .filter(|&l| l >= 0)
-                .min();
-            if let Some(l) = best {
-                for &k in &idx[i..j] {
-                    labels[k as usize] = l;
-                }
-            }
-        }
-        i = j;
     }
+    first
 }
 
 struct OrientationResult<S> {
@@ -1025,15 +1020,20 @@ pub struct Detection {
     /// The structures, largest first.
     pub structures: Vec<Structure>,
     /// Per input point: the id of the largest structure containing it, or
-    /// −1 (background).
+    /// −1 (background). An exact duplicate has its first occurrence's.
     pub labels: Vec<i64>,
+    /// Per input point: the index of the first input point with the same
+    /// coordinates (itself when no earlier point has them). Simplices,
+    /// structures and parts list first occurrences only (SPEC §7).
+    pub first_occurrence: Vec<u32>,
     /// Counters.
     pub stats: RunStats,
 }
 
 impl Detection {
     /// Per input point: the global id of the largest part containing it
-    /// (parts numbered structure by structure, largest first), or −1.
+    /// (parts numbered structure by structure, largest first), or −1. An
+    /// exact duplicate has its first occurrence's.
     pub fn part_labels(&self) -> Vec<i64> {
         let mut labels = vec![-1i64; self.labels.len()];
         let mut best = vec![0usize; self.labels.len()];
@@ -1048,6 +1048,9 @@ impl Detection {
                 }
                 id += 1;
             }
+        }
+        for (i, &f) in self.first_occurrence.iter().enumerate() {
+            labels[i] = labels[f as usize];
         }
         labels
     }
