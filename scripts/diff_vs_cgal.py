@@ -1,10 +1,12 @@
 #!/usr/bin/env python3
-"""Differential test of our Delaunay tetrahedralization against CGAL's, on
-many generated degenerate and near-degenerate point sets.
+"""Differential test of our Delaunay tetrahedralization and alpha
+intervals against CGAL's, on many generated degenerate and near-degenerate
+point sets.
 
     python3 scripts/diff_vs_cgal.py                  # 200 cases, seed 1
     python3 scripts/diff_vs_cgal.py --cases 1000 --seed 7
     python3 scripts/diff_vs_cgal.py --families sphere grid_affine
+    python3 scripts/diff_vs_cgal.py --what alpha     # intervals vs cgal_intervals
 
 CGAL's perturbed Delaunay triangulation is unique whatever the insertion
 order, and ours follows the same perturbation (SPEC §1), so the two sets of
@@ -17,6 +19,12 @@ Both write one tet per line as input indices; both keep the first index of
 a set of duplicates. A mismatch is re-checked with `cgal_verify`, and the
 case is kept under `target/diff_vs_cgal/failures/` with both outputs.
 Exit status 1 when any case differs or a program fails.
+
+With `--what alpha`, our CLI's `alpha --intervals` CSV is compared with
+`cgal_intervals` (CGAL's `Alpha_shape_3` over an exact kernel, each value
+the double nearest to the exact radius): the same edges and triangles,
+`inf` at the same places, and every finite value within 1e-9 relative (the
+tolerance of the fixture tests); the largest deviation seen is printed.
 
 Families (each case draws its sizes and maps from the seeded generator):
   grid          integer n1 x n2 x n3 grid, a random subset, shuffled
@@ -160,8 +168,45 @@ def canon(path):
         return sorted(tuple(sorted(int(t) for t in line.split())) for line in f if line.strip())
 
 
+def read_intervals(path):
+    t = {}
+    with open(path) as f:
+        next(f)  # header
+        for line in f:
+            dim, v0, v1, v2, lo, hi = line.strip().split(",")
+            t[(int(dim), int(v0), int(v1), int(v2) if v2 else -1)] = (float(lo), float(hi))
+    return t
+
+
+def rel_dev(a, b):
+    if math.isinf(a) or math.isinf(b):
+        return 0.0 if a == b else math.inf
+    m = max(abs(a), abs(b))
+    return abs(a - b) / m if m > 0 else 0.0
+
+
+def compare_alpha(xyz, d):
+    ours_c = os.path.join(d, "ours.csv")
+    cgal_c = os.path.join(d, "cgal.csv")
+    o = subprocess.run([OURS, "alpha", xyz, "--intervals", ours_c], capture_output=True, text=True)
+    c = subprocess.run([os.path.join(PEERS, "cgal_intervals"), xyz, cgal_c],
+                       capture_output=True, text=True)
+    if o.returncode != 0 or c.returncode != 0:
+        return "program failed", (f"ours {o.returncode}: {o.stderr.strip()[:200]}; "
+                                  f"cgal {c.returncode}: {c.stderr.strip()[:200]}"), 0.0
+    a, b = read_intervals(ours_c), read_intervals(cgal_c)
+    if a.keys() != b.keys():
+        return "DIFFERENT", (f"simplices: {len(a.keys() - b.keys())} only ours, "
+                             f"{len(b.keys() - a.keys())} only CGAL's"), 0.0
+    dev = max((max(rel_dev(x[0], y[0]), rel_dev(x[1], y[1])) for x, y in
+               ((a[key], b[key]) for key in a)), default=0.0)
+    if dev > 1e-9:
+        return "DIFFERENT", f"largest relative deviation {dev:.3g}", dev
+    return "equal", f"{len(a)} simplices, largest relative deviation {dev:.3g}", dev
+
+
 def run_case(case):
-    k, fam, seed = case
+    k, fam, seed, what = case
     rng = random.Random(seed)
     pts = family_points(fam, rng)
     d = os.path.join(WORK, f"case{k:05d}")
@@ -170,23 +215,34 @@ def run_case(case):
     with open(xyz, "w") as f:
         for p in pts:
             f.write(f"{p[0]!r} {p[1]!r} {p[2]!r}\n")
+    if what == "alpha":
+        status, info, dev = compare_alpha(xyz, d)
+        if status == "equal":
+            shutil.rmtree(d)
+        else:
+            fail = os.path.join(WORK, "failures", f"case{k:05d}_{fam}")
+            shutil.rmtree(fail, ignore_errors=True)
+            shutil.move(d, fail)
+        return (k, fam, seed, len(pts), status, info, dev)
     ours_t = os.path.join(d, "ours.tets")
     cgal_t = os.path.join(d, "cgal.tets")
     o = subprocess.run([OURS, "delaunay", xyz, "--tets", ours_t], capture_output=True, text=True)
     c = subprocess.run([os.path.join(PEERS, "cgal_tets"), xyz, cgal_t], capture_output=True, text=True)
     if o.returncode != 0 or c.returncode != 0:
         return (k, fam, seed, len(pts), "program failed",
-                f"ours {o.returncode}: {o.stderr.strip()[:200]}; cgal {c.returncode}: {c.stderr.strip()[:200]}")
+                f"ours {o.returncode}: {o.stderr.strip()[:200]}; cgal {c.returncode}: {c.stderr.strip()[:200]}",
+                0.0)
     a, b = canon(ours_t), canon(cgal_t)
     if a == b:
         shutil.rmtree(d)
-        return (k, fam, seed, len(pts), "equal", f"{len(a)} tets")
+        return (k, fam, seed, len(pts), "equal", f"{len(a)} tets", 0.0)
     v = subprocess.run([os.path.join(PEERS, "cgal_verify"), xyz, ours_t], capture_output=True, text=True)
     fail = os.path.join(WORK, "failures", f"case{k:05d}_{fam}")
     shutil.rmtree(fail, ignore_errors=True)
     shutil.move(d, fail)
     return (k, fam, seed, len(pts), "DIFFERENT",
-            f"ours {len(a)} tets, CGAL {len(b)}; cgal_verify on ours: {v.stdout.strip()[:200]}")
+            f"ours {len(a)} tets, CGAL {len(b)}; cgal_verify on ours: {v.stdout.strip()[:200]}",
+            0.0)
 
 
 def main():
@@ -195,20 +251,24 @@ def main():
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--families", nargs="+", default=FAMILIES, choices=FAMILIES)
     ap.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
+    ap.add_argument("--what", choices=["delaunay", "alpha"], default="delaunay")
     args = ap.parse_args()
-    if not os.path.exists(os.path.join(PEERS, "cgal_tets")):
-        sys.exit("target/peers/bin/cgal_tets not found: run scripts/bench_vs_cgal.py once to build the peers")
+    peer = "cgal_tets" if args.what == "delaunay" else "cgal_intervals"
+    if not os.path.exists(os.path.join(PEERS, peer)):
+        sys.exit(f"target/peers/bin/{peer} not found: run scripts/bench_vs_cgal.py once to build the peers")
     subprocess.run(["cargo", "build", "--release", "-q", "-p", "aniso-alpha-cli"], cwd=ROOT, check=True)
     shutil.rmtree(WORK, ignore_errors=True)
     os.makedirs(WORK)
     master = random.Random(args.seed)
-    cases = [(k, args.families[k % len(args.families)], master.getrandbits(63))
+    cases = [(k, args.families[k % len(args.families)], master.getrandbits(63), args.what)
              for k in range(args.cases)]
     with ThreadPoolExecutor(args.jobs) as ex:
         results = list(ex.map(run_case, cases))
     tally = {}
     bad = 0
-    for k, fam, seed, n, status, info in results:
+    worst = 0.0
+    for k, fam, seed, n, status, info, dev in results:
+        worst = max(worst, dev)
         t = tally.setdefault(fam, [0, 0, 0])
         t[0] += 1
         t[1] += n
@@ -222,7 +282,11 @@ def main():
         if fam in tally:
             t = tally[fam]
             print(f"| {fam} | {t[0]} | {t[1]} | {t[2]} |")
-    print(f"{len(results) - bad} of {len(results)} cases equal to CGAL, tet for tet")
+    if args.what == "delaunay":
+        print(f"{len(results) - bad} of {len(results)} cases equal to CGAL, tet for tet")
+    else:
+        print(f"{len(results) - bad} of {len(results)} cases with CGAL's simplices and intervals; "
+              f"largest relative deviation of a value: {worst:.3g}")
     sys.exit(1 if bad else 0)
 
 
