@@ -11,31 +11,12 @@
 //! second run gives the same result.
 #![no_main]
 
+use aniso_alpha::aniso::rotation_from_euler;
 use aniso_alpha::detect::detector::{DetectError, Detection, Detector};
 use libfuzzer_sys::fuzz_target;
 
 mod points;
 use points::decode;
-
-/// R_z(a) R_x(b) R_y(c).
-fn rotation(a: f64, b: f64, c: f64) -> [[f64; 3]; 3] {
-    let (sa, ca) = a.sin_cos();
-    let (sb, cb) = b.sin_cos();
-    let (sc, cc) = c.sin_cos();
-    let rz = [[ca, -sa, 0.0], [sa, ca, 0.0], [0.0, 0.0, 1.0]];
-    let rx = [[1.0, 0.0, 0.0], [0.0, cb, -sb], [0.0, sb, cb]];
-    let ry = [[cc, 0.0, sc], [0.0, 1.0, 0.0], [-sc, 0.0, cc]];
-    let mul = |p: [[f64; 3]; 3], q: [[f64; 3]; 3]| {
-        let mut m = [[0.0; 3]; 3];
-        for i in 0..3 {
-            for j in 0..3 {
-                m[i][j] = (0..3).map(|k| p[i][k] * q[k][j]).sum();
-            }
-        }
-        m
-    };
-    mul(mul(rz, rx), ry)
-}
 
 fn check(d: &Detection, points: &[[f64; 3]], k: usize) {
     let n = points.len();
@@ -103,7 +84,7 @@ fuzz_target!(|data: &[u8]| {
     let turn = |b: u8| f64::from(b) * std::f64::consts::PI / 128.0;
     let rotations: Vec<[[f64; 3]; 3]> = angles
         .chunks_exact(3)
-        .map(|c| rotation(turn(c[0]), turn(c[1]), turn(c[2])))
+        .map(|c| rotation_from_euler(turn(c[0]), turn(c[1]), turn(c[2])))
         .collect();
     let points = decode(rest);
     let lines = head[0] & 1 == 0;
