@@ -16,8 +16,9 @@ read by both programs: our CLI's `delaunay` command and the peer program
 `cgal_tets` (see `scripts/bench_vs_cgal.py` for the setup; this script
 expects `target/peers/bin/cgal_tets` and builds our CLI in release mode).
 Both write one tet per line as input indices; both keep the first index of
-a set of duplicates. A mismatch is re-checked with `cgal_verify`, and the
-case is kept under `target/diff_vs_cgal/failures/` with both outputs.
+a set of duplicates. A mismatch is re-checked with `cgal_verify`. A case
+that differs, or on which a program fails, is kept under
+`target/diff_vs_cgal/failures/` with both outputs.
 Exit status 1 when any case differs or a program fails.
 
 With `--what alpha`, our CLI's `alpha --intervals` CSV is compared with
@@ -185,15 +186,37 @@ def rel_dev(a, b):
     return abs(a - b) / m if m > 0 else 0.0
 
 
+def run_both(ours_args, peer, peer_args):
+    """Runs our CLI and a CGAL peer program; on a failure of either, the
+    message to report, else None."""
+    o = subprocess.run([OURS] + ours_args, capture_output=True, text=True)
+    c = subprocess.run([os.path.join(PEERS, peer)] + peer_args, capture_output=True, text=True)
+    if o.returncode != 0 or c.returncode != 0:
+        return (f"ours {o.returncode}: {o.stderr.strip()[:200]}; "
+                f"cgal {c.returncode}: {c.stderr.strip()[:200]}")
+    return None
+
+
+def compare_delaunay(xyz, d):
+    ours_t = os.path.join(d, "ours.tets")
+    cgal_t = os.path.join(d, "cgal.tets")
+    failed = run_both(["delaunay", xyz, "--tets", ours_t], "cgal_tets", [xyz, cgal_t])
+    if failed:
+        return "program failed", failed, 0.0
+    a, b = canon(ours_t), canon(cgal_t)
+    if a == b:
+        return "equal", f"{len(a)} tets", 0.0
+    v = subprocess.run([os.path.join(PEERS, "cgal_verify"), xyz, ours_t], capture_output=True, text=True)
+    return ("DIFFERENT",
+            f"ours {len(a)} tets, CGAL {len(b)}; cgal_verify on ours: {v.stdout.strip()[:200]}", 0.0)
+
+
 def compare_alpha(xyz, d):
     ours_c = os.path.join(d, "ours.csv")
     cgal_c = os.path.join(d, "cgal.csv")
-    o = subprocess.run([OURS, "alpha", xyz, "--intervals", ours_c], capture_output=True, text=True)
-    c = subprocess.run([os.path.join(PEERS, "cgal_intervals"), xyz, cgal_c],
-                       capture_output=True, text=True)
-    if o.returncode != 0 or c.returncode != 0:
-        return "program failed", (f"ours {o.returncode}: {o.stderr.strip()[:200]}; "
-                                  f"cgal {c.returncode}: {c.stderr.strip()[:200]}"), 0.0
+    failed = run_both(["alpha", xyz, "--intervals", ours_c], "cgal_intervals", [xyz, cgal_c])
+    if failed:
+        return "program failed", failed, 0.0
     a, b = read_intervals(ours_c), read_intervals(cgal_c)
     if a.keys() != b.keys():
         return "DIFFERENT", (f"simplices: {len(a.keys() - b.keys())} only ours, "
@@ -206,6 +229,8 @@ def compare_alpha(xyz, d):
 
 
 def run_case(case):
+    """Writes one generated set, compares the two programs on it, and keeps
+    the case's files under failures/ unless they agree."""
     k, fam, seed, what = case
     rng = random.Random(seed)
     pts = family_points(fam, rng)
@@ -215,34 +240,15 @@ def run_case(case):
     with open(xyz, "w") as f:
         for p in pts:
             f.write(f"{p[0]!r} {p[1]!r} {p[2]!r}\n")
-    if what == "alpha":
-        status, info, dev = compare_alpha(xyz, d)
-        if status == "equal":
-            shutil.rmtree(d)
-        else:
-            fail = os.path.join(WORK, "failures", f"case{k:05d}_{fam}")
-            shutil.rmtree(fail, ignore_errors=True)
-            shutil.move(d, fail)
-        return (k, fam, seed, len(pts), status, info, dev)
-    ours_t = os.path.join(d, "ours.tets")
-    cgal_t = os.path.join(d, "cgal.tets")
-    o = subprocess.run([OURS, "delaunay", xyz, "--tets", ours_t], capture_output=True, text=True)
-    c = subprocess.run([os.path.join(PEERS, "cgal_tets"), xyz, cgal_t], capture_output=True, text=True)
-    if o.returncode != 0 or c.returncode != 0:
-        return (k, fam, seed, len(pts), "program failed",
-                f"ours {o.returncode}: {o.stderr.strip()[:200]}; cgal {c.returncode}: {c.stderr.strip()[:200]}",
-                0.0)
-    a, b = canon(ours_t), canon(cgal_t)
-    if a == b:
+    compare = compare_alpha if what == "alpha" else compare_delaunay
+    status, info, dev = compare(xyz, d)
+    if status == "equal":
         shutil.rmtree(d)
-        return (k, fam, seed, len(pts), "equal", f"{len(a)} tets", 0.0)
-    v = subprocess.run([os.path.join(PEERS, "cgal_verify"), xyz, ours_t], capture_output=True, text=True)
-    fail = os.path.join(WORK, "failures", f"case{k:05d}_{fam}")
-    shutil.rmtree(fail, ignore_errors=True)
-    shutil.move(d, fail)
-    return (k, fam, seed, len(pts), "DIFFERENT",
-            f"ours {len(a)} tets, CGAL {len(b)}; cgal_verify on ours: {v.stdout.strip()[:200]}",
-            0.0)
+    else:
+        fail = os.path.join(WORK, "failures", f"case{k:05d}_{fam}")
+        shutil.rmtree(fail, ignore_errors=True)
+        shutil.move(d, fail)
+    return (k, fam, seed, len(pts), status, info, dev)
 
 
 def main():
