@@ -14,7 +14,7 @@ use aniso_alpha::alpha::AlphaComplex;
 use libfuzzer_sys::fuzz_target;
 
 mod points;
-use points::decode;
+use points::{coordinate_key, decode};
 
 /// Relative slack for comparing intervals computed from differently
 /// ordered vertices.
@@ -28,10 +28,7 @@ fn le(a: f64, b: f64) -> bool {
 fn table(ac: &AlphaComplex) -> BTreeMap<Vec<[u64; 3]>, (f64, f64)> {
     let tri = ac.triangulation();
     let key = |vs: &[u32]| {
-        let mut k: Vec<[u64; 3]> = vs
-            .iter()
-            .map(|&v| tri.point(v).map(|c| (c + 0.0).to_bits()))
-            .collect();
+        let mut k: Vec<[u64; 3]> = vs.iter().map(|&v| coordinate_key(tri.point(v))).collect();
         k.sort_unstable();
         k
     };

@@ -13,11 +13,11 @@ use aniso_alpha::delaunay::{DelaunayError, Triangulation};
 use libfuzzer_sys::fuzz_target;
 
 mod points;
-use points::decode;
+use points::{coordinate_key, decode};
 
 /// The finite tets as sorted quadruples of coordinate bit patterns.
 fn by_coordinates(tri: &Triangulation) -> Vec<[[u64; 3]; 4]> {
-    let key = |v: u32| tri.point(v).map(|c| (c + 0.0).to_bits());
+    let key = |v: u32| coordinate_key(tri.point(v));
     let mut tets: Vec<[[u64; 3]; 4]> = tri
         .finite_tets()
         .map(|t| {

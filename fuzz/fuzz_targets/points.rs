@@ -28,3 +28,10 @@ pub fn decode(data: &[u8]) -> Vec<[f64; 3]> {
         .map(|c| [c[0], c[1], c[2]])
         .collect()
 }
+
+/// A point as a comparable key: its coordinates' bits, with −0.0 taken as
+/// 0.0 (the build merges the two, so either may be the kept vertex).
+#[allow(dead_code)] // each target compiles this module; `detect` has no use for it
+pub fn coordinate_key(p: &[f64; 3]) -> [u64; 3] {
+    p.map(|c| (c + 0.0).to_bits())
+}
