@@ -21,8 +21,9 @@ Timed regions (in-process, I/O excluded on both sides):
 Peak RSS is /usr/bin/time's maximum resident set size of the whole process
 (input arrays included on both sides). Repetitions are interleaved; the
 table shows medians, the ratio of the two medians ("time ratio") and the
-median of the per-rep ratios (ours / CGAL of the same rep). The machine is shared: read the ratios, not the
-absolute seconds, and note the load average printed with them.
+median of the per-rep ratios (ours / CGAL of the same rep). The machine is
+shared: read the ratios, not the absolute seconds, and note the load
+average printed with them.
 """
 import argparse
 import json
