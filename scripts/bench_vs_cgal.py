@@ -6,6 +6,7 @@ the ratios (ours / CGAL) of time and peak RSS as a Markdown table.
     python3 scripts/bench_vs_cgal.py --what alpha --sets uniform_100k uniform_1m
     python3 scripts/bench_vs_cgal.py --reps 5 --sets grid50
     python3 scripts/bench_vs_cgal.py --what alpha --threads 1   # our side on one core
+    python3 scripts/bench_vs_cgal.py --build-threads 2 --sets uniform_1m   # parallel build
 
 Setup (once): CGAL from Debian (`apt-get install libcgal-dev libgmp-dev
 libmpfr-dev`), numpy (`pip install numpy`). The script copies the peer
@@ -71,7 +72,7 @@ def timed(cmd, env=None):
     return json.loads(line), rss / 1024.0
 
 
-def run_case(what, data, reps, threads=None):
+def run_case(what, data, reps, threads=None, build_threads=1):
     ours_bin = os.path.join(ROOT, "target", "release", "examples",
                             "triangulate" if what == "delaunay" else "alpha_time")
     cgal_bin = os.path.join(PEERS, "bin", "cgal_delaunay" if what == "delaunay" else "cgal_alpha")
@@ -80,8 +81,9 @@ def run_case(what, data, reps, threads=None):
     env = dict(os.environ)
     if threads:
         env["RAYON_NUM_THREADS"] = str(threads)
+    extra = ["--threads", str(build_threads)] if build_threads > 1 else []
     for _ in range(reps):
-        o, om = timed([ours_bin, data], env)
+        o, om = timed([ours_bin, data] + extra, env)
         c, cm = timed([cgal_bin, data])
         if what == "delaunay":
             ours_t.append(o["time_s"])
@@ -104,19 +106,23 @@ def main():
     ap.add_argument("--sets", nargs="+", default=["uniform_100k", "uniform_1m", "grid50"])
     ap.add_argument("--reps", type=int, default=3)
     ap.add_argument("--threads", type=int, default=None,
-                    help="threads for our side (RAYON_NUM_THREADS; default: all cores). "
-                         "The triangulation is single-threaded either way; the alpha "
-                         "intervals use rayon. CGAL's programs are single-threaded.")
+                    help="threads for our side (RAYON_NUM_THREADS; default: all cores): "
+                         "the alpha intervals use rayon. CGAL's programs are single-threaded.")
+    ap.add_argument("--build-threads", type=int, default=1,
+                    help="threads of our triangulation (default 1: the single-threaded "
+                         "build; more runs the parallel build).")
     args = ap.parse_args()
     setup()
     print(f"load average before: {open('/proc/loadavg').read().split()[:3]}")
-    print(f"our threads: {args.threads or 'all cores'} (of {os.cpu_count()})")
+    print(f"our threads: {args.threads or 'all cores'} (of {os.cpu_count()}); "
+          f"build threads: {args.build_threads}")
     print()
     print(f"| {args.what} | ours (s) | CGAL (s) | time ratio | per-rep ratio | ours RSS (MiB) | CGAL RSS (MiB) | RSS ratio | counts | all reps ours / CGAL (s) |")
     print("|---|---:|---:|---:|---:|---:|---:|---:|---|---|")
     for s in args.sets:
         data = os.path.join(PEERS, "data", s + ".bin")
-        ot, ct, om, cm, ol, cl, info = run_case(args.what, data, args.reps, args.threads)
+        ot, ct, om, cm, ol, cl, info = run_case(args.what, data, args.reps, args.threads,
+                                                  args.build_threads)
         counts = ", ".join(f"{k} {v}" for k, v in info.items())
         reps = "; ".join(f"{a:.3f}/{b:.3f}" for a, b in zip(ol, cl))
         per_rep = statistics.median(a / b for a, b in zip(ol, cl))

@@ -59,10 +59,11 @@ pub fn run(args: &AlphaArgs, timings: &mut Timings) -> Result<(), CliError> {
     let bar = common::spinner("triangulating");
     let tri = timings
         .phase("triangulate", || {
+            let threads = rayon::current_num_threads();
             if euclidean {
-                Triangulation::new(&cloud.points)
+                Triangulation::with_threads(&cloud.points, threads)
             } else {
-                Triangulation::new(&aniso.transform(&cloud.points))
+                Triangulation::with_threads(&aniso.transform(&cloud.points), threads)
             }
         })
         .map_err(|err| CliError::in_file(&args.input, err))?;

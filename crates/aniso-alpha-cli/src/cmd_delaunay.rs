@@ -30,7 +30,9 @@ pub fn run(args: &DelaunayArgs, timings: &mut Timings) -> Result<(), CliError> {
     let cloud = common::read_input(&args.input, &ReadOptions::default(), timings)?;
     let bar = common::spinner("triangulating");
     let tri = timings
-        .phase("triangulate", || Triangulation::new(&cloud.points))
+        .phase("triangulate", || {
+            Triangulation::with_threads(&cloud.points, rayon::current_num_threads())
+        })
         .map_err(|e| CliError::in_file(&args.input, e))?;
     bar.finish_and_clear();
     if tri.dimension() < 3 {

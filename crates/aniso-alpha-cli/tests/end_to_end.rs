@@ -124,6 +124,50 @@ fn delaunay_equals_cgal_on_every_fixture() {
     }
 }
 
+/// `delaunay` on 2 threads (the parallel build: the set is large enough to
+/// share its last rounds) writes the same tets as on 1, up to the rotation
+/// of each tet, and the same from run to run.
+#[test]
+fn delaunay_on_two_threads_equals_one() {
+    let dir = TempDir::new("threads");
+    let input = dir.path("cloud.xyz");
+    // 60,000 points: a jittered lattice with exact duplicates and an
+    // integer grid block (ties), in a fixed order.
+    let mut text = String::new();
+    let mut state = 0x9E37_79B9_7F4A_7C15u64;
+    for i in 0..54_000u64 {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        let r = (state >> 33) as f64 / (1u64 << 31) as f64;
+        text += &format!("{} {} {}\n", i % 40, i / 40 % 45, (i / 1800) as f64 + r);
+    }
+    for i in 0..6_000 {
+        text += &format!("{} {} {}\n", 50 + i % 20, i / 20 % 20, i / 400);
+    }
+    text += "0 0 0.5\n0 0 0.5\n";
+    std::fs::write(&input, text).unwrap();
+    let tets = |threads: &str, name: &str| {
+        let out = dir.path(name);
+        ok(&[
+            "delaunay",
+            input.to_str().unwrap(),
+            "--tets",
+            out.to_str().unwrap(),
+            "--threads",
+            threads,
+        ]);
+        read_tets(&out)
+    };
+    let one = tets("1", "one.tets");
+    assert!(one.len() > 300_000, "{}", one.len());
+    assert_eq!(tets("2", "two.tets"), one);
+    let raw = |name: &str| std::fs::read_to_string(dir.path(name)).unwrap();
+    let first = raw("two.tets");
+    tets("2", "again.tets");
+    assert!(raw("again.tets") == first);
+}
+
 fn read_intervals(p: &Path) -> Vec<(String, f64, f64)> {
     let text = std::fs::read_to_string(p).unwrap();
     let mut lines = text.lines();

@@ -4,7 +4,8 @@
 //! `cargo run --release --example alpha_time -- points.bin` (raw
 //! little-endian f64 triples, as in the `triangulate` example), or
 //! `cargo run --release --example alpha_time -- uniform 100000`.
-//! Add `--repeat N` to report the fastest of N runs.
+//! Add `--repeat N` to report the fastest of N runs, `--threads N` to
+//! triangulate on N threads (default 1).
 mod common;
 
 use aniso_alpha::alpha::AlphaComplex;
@@ -24,13 +25,19 @@ fn main() {
         .and_then(|k| args.get(k + 1))
         .and_then(|s| s.parse().ok())
         .unwrap_or(1);
+    let threads: usize = args
+        .iter()
+        .position(|a| a == "--threads")
+        .and_then(|k| args.get(k + 1))
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1);
     let (mut t_tri, mut t_int) = (f64::INFINITY, f64::INFINITY);
     let (mut c_tri, mut c_int) = (f64::INFINITY, f64::INFINITY);
     let mut ac = None;
     for _ in 0..repeat.max(1) {
         drop(ac.take());
         let (t0, c0) = (Instant::now(), cpu_seconds());
-        let tri = Triangulation::new(&pts).expect("triangulation");
+        let tri = Triangulation::with_threads(&pts, threads).expect("triangulation");
         t_tri = t_tri.min(t0.elapsed().as_secs_f64());
         c_tri = c_tri.min(cpu_seconds() - c0);
         let (t1, c1) = (Instant::now(), cpu_seconds());

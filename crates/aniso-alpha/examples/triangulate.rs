@@ -3,6 +3,7 @@
 //! `cargo run --release --example triangulate -- uniform 1000000`
 //! `cargo run --release --example triangulate -- grid 50`
 //! `cargo run --release --example triangulate -- points.bin` (raw little-endian f64 triples)
+//! Add `--threads N` for the parallel build, `--validate` to check the result.
 mod common;
 
 use aniso_alpha::delaunay::Triangulation;
@@ -13,8 +14,14 @@ fn main() {
     let kind = args.get(1).map(String::as_str).unwrap_or("uniform");
     let n: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(100_000);
     let pts = common::from_args(kind, n);
+    let threads: usize = args
+        .iter()
+        .position(|a| a == "--threads")
+        .and_then(|i| args.get(i + 1))
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1);
     let t0 = Instant::now();
-    let tri = Triangulation::new(&pts).expect("triangulation");
+    let tri = Triangulation::with_threads(&pts, threads).expect("triangulation");
     let dt = t0.elapsed().as_secs_f64();
     println!(
         "{{\"tool\":\"aniso_alpha\",\"input\":\"{kind}\",\"n\":{},\"vertices\":{},\"finite_tets\":{},\"time_s\":{dt:.6}}}",

@@ -2,6 +2,7 @@
 
 use super::isa::Isa;
 use super::order::{brio_order, SplitMix64};
+use super::store::{Owned, Stop, Store};
 use super::{DelaunayError, Triangulation, INFINITE};
 use crate::geometry::predicates::{
     collinear, coplanar_incircle_perturbed, insphere_perturbed_k, insphere_tie_keyed, orient3d,
@@ -10,16 +11,16 @@ use crate::geometry::predicates::{
 use crate::geometry::Point3;
 
 /// The vertices of a cell just allocated, before it is written.
-const DEAD: u32 = u32::MAX - 1;
+pub(crate) const DEAD: u32 = u32::MAX - 1;
 /// An adjacency slot not yet linked.
-const UNSET: u32 = u32::MAX;
+pub(crate) const UNSET: u32 = u32::MAX;
 /// Flag on a tet's `v[0]`: the tet is in the current conflict region.
 /// Vertex ids stay below 2^31 (see [`DelaunayError::TooManyPoints`]), and
 /// `v[0]` and `v[1]` are never the infinite vertex (always at index 3), so
 /// the top bit of either is free; flags live only during one insertion.
-const IN_CONFLICT: u32 = 1 << 31;
+pub(crate) const IN_CONFLICT: u32 = 1 << 31;
 /// Flag on a tet's `v[1]`: the tet was tested and is not in conflict.
-const CLEAR: u32 = 1 << 31;
+pub(crate) const CLEAR: u32 = 1 << 31;
 
 /// One tetrahedron: vertex ids and packed neighbours (`4 * tet + mirror`),
 /// interleaved so that visiting a tet touches one 32-byte block.
@@ -90,7 +91,7 @@ struct EdgeTable {
 /// `wrapping_add`, which is defined for any offset.
 #[inline(always)]
 #[allow(unsafe_code)]
-fn prefetch(cells: &[Cell], i: usize) {
+pub(crate) fn prefetch<T>(cells: &[T], i: usize) {
     #[cfg(target_arch = "x86_64")]
     {
         use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
@@ -177,17 +178,18 @@ fn conflict_quick<K: Kernel, P: Points + ?Sized>(
     }
 }
 
-/// Working state of the incremental construction.
-struct Builder<K: Kernel> {
+/// Working state of the incremental construction, over the cells of
+/// store `S` (one per thread in a parallel build).
+pub(crate) struct Builder<'p, K: Kernel, S> {
     kernel: std::marker::PhantomData<K>,
     /// Static bounds for the predicates over the whole input.
     filter: StaticFilter,
     /// The [`SmallGrid::frame`] of the input when its lexicographic keys
     /// are kept in the point slots and break in-sphere ties.
     grid: Option<([f64; 3], f64)>,
-    pts: Vec<Slot>,
-    cells: Vec<Cell>,
-    free: Vec<u32>,
+    /// Every point to insert, by vertex id.
+    pts: &'p [Slot],
+    pub(crate) store: S,
     rng: SplitMix64,
     // Scratch, reused across insertions.
     conflicts: Vec<u32>,
@@ -208,51 +210,80 @@ struct Builder<K: Kernel> {
     /// Whether the current insertion's new tets are being filed in
     /// `table` (until the cavity proves too large for it).
     filing: bool,
-    last: u32,
-    /// The most cells (live or free) the build may hold: [`MAX_CELLS`]
-    /// (lower in tests of the limit).
-    max_cells: usize,
+    /// Where the next walk starts (a tet this builder owns).
+    pub(crate) last: u32,
     /// Whether insertions run the x86-64-v3 copy of the code (set only
     /// when [`has_v3`](super::isa::has_v3) holds).
     v3: bool,
 }
 
-/// The tet limit was reached during an insertion (the builder is then left
-/// inconsistent and must be dropped).
-#[derive(Debug)]
-struct TetLimit;
-
 /// Tet ids are packed with a 2-bit face index into a `u32`, so there can be
 /// at most 2^30 tetrahedra (about 150 million uniform points). An insertion
 /// that would need more stops the build with
 /// [`DelaunayError::TooManyTets`].
-const MAX_CELLS: usize = 1 << 30;
+pub(crate) const MAX_CELLS: usize = 1 << 30;
 
-/// Points gathered per chunk in insertion order.
-const GATHER: usize = 1024;
+impl<'p, K: Kernel, S> Builder<'p, K, S> {
+    /// A builder over `store` for the points `pts` (by vertex id).
+    pub(crate) fn new(
+        pts: &'p [Slot],
+        store: S,
+        filter: StaticFilter,
+        grid: Option<([f64; 3], f64)>,
+        limits: &Limits,
+        seed: u64,
+    ) -> Self {
+        Builder {
+            kernel: std::marker::PhantomData,
+            filter,
+            grid,
+            pts,
+            store,
+            rng: SplitMix64::new(seed),
+            conflicts: Vec::new(),
+            cleared: Vec::new(),
+            new_tets: Vec::new(),
+            loc: vec![NO_LOCAL; pts.len() + 1],
+            table: Box::new(EdgeTable {
+                nloc: 0,
+                bverts: [0; MAX_LOCAL],
+                faces: [0; MAX_LOCAL * MAX_LOCAL],
+                local: [[0; 4]; FACES],
+            }),
+            max_local: limits.max_local,
+            filing: limits.max_local > 0,
+            last: 0,
+            v3: limits.isa.use_v3(),
+        }
+    }
 
-impl<K: Kernel> Builder<K> {
+    /// The same builder (scratch, walk position) over another store.
+    pub(crate) fn with_store<T>(self, store: T) -> (Builder<'p, K, T>, S) {
+        let b = Builder {
+            kernel: std::marker::PhantomData,
+            filter: self.filter,
+            grid: self.grid,
+            pts: self.pts,
+            store,
+            rng: self.rng,
+            conflicts: self.conflicts,
+            cleared: self.cleared,
+            new_tets: self.new_tets,
+            loc: self.loc,
+            table: self.table,
+            max_local: self.max_local,
+            filing: self.filing,
+            last: self.last,
+            v3: self.v3,
+        };
+        (b, self.store)
+    }
+}
+
+impl<K: Kernel, S: Store> Builder<'_, K, S> {
     #[inline(always)]
     fn p(&self, v: u32) -> &Point3 {
         &self.pts[v as usize].0
-    }
-
-    /// A free cell: a recycled one, or a new one unless that would pass
-    /// the tet limit.
-    #[inline]
-    fn alloc(&mut self) -> Result<u32, TetLimit> {
-        if let Some(t) = self.free.pop() {
-            Ok(t)
-        } else if self.cells.len() >= self.max_cells {
-            Err(TetLimit)
-        } else {
-            let t = self.cells.len() as u32;
-            self.cells.push(Cell {
-                v: [DEAD; 4],
-                n: [UNSET; 4],
-            });
-            Ok(t)
-        }
     }
 
     /// Orientation of tet `t` with its vertex `i` replaced by point `q`
@@ -266,23 +297,30 @@ impl<K: Kernel> Builder<K> {
 
     /// Remembering stochastic walk from `self.last` to a tetrahedron in
     /// conflict with `q`: either a finite tet whose closure contains `q`, or
-    /// an infinite tet whose hull facet `q` sees strictly.
+    /// an infinite tet whose hull facet `q` sees strictly. Stops on a tet
+    /// whose neighbours this thread may not read ([`Stop::Busy`]).
     #[inline(always)]
-    fn locate_impl(&mut self, q: &Point3) -> u32 {
+    fn locate_impl(&mut self, q: &Point3) -> Result<u32, Stop> {
         let mut t = self.last;
-        let v = self.cells[t as usize].v;
+        let v = self.store.cell(t).v;
+        if !self.store.may_read(&v) {
+            return Err(Stop::Busy);
+        }
         if v[3] == INFINITE {
             if K::orient3d_static(self.p(v[0]), self.p(v[1]), self.p(v[2]), q, &self.filter) > 0 {
-                return t;
+                return Ok(t);
             }
-            t = self.cells[t as usize].n[3] >> 2;
+            t = self.store.n(t, 3) >> 2;
         }
         let mut prev = u32::MAX;
         'walk: loop {
-            let c = self.cells[t as usize];
+            let c = self.store.cell(t);
+            if !self.store.may_read(&c.v) {
+                return Err(Stop::Busy);
+            }
             if c.v[3] == INFINITE {
                 // Entered through the hull facet with q strictly beyond it.
-                return t;
+                return Ok(t);
             }
             let r = (self.rng.next_u64() >> 62) as usize;
             for j in 0..4 {
@@ -297,13 +335,13 @@ impl<K: Kernel> Builder<K> {
                     continue 'walk;
                 }
             }
-            return t;
+            return Ok(t);
         }
     }
 
     /// [`Builder::locate_impl`] for the target's baseline instruction set.
     #[inline(never)]
-    fn locate(&mut self, q: &Point3) -> u32 {
+    fn locate(&mut self, q: &Point3) -> Result<u32, Stop> {
         self.locate_impl(q)
     }
 
@@ -312,18 +350,28 @@ impl<K: Kernel> Builder<K> {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
     #[inline(never)]
-    fn locate_v3(&mut self, q: &Point3) -> u32 {
+    fn locate_v3(&mut self, q: &Point3) -> Result<u32, Stop> {
         self.locate_impl(q)
     }
 
-    /// Inserts point `q` as vertex `vid`; returns the vertex it duplicates,
-    /// if any (then nothing changes), or [`TetLimit`]. Runs the copy
-    /// compiled for the best instruction set the CPU has (see
-    /// [`has_v3`](super::isa::has_v3)), unless the build limits ask for
-    /// the baseline.
+    /// Walks to point `vid` without inserting it, and makes the tet found
+    /// the start of the next walk (a parallel build aims each thread at
+    /// its first point this way).
+    pub(crate) fn aim(&mut self, vid: u32) -> Result<(), Stop> {
+        let q = self.pts[vid as usize].0;
+        self.last = self.locate(&q)?;
+        Ok(())
+    }
+
+    /// Inserts point `vid`; returns the vertex it duplicates, if any (then
+    /// nothing changes), or why it stopped (then nothing changes either,
+    /// except for [`Stop::TetLimit`], after which the builder must be
+    /// dropped). Runs the copy compiled for the best instruction set the
+    /// CPU has (see [`has_v3`](super::isa::has_v3)), unless the build
+    /// limits ask for the baseline.
     #[inline(always)]
     #[allow(unsafe_code)]
-    fn insert(&mut self, vid: u32) -> Result<Option<u32>, TetLimit> {
+    pub(crate) fn insert(&mut self, vid: u32) -> Result<Option<u32>, Stop> {
         #[cfg(target_arch = "x86_64")]
         if self.v3 {
             // SAFETY: a `#[target_feature]` function may be called only
@@ -336,9 +384,9 @@ impl<K: Kernel> Builder<K> {
 
     /// [`Builder::insert`] for the target's baseline instruction set.
     #[inline(never)]
-    fn insert_baseline(&mut self, vid: u32) -> Result<Option<u32>, TetLimit> {
+    fn insert_baseline(&mut self, vid: u32) -> Result<Option<u32>, Stop> {
         let q = self.pts[vid as usize].0;
-        let start = self.locate(&q);
+        let start = self.locate(&q)?;
         self.insert_at(vid, q, start)
     }
 
@@ -350,21 +398,25 @@ impl<K: Kernel> Builder<K> {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
     #[inline(never)]
-    fn insert_v3(&mut self, vid: u32) -> Result<Option<u32>, TetLimit> {
+    fn insert_v3(&mut self, vid: u32) -> Result<Option<u32>, Stop> {
         let q = self.pts[vid as usize].0;
-        let start = self.locate_v3(&q);
+        let start = self.locate_v3(&q)?;
         self.insert_at(vid, q, start)
     }
 
     /// Inserts `q`, vertex `vid`, whose walk ended at tet `start` (see
     /// [`Builder::insert`]).
     #[inline(always)]
-    fn insert_at(&mut self, vid: u32, q: Point3, start: u32) -> Result<Option<u32>, TetLimit> {
+    fn insert_at(&mut self, vid: u32, q: Point3, start: u32) -> Result<Option<u32>, Stop> {
         // A duplicate lies on a vertex of the located (finite) tet.
-        for &w in &self.cells[start as usize].v {
+        let sv = self.store.cell(start).v;
+        for w in sv {
             if w != INFINITE && self.pts[w as usize].0 == q {
                 return Ok(Some(w));
             }
+        }
+        if !self.store.owns(&sv) {
+            return Err(Stop::Busy);
         }
 
         // Conflict region by graph search; `conflicts` doubles as the stack.
@@ -373,31 +425,9 @@ impl<K: Kernel> Builder<K> {
         // replaced by q, keeping c's outer neighbour.
         self.conflicts.clear();
         self.new_tets.clear();
-        // The stack holds each conflict tet packed with the face through
-        // which it was found (its parent, in conflict): only the other
-        // three faces are visited. The start has no parent: its face
-        // field is unused, and all four faces are visited.
-        self.enqueue(start << 2);
-        {
-            let cell = self.cells[start as usize];
-            let v = [cell.v[0] & !IN_CONFLICT, cell.v[1], cell.v[2], cell.v[3]];
-            for f in 0..4 {
-                self.visit(start, &v, cell.n[f], f, vid, &q)?;
-            }
-        }
-        let mut k = 1;
-        while k < self.conflicts.len() {
-            let entry = self.conflicts[k];
-            k += 1;
-            let c = entry >> 2;
-            let cell = self.cells[c as usize];
-            // The vertices without the conflict flag (cleared in a
-            // register: a byte-wide clear in memory followed by a wide
-            // copy stalls store forwarding).
-            let v = [cell.v[0] & !IN_CONFLICT, cell.v[1], cell.v[2], cell.v[3]];
-            for f in OTHER[(entry & 3) as usize] {
-                self.visit(c, &v, cell.n[f], f, vid, &q)?;
-            }
+        if let Err(stop) = self.search(start, vid, &q) {
+            self.undo();
+            return Err(stop);
         }
 
         if self.filing {
@@ -409,29 +439,26 @@ impl<K: Kernel> Builder<K> {
             // recognises boundary facets, and mark the new tets' inner
             // faces unlinked.
             for &(packed, c) in &self.new_tets {
-                let (nt, f) = ((packed >> 2) as usize, (packed & 3) as usize);
+                let (nt, f) = (packed >> 2, (packed & 3) as usize);
                 for g in OTHER[f] {
-                    self.cells[nt].n[g] = UNSET;
+                    self.store.set_n(nt, g, UNSET);
                 }
-                self.cells[c as usize].n[f] = packed;
+                self.store.set_n(c, f, packed);
             }
             self.link_by_rotation(vid);
         }
         self.filing = self.max_local > 0;
-        for &n in &self.cleared {
-            self.cells[n as usize].v[1] &= !CLEAR;
-        }
-        self.cleared.clear();
+        self.clear_flags();
 
-        // Free the cavity (the dead cells are exactly the free list, which
+        // Free the cavity (the dead cells are exactly the free cells, which
         // is how compaction finds them; their flags do not matter, as a
         // reused cell is overwritten whole).
-        self.free.extend(self.conflicts.iter().map(|&e| e >> 2));
-        let cells = &self.cells[..];
+        self.store
+            .release_all(self.conflicts.iter().map(|&e| e >> 2));
         // Start the next walk from a new finite tet if there is one.
         let mut last = self.new_tets[0].0 >> 2;
         for &(p, _) in self.new_tets.iter().rev() {
-            if cells[(p >> 2) as usize].v[3] != INFINITE {
+            if self.store.v(p >> 2, 3) != INFINITE {
                 last = p >> 2;
                 break;
             }
@@ -440,15 +467,82 @@ impl<K: Kernel> Builder<K> {
         Ok(None)
     }
 
+    /// The conflict search of [`Builder::insert_at`] from tet `start`,
+    /// building the new tets on the cavity's boundary as it finds them.
+    #[inline(always)]
+    fn search(&mut self, start: u32, vid: u32, q: &Point3) -> Result<(), Stop> {
+        // The stack holds each conflict tet packed with the face through
+        // which it was found (its parent, in conflict): only the other
+        // three faces are visited. The start has no parent: its face
+        // field is unused, and all four faces are visited.
+        self.enqueue(start << 2);
+        {
+            let cell = self.store.cell(start);
+            let v = [cell.v[0] & !IN_CONFLICT, cell.v[1], cell.v[2], cell.v[3]];
+            for f in 0..4 {
+                self.visit(start, &v, cell.n[f], f, vid, q)?;
+            }
+        }
+        let mut k = 1;
+        while k < self.conflicts.len() {
+            let entry = self.conflicts[k];
+            k += 1;
+            let c = entry >> 2;
+            let cell = self.store.cell(c);
+            // The vertices without the conflict flag (cleared in a
+            // register: a byte-wide clear in memory followed by a wide
+            // copy stalls store forwarding).
+            let v = [cell.v[0] & !IN_CONFLICT, cell.v[1], cell.v[2], cell.v[3]];
+            for f in OTHER[(entry & 3) as usize] {
+                self.visit(c, &v, cell.n[f], f, vid, q)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Clears the CLEAR flags set during this insertion.
+    #[inline(always)]
+    fn clear_flags(&mut self) {
+        for &n in &self.cleared {
+            self.store.update(n, |c| c.v[1] &= !CLEAR);
+        }
+        self.cleared.clear();
+    }
+
+    /// Undoes an insertion whose search stopped: gives the outer tets
+    /// back their neighbours, frees the new tets and clears every flag,
+    /// which leaves the cells as they were.
+    #[cold]
+    fn undo(&mut self) {
+        for &(packed, c) in &self.new_tets {
+            let (nt, f) = (packed >> 2, (packed & 3) as usize);
+            let outer = self.store.n(nt, f);
+            self.store
+                .set_n(outer >> 2, (outer & 3) as usize, pack(c, f));
+            self.store.release(nt);
+        }
+        for &e in &self.conflicts {
+            let v0 = self.store.v(e >> 2, 0);
+            self.store.set_v(e >> 2, 0, v0 & !IN_CONFLICT);
+        }
+        self.clear_flags();
+        self.forget_local_numbers();
+        self.filing = self.max_local > 0;
+        self.conflicts.clear();
+        self.new_tets.clear();
+    }
+
     /// Queues tet `packed >> 2`, found in conflict through its face
     /// `packed & 3`: flags it and prefetches its four neighbours, which
     /// it will visit.
     #[inline(always)]
     fn enqueue(&mut self, packed: u32) {
-        let t = (packed >> 2) as usize;
-        self.cells[t].v[0] |= IN_CONFLICT;
-        for x in self.cells[t].n {
-            prefetch(&self.cells, (x >> 2) as usize);
+        let n = self.store.update(packed >> 2, |c| {
+            c.v[0] |= IN_CONFLICT;
+            c.n
+        });
+        for x in n {
+            self.store.prefetch(x >> 2);
         }
         self.conflicts.push(packed);
     }
@@ -466,9 +560,12 @@ impl<K: Kernel> Builder<K> {
         f: usize,
         vid: u32,
         q: &Point3,
-    ) -> Result<(), TetLimit> {
-        let n = (outer >> 2) as usize;
-        let nv = self.cells[n].v;
+    ) -> Result<(), Stop> {
+        let n = outer >> 2;
+        let nv = self.store.cell(n).v;
+        if !self.store.owns(&nv) {
+            return Err(Stop::Busy);
+        }
         if nv[0] & IN_CONFLICT != 0 {
             return Ok(());
         }
@@ -476,15 +573,16 @@ impl<K: Kernel> Builder<K> {
             self.enqueue(outer);
             return Ok(());
         }
-        let nt = self.alloc()?;
+        let nt = self.store.alloc()?;
         // Written in place: building the cell on the stack with
         // `v[f] = vid` and copying it whole stalls store forwarding.
-        let new = &mut self.cells[nt as usize];
-        new.v = *v;
-        new.v[f] = vid;
-        // (Its other neighbours are set by the linking.)
-        new.n[f] = outer;
-        self.cells[n].n[(outer & 3) as usize] = pack(nt, f);
+        self.store.update(nt, |new| {
+            new.v = *v;
+            new.v[f] = vid;
+            // (Its other neighbours are set by the linking.)
+            new.n[f] = outer;
+        });
+        self.store.set_n(n, (outer & 3) as usize, pack(nt, f));
         if self.filing {
             self.file_faces(nt, f, v);
         }
@@ -499,8 +597,8 @@ impl<K: Kernel> Builder<K> {
     /// it again; the usual quick answers are cheaper to repeat than to
     /// mark and unmark.
     #[inline(always)]
-    fn in_conflict(&mut self, n: usize, nv: &[u32; 4], vid: u32, q: &Point3) -> bool {
-        let quick = conflict_quick::<K, _>(&self.pts[..], nv, q, &self.filter);
+    fn in_conflict(&mut self, n: u32, nv: &[u32; 4], vid: u32, q: &Point3) -> bool {
+        let quick = conflict_quick::<K, _>(self.pts, nv, q, &self.filter);
         if quick != 0 {
             return quick > 0;
         }
@@ -508,11 +606,11 @@ impl<K: Kernel> Builder<K> {
             // An exact quick stage answered 0: a tie.
             self.tie_keyed(nv, vid) > 0
         } else {
-            tet_in_conflict::<K, _>(&self.pts[..], nv, q, &self.filter)
+            tet_in_conflict::<K, _>(self.pts, nv, q, &self.filter)
         };
         if !conflict {
-            self.cells[n].v[1] |= CLEAR;
-            self.cleared.push(n as u32);
+            self.store.set_v(n, 1, nv[1] | CLEAR);
+            self.cleared.push(n);
         }
         conflict
     }
@@ -527,15 +625,6 @@ impl<K: Kernel> Builder<K> {
         let s = |w: u32| &self.pts[w as usize];
         let pts = [s(v[0]), s(v[1]), s(v[2]), s(v[3]), s(vid)];
         insphere_tie_keyed::<K>(pts.map(|slot| &slot.0), pts.map(|slot| slot.1))
-    }
-
-    /// The point slot of `p`, with its key if the build keeps them.
-    #[inline(always)]
-    fn slot(&self, p: &Point3) -> Slot {
-        match &self.grid {
-            Some((lo, step)) => Slot(*p, SmallGrid::lex_key(p, lo, *step)),
-            None => Slot(*p, 0),
-        }
     }
 
     /// Files the three inner faces of new tet `nt` (built on facet `f` of
@@ -590,15 +679,15 @@ impl<K: Kernel> Builder<K> {
     #[inline(always)]
     fn link_filed(&mut self) {
         let t = &mut *self.table;
-        let cells = &mut self.cells[..];
         for (i, &(packed, _)) in self.new_tets.iter().enumerate() {
-            let (nt, f) = ((packed >> 2) as usize, (packed & 3) as usize);
+            let (nt, f) = (packed >> 2, (packed & 3) as usize);
             let lv = t.local[i & (FACES - 1)];
-            let cn = &mut cells[nt].n;
-            for &(g, a, b) in &DIRECTED[f] {
-                let e = lv[b] as usize * MAX_LOCAL + lv[a] as usize;
-                cn[g] = t.faces[e & (MAX_LOCAL * MAX_LOCAL - 1)];
-            }
+            self.store.update(nt, |c| {
+                for &(g, a, b) in &DIRECTED[f] {
+                    let e = lv[b] as usize * MAX_LOCAL + lv[a] as usize;
+                    c.n[g] = t.faces[e & (MAX_LOCAL * MAX_LOCAL - 1)];
+                }
+            });
         }
         self.forget_local_numbers();
     }
@@ -615,7 +704,7 @@ impl<K: Kernel> Builder<K> {
     /// Links the new tets of an insertion to each other by turning around
     /// the cavity's boundary edges (any cavity size).
     fn link_by_rotation(&mut self, vid: u32) {
-        let cells = &mut self.cells[..];
+        let cells = &mut self.store;
         // Link the new tets to each other. The face of new tet nt (built
         // on facet f of conflict tet c) opposite g != f holds q and an edge
         // (a, b) of the cavity boundary. Its neighbour is the new tet of
@@ -623,31 +712,31 @@ impl<K: Kernel> Builder<K> {
         // across its face g, through conflict tets only: every cell
         // visited is part of this insertion and already in cache.
         for &(packed, c) in &self.new_tets {
-            let (nt, f) = ((packed >> 2) as usize, (packed & 3) as usize);
+            let (nt, f) = (packed >> 2, (packed & 3) as usize);
             for g in OTHER[f] {
-                if cells[nt].n[g] != UNSET {
+                if cells.n(nt, g) != UNSET {
                     continue;
                 }
                 // Invariant: we are about to cross face `gc` of conflict
                 // tet `cur`; its faces `gc` and `hc` both contain (a, b).
-                let (mut cur, mut gc, mut hc) = (c as usize, g, f);
+                let (mut cur, mut gc, mut hc) = (c, g, f);
                 loop {
-                    let x = cells[cur].n[gc];
-                    let t2 = (x >> 2) as usize;
-                    if cells[t2].v[gc] == vid {
+                    let x = cells.n(cur, gc);
+                    let t2 = x >> 2;
+                    if cells.v(t2, gc) == vid {
                         // (cur, gc) is a boundary facet and t2 its new tet;
                         // the face of t2 holding (q, a, b) is opposite hc.
-                        cells[nt].n[g] = pack(t2 as u32, hc);
-                        cells[t2].n[hc] = pack(nt as u32, g);
+                        cells.set_n(nt, g, pack(t2, hc));
+                        cells.set_n(t2, hc, pack(nt, g));
                         break;
                     }
                     // t2 is in conflict too: the face crossed is (a, b, w)
                     // with w = cur.v[hc]; next cross t2's face opposite w
                     // (only `v[0]` of a conflict tet carries a flag; it is
                     // never the infinite vertex, whose id has the top bit).
-                    let w = cells[cur].v[hc];
+                    let w = cells.v(cur, hc);
                     let w = if hc == 0 { w & !IN_CONFLICT } else { w };
-                    let tv = cells[t2].v;
+                    let tv = cells.cell(t2).v;
                     let kw = (tv[1] == w) as usize
                         + 2 * (tv[2] == w) as usize
                         + 3 * (tv[3] == w) as usize;
@@ -717,34 +806,50 @@ fn lower_dimensional(points: &[Point3], dim: usize) -> Triangulation {
     }
 }
 
-pub(super) fn build(points: &[[f64; 3]]) -> Result<Triangulation, DelaunayError> {
-    build_with(points, Limits::DEFAULT)
+pub(super) fn build(points: &[[f64; 3]], threads: usize) -> Result<Triangulation, DelaunayError> {
+    build_with(
+        points,
+        Limits {
+            threads: threads.max(1),
+            ..Limits::DEFAULT
+        },
+    )
 }
 
 /// Build limits that tests lower to reach rare paths.
 #[derive(Clone, Copy, Debug)]
-struct Limits {
+pub(crate) struct Limits {
     /// The most cells the build may hold (at most [`MAX_CELLS`]).
-    max_cells: usize,
+    pub(crate) max_cells: usize,
     /// The largest cavity (in boundary vertices) linked by table.
-    max_local: usize,
+    pub(crate) max_local: usize,
     /// The instruction set of the insertion loop.
-    isa: Isa,
+    pub(crate) isa: Isa,
     /// Whether a [`SmallGrid`] input keeps lexicographic keys for ties.
-    grid_keys: bool,
+    pub(crate) grid_keys: bool,
+    /// Threads of the build (1: the single-threaded build).
+    pub(crate) threads: usize,
+    /// The smallest BRIO round that a parallel build splits between its
+    /// threads, per thread (earlier rounds run on one thread).
+    pub(crate) par_min: usize,
 }
 
 impl Limits {
-    const DEFAULT: Limits = Limits {
+    pub(crate) const DEFAULT: Limits = Limits {
         max_cells: MAX_CELLS,
         max_local: MAX_LOCAL,
         isa: Isa::Detect,
         grid_keys: true,
+        threads: 1,
+        par_min: 8192,
     };
 }
 
 /// [`build`] with given limits (lower than the defaults only in tests).
-fn build_with(points: &[[f64; 3]], limits: Limits) -> Result<Triangulation, DelaunayError> {
+pub(crate) fn build_with(
+    points: &[[f64; 3]],
+    limits: Limits,
+) -> Result<Triangulation, DelaunayError> {
     let n = points.len();
     if n == 0 {
         return Err(DelaunayError::Empty);
@@ -771,151 +876,203 @@ fn build_with(points: &[[f64; 3]], limits: Limits) -> Result<Triangulation, Dela
             }
         }
     }
+    // A parallel build's shared cells are zeroed by another thread while
+    // this one orders the points.
+    let zeroed = super::parallel::start(n, &limits);
     // (-0.0 == 0.0 for every comparison below, so signed zeros are one point.)
     // The bounding box orders the points and gives the static filter.
     let bbox = crate::geometry::bounding_box(points);
-    let order = brio_order(points, &bbox, 0x5EED_0A11_A1FA_u64, limits.isa);
+    let (order, rounds) = brio_order(points, &bbox, 0x5EED_0A11_A1FA_u64, limits.isa);
     let init = match initial_simplex(points, &order) {
         Ok(s) => s,
         Err(dim) => return Ok(lower_dimensional(points, dim)),
     };
 
-    // Uniform points give about 6.8 tets per point; untouched capacity costs
-    // address space, not resident memory.
-    let expected_tets = (7 * n + n / 2 + 64).min(limits.max_cells);
     let filter = StaticFilter::for_box(&bbox.0, &bbox.1);
-    match SmallGrid::frame(points) {
-        Some(frame) => {
-            let grid = limits.grid_keys.then_some(frame);
-            run::<SmallGrid>(points, &order, init, expected_tets, limits, filter, grid)
+    let frame = SmallGrid::frame(points);
+    let grid = frame.filter(|_| limits.grid_keys);
+    let input = Input::new(points, &order, &rounds, init, grid, bbox);
+    let built = match frame {
+        Some(_) => run::<SmallGrid>(&input, &limits, filter, grid, zeroed),
+        None => run::<Filtered>(&input, &limits, filter, None, zeroed),
+    };
+    let built = built.map_err(|_| DelaunayError::TooManyTets(n))?;
+    Ok(finish(input, built))
+}
+
+/// The points of a build in insertion order, with their input indices.
+pub(crate) struct Input {
+    /// Every point, by vertex id: the first four make the first tet
+    /// (positively oriented), the others follow the BRIO order. A
+    /// duplicate's id is dropped at the end ([`finish`]).
+    pub(crate) pts: Vec<Slot>,
+    /// Vertex id -> input index.
+    ins_input: Vec<u32>,
+    /// The vertex id at which each BRIO round starts, and `pts.len()`.
+    pub(crate) bounds: Vec<usize>,
+    /// The number of input points.
+    n: usize,
+    /// Their bounding box.
+    pub(crate) bbox: ([f64; 3], [f64; 3]),
+}
+
+impl Input {
+    /// Gathers `points` in the order of the first tet `init`, then `order`
+    /// (BRIO rounds of sizes `rounds`).
+    fn new(
+        points: &[Point3],
+        order: &[u32],
+        rounds: &[usize],
+        init: [u32; 4],
+        grid: Option<([f64; 3], f64)>,
+        bbox: ([f64; 3], [f64; 3]),
+    ) -> Input {
+        let n = points.len();
+        let slot = |p: &Point3| match &grid {
+            Some((lo, step)) => Slot(*p, SmallGrid::lex_key(p, lo, *step)),
+            None => Slot(*p, 0),
+        };
+        let mut s = init;
+        if orient3d(
+            &points[s[0] as usize],
+            &points[s[1] as usize],
+            &points[s[2] as usize],
+            &points[s[3] as usize],
+        ) < 0
+        {
+            s.swap(0, 1);
         }
-        None => run::<Filtered>(points, &order, init, expected_tets, limits, filter, None),
+        let mut pts = Vec::with_capacity(n);
+        let mut ins_input = Vec::with_capacity(n);
+        for &i in &s {
+            pts.push(slot(&points[i as usize]));
+            ins_input.push(i);
+        }
+        let mut bounds = Vec::with_capacity(rounds.len() + 1);
+        let mut k = 0;
+        for &size in rounds {
+            bounds.push(pts.len());
+            for &i in &order[k..k + size] {
+                if !init.contains(&i) {
+                    pts.push(slot(&points[i as usize]));
+                    ins_input.push(i);
+                }
+            }
+            k += size;
+        }
+        bounds.push(pts.len());
+        Input {
+            pts,
+            ins_input,
+            bounds,
+            n,
+            bbox,
+        }
     }
 }
 
-/// The incremental construction proper, monomorphised over the kernel.
+/// Each duplicate's vertex id, with the vertex it duplicates.
+pub(crate) type Dups = Vec<(u32, u32)>;
+
+/// The cells of a finished build, before compaction.
+pub(crate) struct Built {
+    /// Every cell, live or dead.
+    pub(crate) cells: Vec<Cell>,
+    /// The dead cells (in any order).
+    pub(crate) holes: Vec<u32>,
+    /// Each duplicate's vertex id, with the vertex it duplicates.
+    pub(crate) dups: Dups,
+}
+
+/// The incremental construction proper, monomorphised over the kernel: on
+/// one thread, or split between threads by [`super::parallel`] when
+/// `zeroed` brings the cells of a parallel build.
 fn run<K: Kernel>(
-    points: &[Point3],
-    order: &[u32],
-    init: [u32; 4],
-    expected_tets: usize,
-    limits: Limits,
+    input: &Input,
+    limits: &Limits,
     filter: StaticFilter,
     grid: Option<([f64; 3], f64)>,
-) -> Result<Triangulation, DelaunayError> {
-    let n = points.len();
-    let too_many = |_: TetLimit| DelaunayError::TooManyTets(n);
-    let mut b = Builder::<K> {
-        kernel: std::marker::PhantomData,
-        filter,
-        grid,
-        pts: Vec::with_capacity(n),
+    zeroed: Option<super::parallel::Zeroed>,
+) -> Result<Built, Stop> {
+    if let Some(zeroed) = zeroed {
+        return super::parallel::run::<K>(input, limits, filter, grid, zeroed);
+    }
+    let m = input.pts.len();
+    let (b, dups) = run_owned::<K>(input, limits, filter, grid, m)?;
+    let Owned { cells, free, .. } = b.store;
+    Ok(Built {
+        cells,
+        holes: free,
+        dups,
+    })
+}
+
+/// Builds the first tet and inserts the points `4..end` on one thread,
+/// into plain cells; returns the builder and the duplicates found.
+pub(crate) fn run_owned<'p, K: Kernel>(
+    input: &'p Input,
+    limits: &Limits,
+    filter: StaticFilter,
+    grid: Option<([f64; 3], f64)>,
+    end: usize,
+) -> Result<(Builder<'p, K, Owned>, Dups), Stop> {
+    // Uniform points give about 6.8 tets per point; untouched capacity costs
+    // address space, not resident memory.
+    let expected_tets = (7 * end + end / 2 + 64).min(limits.max_cells);
+    let store = Owned {
         cells: Vec::with_capacity(expected_tets),
         free: Vec::new(),
-        rng: SplitMix64::new(0xC0FFEE),
-        conflicts: Vec::new(),
-        cleared: Vec::new(),
-        new_tets: Vec::new(),
-        loc: vec![NO_LOCAL; n + 1],
-        table: Box::new(EdgeTable {
-            nloc: 0,
-            bverts: [0; MAX_LOCAL],
-            faces: [0; MAX_LOCAL * MAX_LOCAL],
-            local: [[0; 4]; FACES],
-        }),
-        max_local: limits.max_local,
-        filing: limits.max_local > 0,
-        last: 0,
         max_cells: limits.max_cells.min(MAX_CELLS),
-        v3: limits.isa.use_v3(),
     };
-    let mut vert_input: Vec<u32> = Vec::with_capacity(n);
-    let mut input_vert = vec![u32::MAX; n];
+    let mut b = Builder::<K, _>::new(&input.pts, store, filter, grid, limits, SEED);
+    b.last = first_tet(&mut b.store)?;
+    let mut dups = Vec::new();
+    for vid in 4..end as u32 {
+        if let Some(w) = b.insert(vid)? {
+            dups.push((vid, w));
+        }
+    }
+    Ok((b, dups))
+}
 
-    // The first tetrahedron and its four infinite neighbours.
-    let mut s = init;
-    if orient3d(
-        &points[s[0] as usize],
-        &points[s[1] as usize],
-        &points[s[2] as usize],
-        &points[s[3] as usize],
-    ) < 0
-    {
-        s.swap(0, 1);
-    }
-    for (v, &i) in s.iter().enumerate() {
-        b.pts.push(b.slot(&points[i as usize]));
-        vert_input.push(i);
-        input_vert[i as usize] = v as u32;
-    }
-    let t0 = b.alloc().map_err(too_many)?;
-    b.cells[t0 as usize].v = [0, 1, 2, 3];
+/// The seed of the walks' random choices (of the first thread's, in a
+/// parallel build).
+pub(crate) const SEED: u64 = 0xC0FFEE;
+
+/// Writes the first tetrahedron, vertices 0 to 3, and its four infinite
+/// neighbours into an empty store; returns the first.
+pub(crate) fn first_tet<S: Store>(store: &mut S) -> Result<u32, Stop> {
+    let t0 = store.alloc()?;
+    store.set_vs(t0, [0, 1, 2, 3]);
+    let mut ids = [t0; 5];
     for i in 0..4 {
-        let ti = b.alloc().map_err(too_many)?;
+        let ti = store.alloc()?;
         // Face i of the first tet, reversed so that the infinite vertex (at
         // index 3, as in every infinite tet) is on its outer side.
         let f = FACE[i];
-        b.cells[ti as usize].v = [f[1] as u32, f[0] as u32, f[2] as u32, INFINITE];
+        store.set_vs(ti, [f[1] as u32, f[0] as u32, f[2] as u32, INFINITE]);
+        ids[i + 1] = ti;
     }
-    link_by_faces(&mut b.cells, &[0, 1, 2, 3, 4]);
-    b.last = t0;
-
-    // The points are gathered in insertion order a chunk at a time: the
-    // order jumps around the input, and independent loads overlap their
-    // cache misses where loads inside the insertion loop would not.
-    let mut chunk: Vec<Point3> = Vec::with_capacity(GATHER);
-    for ids in order.chunks(GATHER) {
-        chunk.clear();
-        chunk.extend(ids.iter().map(|&i| points[i as usize]));
-        for (&i, p) in ids.iter().zip(&chunk) {
-            if init.contains(&i) {
-                continue; // one of the initial four
-            }
-            let vid = b.pts.len() as u32;
-            b.pts.push(b.slot(p));
-            match b.insert(vid).map_err(too_many)? {
-                None => vert_input.push(i),
-                Some(w) => {
-                    b.pts.pop();
-                    input_vert[i as usize] = w;
-                    let first = vert_input[w as usize];
-                    if i < first {
-                        vert_input[w as usize] = i;
-                        input_vert[first as usize] = w;
-                    }
-                }
-            }
-        }
-    }
-    // The inputs that became vertices, in one pass after the build (these
-    // scattered stores stalled the insertion loop).
-    for (v, &i) in vert_input.iter().enumerate() {
-        input_vert[i as usize] = v as u32;
-    }
-    Ok(compact(b, vert_input, input_vert))
+    link_by_faces(store, &ids);
+    Ok(t0)
 }
 
 /// Links the faces of a few tets by brute force (used for the first five).
-fn link_by_faces(cells: &mut [Cell], ids: &[u32]) {
+fn link_by_faces<S: Store>(cells: &mut S, ids: &[u32]) {
     for &t in ids {
         for i in 0..4 {
-            let mut fa: Vec<u32> = (0..4)
-                .filter(|&k| k != i)
-                .map(|k| cells[t as usize].v[k])
-                .collect();
+            let mut fa: Vec<u32> = (0..4).filter(|&k| k != i).map(|k| cells.v(t, k)).collect();
             fa.sort_unstable();
             for &u in ids {
                 if u == t {
                     continue;
                 }
                 for j in 0..4 {
-                    let mut fb: Vec<u32> = (0..4)
-                        .filter(|&k| k != j)
-                        .map(|k| cells[u as usize].v[k])
-                        .collect();
+                    let mut fb: Vec<u32> =
+                        (0..4).filter(|&k| k != j).map(|k| cells.v(u, k)).collect();
                     fb.sort_unstable();
                     if fa == fb {
-                        cells[t as usize].n[i] = pack(u, j);
+                        cells.set_n(t, i, pack(u, j));
                     }
                 }
             }
@@ -923,18 +1080,93 @@ fn link_by_faces(cells: &mut [Cell], ids: &[u32]) {
     }
 }
 
-/// Drops dead tets by moving live tets from the end into the holes (only
-/// live cells above the final length move; the rest stay where they are).
-fn compact<K: Kernel>(b: Builder<K>, vert_input: Vec<u32>, input_vert: Vec<u32>) -> Triangulation {
-    let Builder {
-        pts,
+/// The triangulation of a finished build: drops the dead cells and the
+/// duplicates' vertex ids, and maps inputs to vertices.
+fn finish(input: Input, built: Built) -> Triangulation {
+    let Input {
+        pts, ins_input, n, ..
+    } = input;
+    let Built {
         mut cells,
-        free,
-        ..
-    } = b;
-    // The dead cells are exactly the free list: fill the holes below the
-    // final length with the live cells above it (no scan of the cells).
-    let mut holes = free;
+        holes,
+        dups,
+    } = built;
+    compact(&mut cells, holes);
+    let mut input_vert = vec![u32::MAX; n];
+    let (pts, vert_input) = if dups.is_empty() {
+        for (v, &i) in ins_input.iter().enumerate() {
+            input_vert[i as usize] = v as u32;
+        }
+        (pts.into_iter().map(|s| s.0).collect(), ins_input)
+    } else {
+        // Number the vertices without the duplicates' ids, keeping their
+        // order, and give each duplicate's input the vertex it duplicates.
+        const DUP: u32 = u32::MAX;
+        let mut id = vec![0u32; pts.len()];
+        for &(d, _) in &dups {
+            id[d as usize] = DUP;
+        }
+        let mut kept = 0;
+        for x in id.iter_mut() {
+            if *x != DUP {
+                *x = kept;
+                kept += 1;
+            }
+        }
+        for c in cells.iter_mut() {
+            for w in c.v.iter_mut() {
+                if *w != INFINITE {
+                    *w = id[*w as usize];
+                }
+            }
+        }
+        let mut vert_input = Vec::with_capacity(kept as usize);
+        let mut kept_pts = Vec::with_capacity(kept as usize);
+        for (v, s) in pts.iter().enumerate() {
+            if id[v] != DUP {
+                vert_input.push(ins_input[v]);
+                kept_pts.push(s.0);
+            }
+        }
+        for (v, &i) in ins_input.iter().enumerate() {
+            if id[v] != DUP {
+                input_vert[i as usize] = id[v];
+            }
+        }
+        for &(d, w) in &dups {
+            let (i, w) = (ins_input[d as usize], id[w as usize]);
+            input_vert[i as usize] = w;
+            // The vertex stands for the first occurrence of its point.
+            let first = &mut vert_input[w as usize];
+            *first = (*first).min(i);
+        }
+        (kept_pts, vert_input)
+    };
+    let mut num_finite = 0;
+    let mut vert_tet = vec![u32::MAX; pts.len()];
+    for (t, c) in cells.iter().enumerate() {
+        num_finite += (c.v[3] != INFINITE) as usize;
+        for &w in &c.v {
+            if w != INFINITE {
+                vert_tet[w as usize] = t as u32;
+            }
+        }
+    }
+    Triangulation {
+        pts,
+        vert_input,
+        input_vert,
+        cells,
+        num_finite,
+        vert_tet,
+        dim: 3,
+    }
+}
+
+/// Drops the dead cells `holes` by moving live cells from the end into the
+/// holes below the final length (only live cells above it move; the rest
+/// stay where they are).
+fn compact(cells: &mut Vec<Cell>, mut holes: Vec<u32>) {
     holes.sort_unstable();
     let len = cells.len() - holes.len();
     let mut tail_holes = holes.len();
@@ -961,31 +1193,15 @@ fn compact<K: Kernel>(b: Builder<K>, vert_input: Vec<u32>, input_vert: Vec<u32>)
         }
     }
     cells.truncate(len);
-    let mut num_finite = 0;
-    let pts: Vec<Point3> = pts.iter().map(|s| s.0).collect();
-    let mut vert_tet = vec![u32::MAX; pts.len()];
-    for (t, c) in cells.iter().enumerate() {
-        num_finite += (c.v[3] != INFINITE) as usize;
-        for &w in &c.v {
-            if w != INFINITE {
-                vert_tet[w as usize] = t as u32;
-            }
-        }
-    }
-    Triangulation {
-        pts,
-        vert_input,
-        input_vert,
-        cells,
-        num_finite,
-        vert_tet,
-        dim: 3,
-    }
 }
 
 #[cfg(test)]
-mod tests {
-    use super::{build_with, prefetch, Cell, DelaunayError, Isa, Limits, SplitMix64, FACE};
+pub(crate) mod tests {
+    use super::{
+        build_with, prefetch, run_owned, Cell, DelaunayError, Input, Isa, Limits, SplitMix64, Stop,
+        Store, FACE,
+    };
+    use crate::geometry::predicates::{Filtered, StaticFilter};
 
     #[test]
     fn prefetch_never_faults() {
@@ -1000,9 +1216,52 @@ mod tests {
         ];
         for i in [0, 2, 3, 1 << 20, 1 << 40, usize::MAX / 64, usize::MAX] {
             prefetch(&cells, i);
-            prefetch(&[], i);
+            prefetch::<Cell>(&[], i);
         }
         assert_eq!(cells[2].v, [0; 4]);
+    }
+
+    /// An insertion stopped part way through its cavity (here by the tet
+    /// limit; in a parallel build by a tet of another thread) is undone:
+    /// every live cell is as it was, and the cells it took are free again.
+    #[test]
+    fn a_stopped_insertion_is_undone() {
+        let pts = uniform_points(9, 3000);
+        let bbox = crate::geometry::bounding_box(&pts);
+        let (order, rounds) = super::brio_order(&pts, &bbox, 1, Isa::Detect);
+        let init = super::initial_simplex(&pts, &order).unwrap();
+        let input = Input::new(&pts, &order, &rounds, init, None, bbox);
+        let filter = StaticFilter::for_box(&bbox.0, &bbox.1);
+        let mut undone = 0;
+        for end in (100..3000).step_by(97) {
+            let (mut b, _) =
+                run_owned::<Filtered>(&input, &Limits::DEFAULT, filter, None, end).unwrap();
+            let live = |b: &super::Builder<'_, Filtered, super::Owned>| {
+                let free: std::collections::HashSet<u32> = b.store.free.iter().copied().collect();
+                let cells: Vec<(usize, Cell)> = (0..b.store.cells.len())
+                    .filter(|t| !free.contains(&(*t as u32)))
+                    .map(|t| (t, b.store.cells[t]))
+                    .collect();
+                (cells, free)
+            };
+            let before = live(&b);
+            // No cell beyond the free ones: the insertion stops when it
+            // needs more new tets than its cavity frees as it goes.
+            b.store.max_cells = b.store.cells.len();
+            match b.insert(end as u32) {
+                Err(Stop::TetLimit) => {
+                    undone += 1;
+                    let after = live(&b);
+                    assert!(after.0 == before.0, "end {end}");
+                    assert_eq!(after.1, before.1, "end {end}");
+                    // And the builder goes on from there.
+                    b.store.max_cells = usize::MAX;
+                    assert_eq!(b.insert(end as u32), Ok(None));
+                }
+                other => assert_eq!(other, Ok(None)),
+            }
+        }
+        assert!(undone > 10, "{undone}");
     }
 
     #[test]
@@ -1040,14 +1299,14 @@ mod tests {
     }
 
     /// `n` points drawn uniformly in the unit cube (seed `seed`).
-    fn uniform_points(seed: u64, n: usize) -> Vec<[f64; 3]> {
+    pub(crate) fn uniform_points(seed: u64, n: usize) -> Vec<[f64; 3]> {
         let mut rng = SplitMix64::new(seed);
         let mut unif = || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
         (0..n).map(|_| [unif(), unif(), unif()]).collect()
     }
 
     /// The integer grid k × k × k, x fastest.
-    fn int_grid(k: usize) -> Vec<[f64; 3]> {
+    pub(crate) fn int_grid(k: usize) -> Vec<[f64; 3]> {
         (0..k * k * k)
             .map(|i| [(i % k) as f64, (i / k % k) as f64, (i / (k * k)) as f64])
             .collect()
@@ -1055,7 +1314,7 @@ mod tests {
 
     /// The centre and the integer points on the sphere x² + y² + z² = r2
     /// (cospherical: in-sphere tests among the points on the sphere tie).
-    fn integer_sphere(r2: i32) -> Vec<[f64; 3]> {
+    pub(crate) fn integer_sphere(r2: i32) -> Vec<[f64; 3]> {
         let r = (r2 as f64).sqrt() as i32 + 1;
         let mut sphere = vec![[0.0; 3]];
         for x in -r..=r {

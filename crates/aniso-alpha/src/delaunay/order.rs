@@ -89,6 +89,42 @@ fn hilbert_keys(x: [[u32; LANES]; 3], bits: u32) -> [u64; LANES] {
     keys
 }
 
+/// The Hilbert key of each point on a grid of `2^bits` cells per axis over
+/// the box `bbox` (a parallel build cuts the curve between its threads
+/// with them).
+pub(crate) fn curve_keys<'a>(
+    points: impl ExactSizeIterator<Item = &'a [f64; 3]>,
+    bbox: &([f64; 3], [f64; 3]),
+    bits: u32,
+) -> Vec<u64> {
+    let bits = bits.clamp(1, HILBERT_BITS);
+    let (lo, hi) = *bbox;
+    let max = ((1u64 << bits) - 1) as f64;
+    let scale = std::array::from_fn::<f64, 3, _>(|k| {
+        let ext = hi[k] - lo[k];
+        if ext > 0.0 && ext.is_finite() {
+            max / ext
+        } else {
+            0.0
+        }
+    });
+    let mut keys = Vec::with_capacity(points.len());
+    let mut x = [[0u32; LANES]; 3];
+    let mut l = 0;
+    for p in points {
+        for k in 0..3 {
+            x[k][l] = ((p[k] - lo[k]) * scale[k]).clamp(0.0, max) as u32;
+        }
+        l += 1;
+        if l == LANES {
+            keys.extend(hilbert_keys(x, bits));
+            l = 0;
+        }
+    }
+    keys.extend(&hilbert_keys(x, bits)[..l]);
+    keys
+}
+
 /// The low 21 bits of `v` moved to bits 0, 3, 6, …, 60.
 #[inline(always)]
 fn spread3(v: u32) -> u64 {
@@ -162,6 +198,8 @@ fn sort_by_keys(keys: Vec<u64>) -> Vec<u32> {
 /// cache); eighths, +2.4% instructions and no faster. `bbox` is the
 /// points' bounding box ([`crate::geometry::bounding_box`]).
 ///
+/// Also returns the size of each round, first to last.
+///
 /// The keys are computed by a copy compiled for x86-64-v3 when `isa`
 /// allows and the CPU has it (see [`super::isa`]); the order is the same.
 #[allow(unsafe_code)]
@@ -170,28 +208,38 @@ pub(crate) fn brio_order(
     bbox: &([f64; 3], [f64; 3]),
     seed: u64,
     isa: Isa,
-) -> Vec<u32> {
+) -> (Vec<u32>, Vec<usize>) {
     #[cfg(target_arch = "x86_64")]
     if isa.use_v3() {
         // SAFETY: a `#[target_feature]` function may be called only on a
         // CPU with the features it enables, which `use_v3` checked.
-        return sort_by_keys(unsafe { brio_keys_v3(points, bbox, seed) });
+        let (keys, rounds) = unsafe { brio_keys_v3(points, bbox, seed) };
+        return (sort_by_keys(keys), rounds);
     }
     let _ = isa;
-    sort_by_keys(brio_keys(points, bbox, seed))
+    let (keys, rounds) = brio_keys(points, bbox, seed);
+    (sort_by_keys(keys), rounds)
 }
 
 /// [`brio_keys`] compiled for x86-64-v3 (see [`super::isa`]).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
-fn brio_keys_v3(points: &[[f64; 3]], bbox: &([f64; 3], [f64; 3]), seed: u64) -> Vec<u64> {
+fn brio_keys_v3(
+    points: &[[f64; 3]],
+    bbox: &([f64; 3], [f64; 3]),
+    seed: u64,
+) -> (Vec<u64>, Vec<usize>) {
     brio_keys(points, bbox, seed)
 }
 
 /// The key of each point of [`brio_order`]: its round, then its Hilbert
-/// cell at the round's resolution.
+/// cell at the round's resolution; and the size of each round.
 #[inline(always)]
-fn brio_keys(points: &[[f64; 3]], bbox: &([f64; 3], [f64; 3]), seed: u64) -> Vec<u64> {
+fn brio_keys(
+    points: &[[f64; 3]],
+    bbox: &([f64; 3], [f64; 3]),
+    seed: u64,
+) -> (Vec<u64>, Vec<usize>) {
     let n = points.len();
     let (lo, hi) = *bbox;
     let max = ((1u64 << HILBERT_BITS) - 1) as f64;
@@ -228,6 +276,7 @@ fn brio_keys(points: &[[f64; 3]], bbox: &([f64; 3], [f64; 3]), seed: u64) -> Vec
     let round_shift = 3 * bits;
     let mut rng = SplitMix64::new(seed);
     let mut keys: Vec<u64> = Vec::with_capacity(n);
+    let mut rounds = vec![0usize; top + 1];
     for chunk in points.chunks(LANES) {
         let mut x = [[0u32; LANES]; 3];
         for (l, p) in chunk.iter().enumerate() {
@@ -239,9 +288,10 @@ fn brio_keys(points: &[[f64; 3]], bbox: &([f64; 3], [f64; 3]), seed: u64) -> Vec
             let level = ((rng.next_u64().leading_zeros() / 2) as usize).min(top);
             let cell = h >> (3 * (bits - level_bits[level].min(bits)));
             keys.push(((top - level) as u64) << round_shift | cell);
+            rounds[top - level] += 1;
         }
     }
-    keys
+    (keys, rounds)
 }
 
 #[cfg(test)]
@@ -387,7 +437,7 @@ mod tests {
         let pts: Vec<[f64; 3]> = (0..n)
             .map(|_| [0; 3].map(|_| (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64))
             .collect();
-        let order = brio_order(&pts, &crate::geometry::bounding_box(&pts), 1, Isa::Detect);
+        let order = brio_order(&pts, &crate::geometry::bounding_box(&pts), 1, Isa::Detect).0;
         let step = |w: &[u32]| {
             let (p, q) = (pts[w[0] as usize], pts[w[1] as usize]);
             ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
@@ -415,7 +465,7 @@ mod tests {
                 ]
             })
             .collect();
-        let mut o = brio_order(&pts, &crate::geometry::bounding_box(&pts), 1, Isa::Detect);
+        let mut o = brio_order(&pts, &crate::geometry::bounding_box(&pts), 1, Isa::Detect).0;
         o.sort();
         assert!(o.iter().enumerate().all(|(i, &v)| i as u32 == v));
     }
@@ -434,7 +484,9 @@ mod tests {
             let bbox = crate::geometry::bounding_box(&pts);
             let order = brio_order(&pts, &bbox, 9, Isa::Detect);
             assert_eq!(order, brio_order(&pts, &bbox, 9, Isa::Baseline), "n = {n}");
-            let mut seen = order.clone();
+            // The rounds cover the order.
+            assert_eq!(order.1.iter().sum::<usize>(), n);
+            let mut seen = order.0.clone();
             seen.sort_unstable();
             assert!(seen.iter().copied().eq(0..n as u32));
         }
