@@ -19,18 +19,8 @@ fn main() {
     let pts = common::from_args(kind, n);
     // `--repeat N`: run N times and report the fastest of each phase (the
     // machine may be shared; the minimum is the least noisy figure).
-    let repeat: usize = args
-        .iter()
-        .position(|a| a == "--repeat")
-        .and_then(|k| args.get(k + 1))
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(1);
-    let threads: usize = args
-        .iter()
-        .position(|a| a == "--threads")
-        .and_then(|k| args.get(k + 1))
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(1);
+    let repeat = common::option(&args, "--repeat").unwrap_or(1);
+    let threads = common::option(&args, "--threads").unwrap_or(1);
     let (mut t_tri, mut t_int) = (f64::INFINITY, f64::INFINITY);
     let (mut c_tri, mut c_int) = (f64::INFINITY, f64::INFINITY);
     let mut ac = None;

@@ -14,12 +14,7 @@ fn main() {
     let kind = args.get(1).map(String::as_str).unwrap_or("uniform");
     let n: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(100_000);
     let pts = common::from_args(kind, n);
-    let threads: usize = args
-        .iter()
-        .position(|a| a == "--threads")
-        .and_then(|i| args.get(i + 1))
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(1);
+    let threads = common::option(&args, "--threads").unwrap_or(1);
     let t0 = Instant::now();
     let tri = Triangulation::with_threads(&pts, threads).expect("triangulation");
     let dt = t0.elapsed().as_secs_f64();

@@ -48,3 +48,9 @@ pub fn from_args(kind: &str, n: usize) -> Vec<[f64; 3]> {
         _ => uniform(n, 20240601),
     }
 }
+
+/// The value after `--name` in `args`, if there is one and it parses.
+pub fn option(args: &[String], name: &str) -> Option<usize> {
+    let k = args.iter().position(|a| a == name)?;
+    args.get(k + 1)?.parse().ok()
+}

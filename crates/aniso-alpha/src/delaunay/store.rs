@@ -50,10 +50,18 @@ pub(crate) trait Store {
     fn may_read(&self, v: &[u32; 4]) -> bool;
     /// A cell for a new tet (already claimed).
     fn alloc(&mut self) -> Result<u32, Stop>;
+    /// The cells of dead tets, reused first by [`Store::alloc`].
+    fn free_cells(&mut self) -> &mut Vec<u32>;
     /// Returns the cell of a dead tet for reuse.
-    fn release(&mut self, t: u32);
+    #[inline(always)]
+    fn release(&mut self, t: u32) {
+        self.free_cells().push(t);
+    }
     /// Returns the cells of dead tets for reuse.
-    fn release_all(&mut self, t: impl Iterator<Item = u32>);
+    #[inline(always)]
+    fn release_all(&mut self, t: impl Iterator<Item = u32>) {
+        self.free_cells().extend(t);
+    }
 }
 
 /// A new cell's contents: vertices not yet written, neighbours not linked.
@@ -125,12 +133,8 @@ impl Store for Owned {
         }
     }
     #[inline(always)]
-    fn release(&mut self, t: u32) {
-        self.free.push(t);
-    }
-    #[inline(always)]
-    fn release_all(&mut self, t: impl Iterator<Item = u32>) {
-        self.free.extend(t);
+    fn free_cells(&mut self) -> &mut Vec<u32> {
+        &mut self.free
     }
 }
 
@@ -294,11 +298,7 @@ impl Store for Shared<'_> {
         }
     }
     #[inline(always)]
-    fn release(&mut self, t: u32) {
-        self.free.push(t);
-    }
-    #[inline(always)]
-    fn release_all(&mut self, t: impl Iterator<Item = u32>) {
-        self.free.extend(t);
+    fn free_cells(&mut self) -> &mut Vec<u32> {
+        &mut self.free
     }
 }
