@@ -1199,7 +1199,7 @@ fn compact(cells: &mut Vec<Cell>, mut holes: Vec<u32>) {
 pub(crate) mod tests {
     use super::{
         build_with, prefetch, run_owned, Cell, DelaunayError, Input, Isa, Limits, SplitMix64, Stop,
-        Store, FACE,
+        FACE,
     };
     use crate::geometry::predicates::{Filtered, StaticFilter};
 

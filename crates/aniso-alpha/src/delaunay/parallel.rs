@@ -2,8 +2,10 @@
 //! Hilbert order per thread, and the threads insert their pieces at once
 //! into one shared cell array ([`Shared`], whose doc states the ownership
 //! rule). An insertion that needs a tet its thread does not own is undone
-//! and left for the end of the round, when one thread inserts the points
-//! left over. The first rounds, too small to share, run on one thread.
+//! and left over; a second pass cuts the points left over (they lie along
+//! the borders between pieces) across those borders, and one thread
+//! inserts what the second pass leaves. The first rounds, too small to
+//! share, run on one thread.
 //!
 //! The result has the same tets as the single-threaded build (the
 //! triangulation is unique) and the same vertex ids (they follow the
@@ -127,11 +129,12 @@ fn insert_piece<K: Kernel>(
         // first of equal points in the order is always the one inserted
         // (equal points are consecutive, and in one piece).
         let left = out.deferred.last() == Some(&prev);
-        prev = vid;
-        if left && pts[vid as usize].0 == pts[vid as usize - 1].0 {
+        if left && pts[vid as usize].0 == pts[prev as usize].0 {
             out.deferred.push(vid);
+            prev = vid;
             continue;
         }
+        prev = vid;
         match b.insert(vid) {
             Ok(None) => out.inserted = true,
             Ok(Some(w)) => out.dups.push((vid, w)),
