@@ -48,7 +48,8 @@ pub(crate) trait Store {
     /// Whether this thread may read the neighbours of the tet with
     /// vertices `v`, which no other thread changes (always for [`Owned`]).
     fn may_read(&self, v: &[u32; 4]) -> bool;
-    /// A cell for a new tet (already claimed).
+    /// A cell for a new tet, owned by this thread ([`Stop::Busy`] when a
+    /// [`Shared`] thread has none left).
     fn alloc(&mut self) -> Result<u32, Stop>;
     /// The cells of dead tets, reused first by [`Store::alloc`].
     fn free_cells(&mut self) -> &mut Vec<u32>;
