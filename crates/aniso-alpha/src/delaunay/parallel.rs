@@ -401,9 +401,17 @@ pub(crate) fn run<K: Kernel>(
         for j in 0..threads {
             st.piece[cuts[j]..cuts[j + 1]].fill(1 << j);
         }
+        // (A cut pushed to the round's end by equal points leaves the
+        // pieces after it empty: no earlier vertex goes there either.)
         let cut_keys: Vec<u64> = cuts[1..threads]
             .iter()
-            .map(|&c| key(&pts[c..c + 1])[0])
+            .map(|&c| {
+                if c < hi {
+                    key(&pts[c..c + 1])[0]
+                } else {
+                    u64::MAX
+                }
+            })
             .collect();
         for (p, &k) in st.piece[..lo].iter_mut().zip(&keys) {
             *p = 1 << cut_keys.partition_point(|&c| c <= k);
@@ -574,6 +582,20 @@ pub(crate) mod tests {
                 check(pts, threads, 64);
             }
         }
+    }
+
+    /// A run of equal points that fills a round from its middle to its end
+    /// (the cut between the pieces moves past all of them to the round's
+    /// end): points clustered near the curve's start, and many copies of
+    /// one point further along it.
+    #[test]
+    fn parallel_build_with_equal_points_to_the_end_of_a_round() {
+        let mut pts: Vec<[f64; 3]> = uniform_points(8, 3000)
+            .iter()
+            .map(|p| p.map(|x| 0.1 * x))
+            .collect();
+        pts.extend(std::iter::repeat_n([0.9, 0.9, 0.9], 60_000));
+        check(&pts, 2, 1024);
     }
 
     /// A parallel build gives the same cells from run to run: which points
