@@ -522,8 +522,7 @@ impl<K: Kernel, S: Store> Builder<'_, K, S> {
             self.store.release(nt);
         }
         for &e in &self.conflicts {
-            let v0 = self.store.v(e >> 2, 0);
-            self.store.set_v(e >> 2, 0, v0 & !IN_CONFLICT);
+            self.store.update(e >> 2, |c| c.v[0] &= !IN_CONFLICT);
         }
         self.clear_flags();
         self.forget_local_numbers();
@@ -609,7 +608,7 @@ impl<K: Kernel, S: Store> Builder<'_, K, S> {
             tet_in_conflict::<K, _>(self.pts, nv, q, &self.filter)
         };
         if !conflict {
-            self.store.set_v(n, 1, nv[1] | CLEAR);
+            self.store.update(n, |c| c.v[1] |= CLEAR);
             self.cleared.push(n);
         }
         conflict
@@ -1043,14 +1042,16 @@ pub(crate) const SEED: u64 = 0xC0FFEE;
 /// neighbours into an empty store; returns the first.
 pub(crate) fn first_tet<S: Store>(store: &mut S) -> Result<u32, Stop> {
     let t0 = store.alloc()?;
-    store.set_vs(t0, [0, 1, 2, 3]);
+    store.update(t0, |c| c.v = [0, 1, 2, 3]);
     let mut ids = [t0; 5];
     for i in 0..4 {
         let ti = store.alloc()?;
         // Face i of the first tet, reversed so that the infinite vertex (at
         // index 3, as in every infinite tet) is on its outer side.
         let f = FACE[i];
-        store.set_vs(ti, [f[1] as u32, f[0] as u32, f[2] as u32, INFINITE]);
+        store.update(ti, |c| {
+            c.v = [f[1] as u32, f[0] as u32, f[2] as u32, INFINITE]
+        });
         ids[i + 1] = ti;
     }
     link_by_faces(store, &ids);

@@ -31,10 +31,6 @@ pub(crate) trait Store {
     fn v(&self, t: u32, i: usize) -> u32;
     /// Neighbour word `i` of tet `t`.
     fn n(&self, t: u32, i: usize) -> u32;
-    /// Sets the four vertex words of tet `t`.
-    fn set_vs(&mut self, t: u32, v: [u32; 4]);
-    /// Sets vertex word `i` of tet `t`.
-    fn set_v(&mut self, t: u32, i: usize, x: u32);
     /// Sets neighbour word `i` of tet `t`.
     fn set_n(&mut self, t: u32, i: usize, x: u32);
     /// Changes tet `t` through `f` (one index into the cells for
@@ -92,14 +88,6 @@ impl Store for Owned {
     #[inline(always)]
     fn n(&self, t: u32, i: usize) -> u32 {
         self.cells[t as usize].n[i]
-    }
-    #[inline(always)]
-    fn set_vs(&mut self, t: u32, v: [u32; 4]) {
-        self.cells[t as usize].v = v;
-    }
-    #[inline(always)]
-    fn set_v(&mut self, t: u32, i: usize, x: u32) {
-        self.cells[t as usize].v[i] = x;
     }
     #[inline(always)]
     fn set_n(&mut self, t: u32, i: usize, x: u32) {
@@ -242,17 +230,6 @@ impl Store for Shared<'_> {
     #[inline(always)]
     fn n(&self, t: u32, i: usize) -> u32 {
         self.cells[t as usize].0[4 + i].load(Relaxed)
-    }
-    #[inline(always)]
-    fn set_vs(&mut self, t: u32, v: [u32; 4]) {
-        let w = &self.cells[t as usize].0;
-        for i in 0..4 {
-            w[i].store(v[i], Relaxed);
-        }
-    }
-    #[inline(always)]
-    fn set_v(&mut self, t: u32, i: usize, x: u32) {
-        self.cells[t as usize].0[i].store(x, Relaxed);
     }
     #[inline(always)]
     fn set_n(&mut self, t: u32, i: usize, x: u32) {
