@@ -89,6 +89,22 @@ fn hilbert_keys(x: [[u32; LANES]; 3], bits: u32) -> [u64; LANES] {
     keys
 }
 
+/// Per axis, the factor that maps the box `bbox` onto `0..=max` (0 on an
+/// axis of zero or unrepresentable extent): a point's grid cell on that axis
+/// is `((p - lo) * scale).clamp(0, max)`, truncated.
+#[inline(always)]
+fn cell_scale(bbox: &([f64; 3], [f64; 3]), max: f64) -> [f64; 3] {
+    let (lo, hi) = bbox;
+    std::array::from_fn(|k| {
+        let ext = hi[k] - lo[k];
+        if ext > 0.0 && ext.is_finite() {
+            max / ext
+        } else {
+            0.0
+        }
+    })
+}
+
 /// The Hilbert key of each point on a grid of `2^bits` cells per axis over
 /// the box `bbox` (a parallel build cuts the curve between its threads
 /// with them).
@@ -98,16 +114,9 @@ pub(crate) fn curve_keys<'a>(
     bits: u32,
 ) -> Vec<u64> {
     let bits = bits.clamp(1, HILBERT_BITS);
-    let (lo, hi) = *bbox;
+    let lo = bbox.0;
     let max = ((1u64 << bits) - 1) as f64;
-    let scale = std::array::from_fn::<f64, 3, _>(|k| {
-        let ext = hi[k] - lo[k];
-        if ext > 0.0 && ext.is_finite() {
-            max / ext
-        } else {
-            0.0
-        }
-    });
+    let scale = cell_scale(bbox, max);
     let mut keys = Vec::with_capacity(points.len());
     let mut x = [[0u32; LANES]; 3];
     let mut l = 0;
@@ -241,17 +250,9 @@ fn brio_keys(
     seed: u64,
 ) -> (Vec<u64>, Vec<usize>) {
     let n = points.len();
-    let (lo, hi) = *bbox;
+    let lo = bbox.0;
     let max = ((1u64 << HILBERT_BITS) - 1) as f64;
-    let mut scale = [0.0; 3];
-    for k in 0..3 {
-        let ext = hi[k] - lo[k];
-        scale[k] = if ext > 0.0 && ext.is_finite() {
-            max / ext
-        } else {
-            0.0
-        };
-    }
+    let scale = cell_scale(bbox, max);
     // Rounds by level from the end: level 0 is the last and largest;
     // `top`, the first, gets every point that draws a level beyond it.
     const FIRST_ROUND: usize = 128;
