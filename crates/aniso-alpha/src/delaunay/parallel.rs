@@ -17,7 +17,7 @@
 use super::build::{run_owned, Builder, Built, Input, Limits, Slot, MAX_CELLS};
 use super::order::curve_keys;
 use super::store::Owned;
-use super::store::{AtomicCell, Shared, Stop};
+use super::store::{AtomicCell, Shared, Stop, ThreadCells};
 use crate::geometry::predicates::{Kernel, StaticFilter};
 
 /// The most threads a parallel build uses (each has a bit in a byte).
@@ -32,14 +32,7 @@ const SPARE: usize = 4096;
 /// (bits per axis).
 const CURVE_BITS: u32 = 10;
 
-/// A thread's own cells between rounds.
-#[derive(Default)]
-struct Parked {
-    free: Vec<u32>,
-    chunk: (usize, usize),
-}
-
-type Parking<'p, K> = Builder<'p, K, Parked>;
+type Parking<'p, K> = Builder<'p, K, ThreadCells>;
 
 /// Gives builder `b` the shared cells, as the owner of piece `me`.
 fn attach<'p, 'a, K: Kernel>(
@@ -48,25 +41,20 @@ fn attach<'p, 'a, K: Kernel>(
     piece: &'a [u8],
     me: u8,
 ) -> Builder<'p, K, Shared<'a>> {
-    let (b, parked) = b.with_store(());
-    let store = Shared {
+    let (b, own) = b.with_store(());
+    b.with_store(Shared {
         cells,
         piece,
         me,
-        free: parked.free,
-        chunk: parked.chunk,
-    };
-    b.with_store(store).0
+        own,
+    })
+    .0
 }
 
 /// Takes the shared cells back from builder `b`.
 fn detach<'p, K: Kernel>(b: Builder<'p, K, Shared<'_>>) -> Parking<'p, K> {
     let (b, s) = b.with_store(());
-    let parked = Parked {
-        free: s.free,
-        chunk: s.chunk,
-    };
-    b.with_store(parked).0
+    b.with_store(s.own).0
 }
 
 /// The shared cells between rounds (owned, so they can grow).
@@ -84,7 +72,8 @@ impl Cells {
     /// the cells given so far (the rest of the old one joins its free
     /// cells).
     fn hand(&mut self, b: &mut Parking<'_, impl Kernel>, k: usize) -> Result<(), Stop> {
-        let old = b.store.chunk;
+        let own = &mut b.store;
+        let old = own.chunk;
         if old.1 - old.0 >= k {
             return Ok(());
         }
@@ -95,8 +84,8 @@ impl Cells {
         if end > self.cells.len() {
             self.cells.resize_with(end, AtomicCell::default);
         }
-        b.store.free.extend(old.0 as u32..old.1 as u32);
-        b.store.chunk = (self.next, end);
+        own.free.extend(old.0 as u32..old.1 as u32);
+        own.chunk = (self.next, end);
         self.next = end;
         Ok(())
     }
@@ -345,7 +334,7 @@ pub(crate) fn run<K: Kernel>(
     }
     let live = b0.last;
     let b0 = b0
-        .with_store(Parked {
+        .with_store(ThreadCells {
             free,
             chunk: (early.len(), early.len()),
         })
@@ -353,7 +342,7 @@ pub(crate) fn run<K: Kernel>(
     let mut builders = vec![b0];
     builders.extend((1..threads).map(|j| {
         let seed = super::build::SEED.wrapping_add(j as u64);
-        Builder::new(pts, Parked::default(), filter, grid, limits, seed)
+        Builder::new(pts, ThreadCells::default(), filter, grid, limits, seed)
     }));
     let mut st = State::<K> {
         pts,
@@ -434,9 +423,9 @@ pub(crate) fn run<K: Kernel>(
     // of their ranges.
     let mut holes: Vec<u32> = Vec::new();
     for b in st.builders {
-        let (_, parked) = b.with_store(());
-        holes.extend(parked.free);
-        holes.extend(parked.chunk.0 as u32..parked.chunk.1 as u32);
+        let (_, own) = b.with_store(());
+        holes.extend(own.free);
+        holes.extend(own.chunk.0 as u32..own.chunk.1 as u32);
     }
     let mut all = st.cells.cells;
     all.truncate(st.cells.next);

@@ -202,6 +202,14 @@ pub(crate) struct Shared<'a> {
     /// This thread's piece bit (all ones when it runs alone: it owns every
     /// tet).
     pub(crate) me: u8,
+    /// This thread's own cells.
+    pub(crate) own: ThreadCells,
+}
+
+/// The cells a thread of a parallel build may take for new tets; it keeps
+/// them between passes.
+#[derive(Default)]
+pub(crate) struct ThreadCells {
     /// Dead cells of this thread, reused first.
     pub(crate) free: Vec<u32>,
     /// This thread's unused cells: `chunk.0..chunk.1`.
@@ -266,17 +274,18 @@ impl Store for Shared<'_> {
     }
     #[inline]
     fn alloc(&mut self) -> Result<u32, Stop> {
-        if let Some(t) = self.free.pop() {
+        let own = &mut self.own;
+        if let Some(t) = own.free.pop() {
             Ok(t)
-        } else if self.chunk.0 < self.chunk.1 {
-            self.chunk.0 += 1;
-            Ok(self.chunk.0 as u32 - 1)
+        } else if own.chunk.0 < own.chunk.1 {
+            own.chunk.0 += 1;
+            Ok(own.chunk.0 as u32 - 1)
         } else {
             Err(Stop::Busy)
         }
     }
     #[inline(always)]
     fn free_cells(&mut self) -> &mut Vec<u32> {
-        &mut self.free
+        &mut self.own.free
     }
 }
