@@ -30,7 +30,7 @@
 //! tri.validate().unwrap();
 //! ```
 // `unsafe` is denied everywhere but in the Delaunay build: one
-// cache-prefetch hint (`delaunay::build::prefetch`) and the two calls into
+// cache-prefetch hint (`delaunay::cell::prefetch`) and the two calls into
 // the x86-64-v3 copies of the hot loops, made after run-time feature
 // detection (`delaunay::isa`), each documented and tested where it is.
 #![deny(unsafe_code)]
@@ -46,4 +46,5 @@ pub mod detect;
 pub mod eval;
 pub mod geometry;
 pub mod io;
+pub mod rng;
 pub mod synth;

@@ -573,15 +573,9 @@ mod tests {
     /// tets.
     #[test]
     fn cell_mask_matches_per_face_tests() {
-        const FACE: [[usize; 3]; 4] = [[1, 3, 2], [0, 2, 3], [0, 3, 1], [0, 1, 2]];
-        let mut s = 7u64;
-        let mut rnd = || {
-            s = s.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = s;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-        };
+        use crate::delaunay::FACE;
+        let mut rng = crate::rng::SplitMix64::new(7);
+        let mut rnd = || rng.uniform();
         let mut set = 0;
         for it in 0..20000 {
             let p: [Point3; 4] = std::array::from_fn(|_| {

@@ -88,18 +88,15 @@
 
 pub mod exact;
 
-use crate::delaunay::{DelaunayError, Triangulation, INFINITE};
-use crate::geometry::Point3;
+use crate::delaunay::{DelaunayError, Triangulation, EDGES as PAIRS, FACE, INFINITE};
+use crate::geometry::{transform_points, Point3};
 
-/// Faces: for local vertex `i`, the other three local indices in an order
-/// that makes `(f[0], f[1], f[2], i)` an even permutation of `(0, 1, 2, 3)`,
-/// so that face `i` of a positively oriented tet has its normal (right-hand
-/// rule) pointing towards vertex `i`, i.e. into the tet.
-const FACE: [[usize; 3]; 4] = [[1, 3, 2], [0, 2, 3], [0, 3, 1], [0, 1, 2]];
+/// `Q = diag(e)·R` from a rotation and an elongation (the one definition
+/// is [`crate::geometry::q_matrix`]).
+pub use crate::geometry::q_matrix;
+
 /// A cell's vertices and `(neighbour, mirror index)` per face.
 type GatheredCell = ([u32; 4], [(u32, usize); 4]);
-/// The 6 edges of a tet as local index pairs.
-const PAIRS: [[usize; 2]; 6] = [[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]];
 
 /// An edge of the triangulation with its alpha interval, vertices given as
 /// input indices (ascending).
@@ -256,7 +253,7 @@ impl AlphaComplex {
     /// As [`Triangulation::new`] (a non-finite coordinate after the
     /// transform is reported at its input index).
     pub fn anisotropic(points: &[[f64; 3]], q_rows: &[[f64; 3]; 3]) -> Result<Self, DelaunayError> {
-        Self::from_points(&transform_points(points, q_rows))
+        Self::from_points(&transform_points(q_rows, points))
     }
 
     /// The triangulation the intervals refer to.
@@ -906,25 +903,4 @@ pub(crate) fn triangle_rho_sorted(pts: &[Point3], mut f: [u32; 3]) -> f64 {
     f.sort_unstable();
     let [a, b, c] = f.map(|v| &pts[v as usize]);
     triangle_rho(a, b, c)
-}
-
-/// `Q = diag(e)·R`: row `i` of the rotation `r` scaled by `e[i]`
-/// (`Q_ij = e_i·R_ij`, one rounding each).
-///
-/// ```
-/// use aniso_alpha::alpha::q_matrix;
-/// let r = [[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]];
-/// assert_eq!(q_matrix(&r, &[2.0, 1.0, 0.5]), [[0.0, 2.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 0.5]]);
-/// ```
-pub fn q_matrix(rotation: &[[f64; 3]; 3], elongation: &[f64; 3]) -> [[f64; 3]; 3] {
-    std::array::from_fn(|i| rotation[i].map(|x| elongation[i] * x))
-}
-
-/// `q_i = (Q_i1·x + Q_i2·y) + Q_i3·z` for every point, each operation
-/// rounded in that order (no fused multiply-add).
-fn transform_points(points: &[[f64; 3]], q: &[[f64; 3]; 3]) -> Vec<[f64; 3]> {
-    points
-        .iter()
-        .map(|p| std::array::from_fn(|i| (q[i][0] * p[0] + q[i][1] * p[1]) + q[i][2] * p[2]))
-        .collect()
 }

@@ -14,10 +14,11 @@
 //! the number of threads, never on timing: the tet ids are the same from
 //! run to run for a given number of threads.
 
-use super::build::{run_owned, Builder, Built, Input, Limits, Slot, MAX_CELLS};
+use super::cell::MAX_CELLS;
+use super::insert::{BuildStats, Builder, Built, Input, Limits, Slot, SEED};
 use super::order::curve_keys;
-use super::store::Owned;
-use super::store::{AtomicCell, Shared, Stop, ThreadCells};
+use super::sequential::run_owned;
+use super::store::{AtomicCell, Owned, Shared, Stop, ThreadCells};
 use crate::geometry::predicates::{Kernel, StaticFilter};
 
 /// The most threads a parallel build uses (each has a bit in a byte).
@@ -47,6 +48,7 @@ fn attach<'p, 'a, K: Kernel>(
         piece,
         me,
         own,
+        fresh: u32::MAX,
     })
     .0
 }
@@ -146,6 +148,8 @@ struct State<'p, K: Kernel> {
     /// A tet known to be live: the last one made by the last builder that
     /// inserted a point (a thread's tets survive its pass).
     live: u32,
+    /// Points left over by the passes so far.
+    deferred: usize,
 }
 
 impl<K: Kernel> State<'_, K> {
@@ -224,9 +228,6 @@ impl<K: Kernel> State<'_, K> {
         });
         self.builders = attached.into_iter().map(detach).collect();
         let mut deferred = Vec::new();
-        #[cfg(test)]
-        tests::DEFERRED
-            .with(|d| d.set(d.get() + pieces.iter().map(|p| p.deferred.len()).sum::<usize>()));
         for (p, b) in pieces.into_iter().zip(&self.builders) {
             if p.inserted {
                 self.live = b.last;
@@ -235,6 +236,7 @@ impl<K: Kernel> State<'_, K> {
             self.dups.extend(p.dups);
         }
         deferred.sort_unstable();
+        self.deferred += deferred.len();
         Ok(deferred)
     }
 
@@ -341,7 +343,7 @@ pub(crate) fn run<K: Kernel>(
         .0;
     let mut builders = vec![b0];
     builders.extend((1..threads).map(|j| {
-        let seed = super::build::SEED.wrapping_add(j as u64);
+        let seed = SEED.wrapping_add(j as u64);
         Builder::new(pts, ThreadCells::default(), filter, grid, limits, seed)
     }));
     let mut st = State::<K> {
@@ -356,6 +358,7 @@ pub(crate) fn run<K: Kernel>(
         piece: vec![0u8; m + 1],
         dups,
         live,
+        deferred: 0,
     };
     drop(early);
 
@@ -435,35 +438,33 @@ pub(crate) fn run<K: Kernel>(
         cells,
         holes,
         dups: st.dups,
+        stats: BuildStats {
+            threads,
+            deferred: st.deferred,
+        },
     })
 }
 
 #[cfg(test)]
-pub(crate) mod tests {
-    use super::super::build::tests::{int_grid, integer_sphere, uniform_points};
-    use super::super::build::{build_with, Limits};
-    use super::super::order::SplitMix64;
+mod tests {
+    use super::super::build::{build_stats, build_with};
+    use super::super::insert::Limits;
+    use super::super::test_points::{int_grid, integer_sphere, uniform_points};
     use super::super::{DelaunayError, Triangulation, INFINITE};
+    use crate::rng::SplitMix64;
     use proptest::prelude::*;
-
-    thread_local! {
-        /// Points left over by the passes of the parallel builds run on
-        /// this thread.
-        pub(crate) static DEFERRED: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
-    }
 
     /// Builds `pts` on `threads` threads, sharing rounds from `par_min`
     /// points per thread; returns the triangulation and the points left
     /// over by the parallel passes.
     fn build(pts: &[[f64; 3]], threads: usize, par_min: usize) -> (Triangulation, usize) {
-        DEFERRED.with(|d| d.set(0));
         let limits = Limits {
             threads,
             par_min,
             ..Limits::DEFAULT
         };
-        let tri = build_with(pts, limits).unwrap();
-        (tri, DEFERRED.with(|d| d.get()))
+        let (tri, stats) = build_stats(pts, limits).unwrap();
+        (tri, stats.deferred)
     }
 
     /// Every tet (finite and infinite) of `tri` by input indices, each

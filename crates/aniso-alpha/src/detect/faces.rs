@@ -48,7 +48,7 @@ fn triangle_gabriel(tri: &Triangulation, f: [u32; 3], apexes: [u32; 2]) -> bool 
         .all(|&w| triangle_diametral_side(a, b, c, tri.point(w)) >= 0)
 }
 
-const FACE: [[usize; 3]; 4] = [[1, 3, 2], [0, 2, 3], [0, 3, 1], [0, 1, 2]];
+use crate::delaunay::FACE;
 
 /// Whether a triangle with these sides (tet, face) is in F_α. `r` are
 /// the tets' circumradii. Radii and the Gabriel test are computed exactly as
