@@ -183,7 +183,7 @@ proptest! {
 /// and several edge runs per thread.
 #[test]
 fn intervals_do_not_depend_on_thread_count() {
-    let mut r = Rng(0x5151);
+    let mut r = Rng::new(0x5151);
     let mut pts: Vec<[f64; 3]> = (0..60_000)
         .map(|_| [r.uniform(), r.uniform(), r.uniform()])
         .collect();

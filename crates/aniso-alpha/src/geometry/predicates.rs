@@ -983,14 +983,7 @@ pub fn coplanar_incircle_perturbed(p0: &Point3, p1: &Point3, p2: &Point3, p: &Po
 mod tests {
     use super::*;
 
-    /// One step of Knuth's MMIX linear congruential generator (the tests'
-    /// deterministic source of coordinates).
-    fn lcg(s: &mut u64) -> u64 {
-        *s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        *s
-    }
+    use crate::rng::SplitMix64;
 
     fn det3(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
         a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
@@ -1000,8 +993,8 @@ mod tests {
     #[test]
     fn orient_matches_naive_on_small_integers() {
         // Small integers: the naive determinant is exact.
-        let mut s = 12345u64;
-        let mut next = || ((lcg(&mut s) >> 33) % 7) as f64 - 3.0;
+        let mut rng = SplitMix64::new(12345u64);
+        let mut next = || ((rng.next_u64() >> 33) % 7) as f64 - 3.0;
         for _ in 0..5000 {
             let p: Vec<[f64; 3]> = (0..5).map(|_| [next(), next(), next()]).collect();
             let sub = |u: [f64; 3], v: [f64; 3]| [u[0] - v[0], u[1] - v[1], u[2] - v[2]];
@@ -1040,8 +1033,8 @@ mod tests {
 
     #[test]
     fn integer_stage_agrees_with_robust() {
-        let mut s = 99u64;
-        let mut next = |range: u64| (lcg(&mut s) >> 33) % range;
+        let mut rng = SplitMix64::new(99u64);
+        let mut next = |range: u64| (rng.next_u64() >> 33) % range;
         let mut used = 0;
         for round in 0..20000 {
             // Dyadic grids of various scales and offsets, some near the
@@ -1143,8 +1136,8 @@ mod tests {
 
     #[test]
     fn small_grid_kernel_agrees_with_filtered() {
-        let mut s = 5u64;
-        let mut next = |m: u64| (lcg(&mut s) >> 33) % m;
+        let mut rng = SplitMix64::new(5u64);
+        let mut next = |m: u64| (rng.next_u64() >> 33) % m;
         for round in 0..20000 {
             let step = [1.0, 0.25, 8.0][round % 3];
             let offset = [0.0, 1024.0, -3.0 * 1024.0 * 1024.0][round % 3];
@@ -1195,8 +1188,8 @@ mod tests {
         // offsets, judged with the static bound of the whole set: the
         // answer must be the exact one. The plain determinant gets many of
         // these wrong (counted), so a bound that is too small fails here.
-        let mut s = 77u64;
-        let mut unif = || (lcg(&mut s) >> 11) as f64 / (1u64 << 53) as f64;
+        let mut rng = SplitMix64::new(77u64);
+        let mut unif = || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
         let mut plain_wrong = 0;
         for (scale, offset) in [
             (1.0, 0.0),
@@ -1376,8 +1369,8 @@ mod tests {
                 }
             }
         }
-        let mut s = 0x1234_5678u64;
-        let mut next = |n: usize| ((lcg(&mut s) >> 33) % n as u64) as usize;
+        let mut rng = SplitMix64::new(0x1234_5678u64);
+        let mut next = |n: usize| ((rng.next_u64() >> 33) % n as u64) as usize;
         let (mut ties, mut decided_late) = (0, 0);
         while ties < 3000 {
             let mut t = [0usize; 5];
@@ -1414,8 +1407,8 @@ mod tests {
     #[test]
     fn keyed_tie_matches_lex_tie() {
         // A dyadic grid (step 1/4) shifted to negative and large offsets.
-        let mut s = 0x9e37_79b9u64;
-        let mut next = |n: u64| (lcg(&mut s) >> 33) % n;
+        let mut rng = SplitMix64::new(0x9e37_79b9u64);
+        let mut next = |n: u64| (rng.next_u64() >> 33) % n;
         for offset in [0.0, -3.25, 1e6] {
             let grid: Vec<Point3> = (0..200)
                 .map(|_| {
@@ -1454,8 +1447,8 @@ mod tests {
         // Random points, and points near a common sphere and plane, where
         // the static stage must often abstain. Whenever a quick stage
         // answers, it equals the full predicate.
-        let mut s = 0x9e37_79b9u64;
-        let mut unif = || (lcg(&mut s) >> 11) as f64 / (1u64 << 53) as f64;
+        let mut rng = SplitMix64::new(0x9e37_79b9u64);
+        let mut unif = || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
         let filter = StaticFilter::for_box(&[-2.0; 3], &[2.0; 3]);
         let (mut decided, mut abstained) = (0, 0);
         for round in 0..20_000 {
