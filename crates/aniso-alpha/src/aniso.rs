@@ -336,7 +336,7 @@ impl Anisotropy {
     }
 
     /// Q = diag(e) · R: Q_ij = e_i · R_ij (one rounding per entry, see
-    /// [`q_matrix`](crate::geometry::q_matrix)).
+    /// [`q_matrix`]).
     pub fn q(&self) -> Mat3 {
         q_matrix(&self.rotation, &self.elongation)
     }

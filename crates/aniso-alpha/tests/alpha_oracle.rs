@@ -48,7 +48,7 @@ fn edge_predicate_matches_exact_oracle() {
             p = [a[0], b[1], p[2]];
         }
         let want = oracle_edge(&a, &b, &p);
-        let got = edge_diametral_side(&a, &b, &p);
+        let got = edge_diametral_side(&a, &b, &p).to_i32();
         assert_eq!(got, want, "a={a:?} b={b:?} p={p:?}");
         signs[(want + 1) as usize] += 1;
     }
@@ -74,7 +74,7 @@ fn triangle_predicate_matches_exact_oracle() {
         }
         let p = point(&mut r, kind);
         let want = oracle_triangle(&a, &b, &c, &p);
-        let got = triangle_diametral_side(&a, &b, &c, &p);
+        let got = triangle_diametral_side(&a, &b, &c, &p).to_i32();
         assert_eq!(got, want, "a={a:?} b={b:?} c={c:?} p={p:?}");
         signs[(want + 1) as usize] += 1;
         tested += 1;

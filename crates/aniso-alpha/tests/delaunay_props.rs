@@ -7,7 +7,7 @@
 
 mod common;
 use aniso_alpha::delaunay::Triangulation;
-use aniso_alpha::geometry::predicates::{insphere_perturbed, orient3d};
+use aniso_alpha::geometry::predicates::{insphere_perturbed, orient3d, Sign};
 use common::{canonical_sorted, Rng};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
@@ -42,7 +42,7 @@ fn affine_dim(pts: &[[f64; 3]]) -> usize {
     else {
         return 1;
     };
-    if pts.iter().any(|p| orient3d(&a, b, c, p) != 0) {
+    if pts.iter().any(|p| orient3d(&a, b, c, p) != Sign::Zero) {
         3
     } else {
         2
@@ -415,17 +415,17 @@ fn brute_force(pts: &[[f64; 3]]) -> Vec<[u32; 4]> {
                 for d in c + 1..n {
                     let mut t = [a, b, c, d];
                     let o = orient3d(&pts[a], &pts[b], &pts[c], &pts[d]);
-                    if o == 0 {
+                    if o == Sign::Zero {
                         continue;
                     }
-                    if o < 0 {
+                    if o == Sign::Negative {
                         t.swap(0, 1);
                     }
                     let empty = (0..n).all(|e| {
                         t.contains(&e)
                             || insphere_perturbed(
                                 &pts[t[0]], &pts[t[1]], &pts[t[2]], &pts[t[3]], &pts[e],
-                            ) < 0
+                            ) == Sign::Negative
                     });
                     if empty {
                         out.push(t.map(|x| x as u32));
@@ -533,7 +533,7 @@ fn triangle_and_hull_orientations() {
             let [a, b, d] = t.vertices.map(|v| *tri.point(v));
             if apex != INFINITE {
                 // The normal points into sides[0]: towards its apex.
-                assert_eq!(orient3d(&a, &b, &d, tri.point(apex)), 1);
+                assert_eq!(orient3d(&a, &b, &d, tri.point(apex)), Sign::Positive);
             }
             n += 1;
         }
@@ -542,7 +542,7 @@ fn triangle_and_hull_orientations() {
         for f in tri.hull_facets() {
             let [a, b, c] = f.map(|v| *tri.point(v));
             for v in 0..tri.num_vertices() as u32 {
-                assert!(orient3d(&a, &b, &c, tri.point(v)) <= 0);
+                assert!(orient3d(&a, &b, &c, tri.point(v)) <= Sign::Zero);
             }
         }
     }

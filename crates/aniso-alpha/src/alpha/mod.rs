@@ -88,7 +88,7 @@
 
 pub mod exact;
 
-use crate::delaunay::{DelaunayError, Triangulation, EDGES as PAIRS, FACE, INFINITE};
+use crate::delaunay::{DelaunayError, Triangulation, VertexId, EDGES as PAIRS, FACE, INFINITE};
 use crate::geometry::{transform_points, Point3};
 
 /// `Q = diag(e)·R` from a rotation and an elongation (the one definition
@@ -276,10 +276,18 @@ impl AlphaComplex {
         self.tri_face.len()
     }
 
-    /// Vertex ids `(a, b)`, `a < b`, of edge `e`.
+    /// Vertex ids `(a, b)`, `a < b`, of edge `e` (ids of the
+    /// triangulation's vertices, not input indices: see
+    /// [`Self::input_index`]).
     #[inline]
-    pub fn edge_vertices(&self, e: usize) -> [u32; 2] {
-        self.edge_v[e]
+    pub fn edge_vertices(&self, e: usize) -> [VertexId; 2] {
+        self.edge_v[e].map(VertexId)
+    }
+
+    /// The smallest input index of vertex `v`.
+    #[inline]
+    pub fn input_index(&self, v: VertexId) -> u32 {
+        self.tri.input_index(v.0)
     }
 
     /// `(α_min, α_max)` of edge `e`.
@@ -289,8 +297,8 @@ impl AlphaComplex {
     }
 
     /// The id of the edge between vertex ids `a` and `b`, if it exists.
-    pub fn find_edge(&self, a: u32, b: u32) -> Option<usize> {
-        let (a, b) = if a < b { (a, b) } else { (b, a) };
+    pub fn find_edge(&self, a: VertexId, b: VertexId) -> Option<usize> {
+        let (a, b) = (a.0.min(b.0), a.0.max(b.0));
         let s = *self.edge_start.get(a as usize)? as usize;
         let e = *self.edge_start.get(a as usize + 1)? as usize;
         self.edge_v[s..e]
@@ -302,7 +310,13 @@ impl AlphaComplex {
     /// Vertex ids of triangle `f`, ordered so that its normal (right-hand
     /// rule) points into the first of its two cells ([`Self::triangle_cells`]).
     #[inline]
-    pub fn triangle_vertices(&self, f: usize) -> [u32; 3] {
+    pub fn triangle_vertices(&self, f: usize) -> [VertexId; 3] {
+        self.triangle_vertex_ids(f).map(VertexId)
+    }
+
+    /// [`Self::triangle_vertices`] as plain ids.
+    #[inline]
+    fn triangle_vertex_ids(&self, f: usize) -> [u32; 3] {
         let p = self.tri_face[f];
         let (t, i) = (p >> 2, (p & 3) as usize);
         let v = self.tri.tet(t);
@@ -364,7 +378,7 @@ impl AlphaComplex {
     /// indices.
     pub fn triangles(&self) -> impl Iterator<Item = TriangleInterval> + '_ {
         (0..self.num_triangles()).map(move |f| TriangleInterval {
-            vertices: self.input3(self.triangle_vertices(f)),
+            vertices: self.input3(self.triangle_vertex_ids(f)),
             alpha_min: self.tri_iv[f][0],
             alpha_max: self.tri_iv[f][1],
         })
@@ -397,7 +411,7 @@ impl AlphaComplex {
     /// `F_{2,α}` as ascending input-index triples.
     pub fn triangles_at(&self, alpha: f64) -> impl Iterator<Item = [u32; 3]> + '_ {
         self.triangle_ids_at(alpha)
-            .map(move |f| self.input3(self.triangle_vertices(f)))
+            .map(move |f| self.input3(self.triangle_vertex_ids(f)))
     }
 
     /// The α spectrum: every distinct finite critical value, ascending —
@@ -440,7 +454,7 @@ impl AlphaComplex {
             if in_t == in_n {
                 continue;
             }
-            let [a, b, c] = self.triangle_vertices(f).map(|x| self.tri.input_index(x));
+            let [a, b, c] = self.triangle_vertex_ids(f).map(|x| self.tri.input_index(x));
             // The normal of (a, b, c) points into t.
             out.push(if in_t { [a, c, b] } else { [a, b, c] });
         }
@@ -697,7 +711,8 @@ impl TriangleCtx<'_> {
                         &pts[x as usize],
                         &pts[y as usize],
                         &pts[z as usize],
-                    ) < 0;
+                    )
+                    .is_negative();
                     refuted |= (inside as u8) << e;
                 }
                 out.push(TriangleOut {

@@ -29,7 +29,7 @@ pub(crate) fn initial_simplex(points: &[Point3], order: &[u32]) -> Result<[u32; 
     let c = &points[p2 as usize];
     let Some(&p3) = order
         .iter()
-        .find(|&&i| orient3d(a, b, c, &points[i as usize]) != 0)
+        .find(|&&i| !orient3d(a, b, c, &points[i as usize]).is_zero())
     else {
         return Err(2);
     };

@@ -18,14 +18,14 @@
 ///
 /// ```
 /// use aniso_alpha::delaunay::{Triangulation, FACE};
-/// use aniso_alpha::geometry::predicates::orient3d;
+/// use aniso_alpha::geometry::predicates::{orient3d, Sign};
 /// let pts = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 /// let tri = Triangulation::new(&pts)?;
 /// let v = tri.finite_tets().next().unwrap();
 /// let p = |k: usize| tri.point(v[k]);
 /// for (i, f) in FACE.iter().enumerate() {
 ///     // Face i, then vertex i: positively oriented.
-///     assert_eq!(orient3d(p(f[0]), p(f[1]), p(f[2]), p(i)), 1);
+///     assert_eq!(orient3d(p(f[0]), p(f[1]), p(f[2]), p(i)), Sign::Positive);
 /// }
 /// # Ok::<(), aniso_alpha::delaunay::DelaunayError>(())
 /// ```

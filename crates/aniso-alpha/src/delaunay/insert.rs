@@ -46,7 +46,7 @@ fn tet_in_conflict<K: Kernel>(
         if o != 0 {
             return o > 0;
         }
-        coplanar_incircle_perturbed(p(v[0]), p(v[1]), p(v[2]), q) > 0
+        coplanar_incircle_perturbed(p(v[0]), p(v[1]), p(v[2]), q).is_positive()
     } else {
         insphere_perturbed_k::<K>(p(v[0]), p(v[1]), p(v[2]), p(v[3]), q, filter) > 0
     }
@@ -522,7 +522,8 @@ impl Input {
             &points[s[1] as usize],
             &points[s[2] as usize],
             &points[s[3] as usize],
-        ) < 0
+        )
+        .is_negative()
         {
             s.swap(0, 1);
         }

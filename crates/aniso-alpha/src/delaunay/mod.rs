@@ -60,6 +60,33 @@ use crate::geometry::Point3;
 /// The id of the infinite vertex.
 pub const INFINITE: u32 = u32::MAX;
 
+/// A vertex of a triangulation: an index into [`Triangulation::points`],
+/// in insertion order, as opposed to an index into the caller's input
+/// (duplicates share one vertex; [`Triangulation::input_index`] and
+/// [`Triangulation::vertex_of_input`] translate). The
+/// [`AlphaComplex`](crate::alpha::AlphaComplex) reports both kinds, and
+/// gives its vertex ids this type so that the two cannot be mixed up.
+///
+/// ```
+/// use aniso_alpha::AlphaComplex;
+/// // The first input point is a duplicate of the third.
+/// let pts = [[1.0, 1.0, 1.0], [0.0, 0.0, 0.0], [1.0, 1.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+/// let ac = AlphaComplex::from_points(&pts)?;
+/// let [a, b] = ac.edge_vertices(0);
+/// assert!(a < b);
+/// let tri = ac.triangulation();
+/// assert_eq!(tri.point(a.0), &pts[ac.input_index(a) as usize]);
+/// # Ok::<(), aniso_alpha::delaunay::DelaunayError>(())
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct VertexId(pub u32);
+
+impl From<VertexId> for u32 {
+    fn from(v: VertexId) -> u32 {
+        v.0
+    }
+}
+
 /// Error building a triangulation.
 #[derive(Debug, Clone, PartialEq)]
 pub enum DelaunayError {

@@ -45,7 +45,7 @@ fn triangle_gabriel(tri: &Triangulation, f: [u32; 3], apexes: [u32; 2]) -> bool 
     apexes
         .iter()
         .filter(|&&w| w != INFINITE)
-        .all(|&w| triangle_diametral_side(a, b, c, tri.point(w)) >= 0)
+        .all(|&w| !triangle_diametral_side(a, b, c, tri.point(w)).is_negative())
 }
 
 use crate::delaunay::FACE;
@@ -115,7 +115,7 @@ pub fn edges_at(tri: &Triangulation, alpha: f64) -> Vec<[u32; 2]> {
             tri.tet(t)
                 .iter()
                 .filter(|&&w| w != a && w != b && w != INFINITE)
-                .all(|&w| edge_diametral_side(pa, pb, tri.point(w)) >= 0)
+                .all(|&w| !edge_diametral_side(pa, pb, tri.point(w)).is_negative())
         });
         let inside = gabriel || {
             // α_min = min over incident triangles of their α_min: the

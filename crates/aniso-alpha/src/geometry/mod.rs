@@ -13,7 +13,7 @@ pub use linear::{
     add, cross, det3, dot, mat_mul, norm, normalize, q_matrix, scale, sub, transform_point,
     transform_points, Mat3,
 };
-pub use predicates::Point3;
+pub use predicates::{Point3, Sign};
 
 /// The axis-aligned bounding box `(lo, hi)` of `points`; for an empty slice
 /// `lo` is `+∞` and `hi` is `−∞` on every axis.
