@@ -6,6 +6,7 @@
 //! Nothing here knows about triangulation topology.
 
 pub mod circum;
+pub mod kdtree;
 mod linear;
 pub mod predicates;
 
