@@ -9,6 +9,7 @@ pub mod circum;
 pub mod kdtree;
 mod linear;
 pub mod predicates;
+mod wide;
 
 pub use linear::{
     add, cross, det3, dot, mat_mul, norm, normalize, q_matrix, scale, sub, transform_point,

@@ -17,6 +17,7 @@
 //! * [`insphere`]`(a, b, c, d, e)` is positive when `e` lies strictly inside
 //!   the circumsphere of the *positively oriented* tetrahedron `abcd`.
 
+use super::wide::{insphere_narrow_f, insphere_wide, orient3d_narrow_f, orient3d_wide};
 use robust::{Coord, Coord3D};
 
 /// A point in 3D.
@@ -542,7 +543,17 @@ fn orient3d_slow(a: &Point3, b: &Point3, c: &Point3, d: &Point3) -> i32 {
     if small_ints(&r, 65536.0) && [a, b, c, d].iter().all(|p| small_ints(&p[..], 4.5e15)) {
         return -sign(orient_det(&r));
     }
+    // Then exact integers: coordinates within 60 bits of each other (most
+    // data), differences within 23 bits (coordinates far from the origin),
+    // coordinates within 100 bits, and only beyond that `robust`'s
+    // expansions.
+    if let Some(s) = orient3d_narrow_f(a, b, c, d) {
+        return -s;
+    }
     if let Some(s) = orient3d_int(a, b, c, d) {
+        return -s;
+    }
+    if let Some(s) = orient3d_wide(a, b, c, d) {
         return -s;
     }
     -sign(robust::orient3d(c3(a), c3(b), c3(c), c3(d)))
@@ -558,7 +569,14 @@ fn insphere_slow(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> 
     if small_ints(&r, 512.0) && [a, b, c, d, e].iter().all(|p| small_ints(&p[..], 4.5e15)) {
         return -sign(insphere_det(&r));
     }
+    // Then exact integers, as in `orient3d_slow`.
+    if let Some(s) = insphere_narrow_f(a, b, c, d, e) {
+        return -s;
+    }
     if let Some(s) = insphere_int(a, b, c, d, e) {
+        return -s;
+    }
+    if let Some(s) = insphere_wide(a, b, c, d, e) {
         return -s;
     }
     -sign(robust::insphere(c3(a), c3(b), c3(c), c3(d), c3(e)))
