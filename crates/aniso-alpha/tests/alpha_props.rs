@@ -121,7 +121,12 @@ fn tied_radii_keep_intervals_ordered() {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(128))]
+    // A fixed seed: the same cases on every run.
+    #![proptest_config(ProptestConfig {
+        cases: 128,
+        rng_seed: proptest::test_runner::RngSeed::Fixed(0xA1FA),
+        ..ProptestConfig::default()
+    })]
 
     #[test]
     fn identity_is_euclidean(pts in points_strategy()) {

@@ -101,12 +101,17 @@ pub(crate) fn build_stats(
     }
     check_coordinates(points)?;
     // A parallel build's shared cells are zeroed by another thread while
-    // this one orders the points.
+    // this one orders the points (see `parallel::Zeroing`).
     let zeroed = parallel::start(n, &limits);
     // (-0.0 == 0.0 for every comparison below, so signed zeros are one point.)
     // The bounding box orders the points and gives the static filter.
     let bbox = crate::geometry::bounding_box(points);
-    let (order, rounds) = brio_order(points, &bbox, 0x5EED_0A11_A1FA_u64, limits.isa);
+    let (order, rounds, distinct) = brio_order(points, &bbox, 0x5EED_0A11_A1FA_u64, limits.isa);
+    if let Some(z) = &zeroed {
+        // The rest of the shared cells: as many as the distinct points
+        // need.
+        z.aim(distinct);
+    }
     let init = match initial_simplex(points, &order) {
         Ok(s) => s,
         Err(dim) => return Ok((lower_dimensional(points, dim), BuildStats::default())),
@@ -157,7 +162,7 @@ fn run<K: Kernel>(
     limits: &Limits,
     filter: StaticFilter,
     grid: Option<([f64; 3], f64)>,
-    zeroed: Option<parallel::Zeroed>,
+    zeroed: Option<parallel::Zeroing>,
 ) -> Result<Built, Stop> {
     match zeroed {
         Some(zeroed) => parallel::run::<K>(input, limits, filter, grid, zeroed),
@@ -252,8 +257,119 @@ fn finish(input: Input, built: Built) -> Triangulation {
 #[cfg(test)]
 mod tests {
     use super::super::insert::Limits;
-    use super::{build_with, DelaunayError};
+    use super::super::Triangulation;
+    use super::{build_stats, build_with, DelaunayError};
     use crate::rng::SplitMix64;
+
+    /// `n` points on a line in random order along it, each coordinate
+    /// rounded to `step` (the cliff of issue 19: nearly collinear points).
+    fn rounded_line(seed: u64, n: usize, step: f64) -> Vec<[f64; 3]> {
+        let mut rng = SplitMix64::new(seed);
+        let round = |x: f64| (x / step).round() * step;
+        (0..n)
+            .map(|_| {
+                let t = rng.uniform();
+                [round(t), round(0.7 * t), round(0.3 * t)]
+            })
+            .collect()
+    }
+
+    /// Builds `pts` on one thread and on `threads` threads (sharing rounds
+    /// from 32 points per thread): both valid, with the same vertices, the
+    /// same input mapping and the same tets.
+    fn same_on_threads(pts: &[[f64; 3]], threads: usize) -> Triangulation {
+        let one = build_with(pts, Limits::DEFAULT).unwrap();
+        one.validate_with_input(pts).unwrap();
+        let limits = Limits {
+            threads,
+            par_min: 32,
+            ..Limits::DEFAULT
+        };
+        let (par, stats) = build_stats(pts, limits).unwrap();
+        assert_eq!(stats.threads, threads);
+        par.validate_with_input(pts).unwrap();
+        assert_eq!(par.points(), one.points());
+        assert_eq!(par.input_vert, one.input_vert);
+        assert_eq!(par.vert_input, one.vert_input);
+        let sorted = |t: &Triangulation| {
+            let mut v: Vec<[u32; 4]> = t
+                .finite_tets()
+                .map(|mut x| {
+                    x.sort_unstable();
+                    x
+                })
+                .collect();
+            v.sort_unstable();
+            v
+        };
+        assert!(sorted(&par) == sorted(&one));
+        one
+    }
+
+    /// Nearly collinear points: a line rounded to 1e-6 (every in-sphere
+    /// test is close to a tie, and most need exact arithmetic), and a line
+    /// whose points are exactly collinear in decimal, so collinear up to the
+    /// rounding of the decimals to binary (every test is exact).
+    #[test]
+    fn nearly_collinear_points_triangulate() {
+        for pts in [
+            rounded_line(1, 4000, 1e-6),
+            (0..4000)
+                .map(|i| {
+                    let t = i as f64 * 1e-4;
+                    [t, 0.7 * t, 0.3 * t].map(|x| (x * 1e6).round() / 1e6)
+                })
+                .collect(),
+        ] {
+            let tri = same_on_threads(&pts, 2);
+            assert_eq!(tri.dimension(), 3);
+            assert!(tri.num_finite_tets() > pts.len());
+        }
+    }
+
+    /// Duplicate-heavy input: 31 copies of each of 500 points, in random
+    /// order, on one and several threads: every copy maps to the vertex of
+    /// its point, and the vertex stands for the first copy in the input.
+    #[test]
+    fn duplicate_heavy_input() {
+        let mut rng = SplitMix64::new(31);
+        let base: Vec<[f64; 3]> = (0..500)
+            .map(|_| [rng.uniform(), rng.uniform(), rng.uniform()])
+            .collect();
+        let mut pts: Vec<[f64; 3]> = base.iter().flat_map(|p| [*p; 31]).collect();
+        for i in (1..pts.len()).rev() {
+            pts.swap(i, rng.below(i as u64 + 1) as usize);
+        }
+        for threads in [2, 3] {
+            let tri = same_on_threads(&pts, threads);
+            assert_eq!(tri.num_vertices(), 500);
+            assert_eq!(tri.num_duplicates(), 30 * 500);
+            for v in 0..500u32 {
+                let first = tri.input_index(v) as usize;
+                assert!((0..first).all(|i| pts[i] != pts[first]));
+            }
+        }
+        // The same points without the copies: the same triangulation.
+        let distinct: Vec<[f64; 3]> = (0..pts.len())
+            .filter(|&i| (0..i).all(|j| pts[j] != pts[i]))
+            .map(|i| pts[i])
+            .collect();
+        let tri = build_with(&pts, Limits::DEFAULT).unwrap();
+        let alone = build_with(&distinct, Limits::DEFAULT).unwrap();
+        let coords = |t: &Triangulation| {
+            let mut v: Vec<[[u64; 3]; 4]> = t
+                .finite_tets()
+                .map(|x| {
+                    let mut c = x.map(|w| t.point(w).map(f64::to_bits));
+                    c.sort_unstable();
+                    c
+                })
+                .collect();
+            v.sort_unstable();
+            v
+        };
+        assert!(coords(&tri) == coords(&alone));
+    }
 
     #[test]
     fn tet_limit_is_a_typed_error() {

@@ -79,7 +79,8 @@ pub(crate) struct Builder<'p, K: Kernel, S> {
     rng: SplitMix64,
     /// The current insertion's cavity (scratch, reused across insertions).
     cav: Cavity,
-    /// Where the next walk starts (a tet this builder owns).
+    /// Where the next walk starts: a live tet this builder may read (one
+    /// it made last, or where it found the last duplicate).
     pub(crate) last: u32,
     /// Whether insertions run the x86-64-v3 copy of the code (set only
     /// when [`has_v3`](super::isa::has_v3) holds).
@@ -228,6 +229,26 @@ impl<K: Kernel, S: Store> Builder<'_, K, S> {
         self.insert_baseline(vid)
     }
 
+    /// [`Builder::insert`] after point `prev.0`, which became vertex
+    /// `prev.1` (itself, or the vertex it duplicates): a point equal to it
+    /// duplicates that vertex without a walk. Equal points are consecutive
+    /// in the insertion order wherever they crowd (see
+    /// `order::refine_crowded`), so a run of copies costs one comparison
+    /// each.
+    #[inline]
+    pub(crate) fn insert_after(
+        &mut self,
+        vid: u32,
+        prev: Option<(u32, u32)>,
+    ) -> Result<Option<u32>, Stop> {
+        if let Some((p, w)) = prev {
+            if self.pts[p as usize].0 == self.pts[vid as usize].0 {
+                return Ok(Some(w));
+            }
+        }
+        self.insert(vid)
+    }
+
     /// [`Builder::insert`] for the target's baseline instruction set.
     #[inline(never)]
     fn insert_baseline(&mut self, vid: u32) -> Result<Option<u32>, Stop> {
@@ -254,10 +275,13 @@ impl<K: Kernel, S: Store> Builder<'_, K, S> {
     /// [`Builder::insert`]).
     #[inline(always)]
     fn insert_at(&mut self, vid: u32, q: Point3, start: u32) -> Result<Option<u32>, Stop> {
-        // A duplicate lies on a vertex of the located (finite) tet.
+        // A duplicate lies on a vertex of the located (finite) tet, which
+        // is where the next walk starts (the next point is often another
+        // copy, or near it).
         let sv = self.store.cell(start).v;
         for w in sv {
             if w != INFINITE && self.pts[w as usize].0 == q {
+                self.last = start;
                 return Ok(Some(w));
             }
         }
@@ -625,7 +649,7 @@ mod tests {
     fn a_stopped_insertion_is_undone() {
         let pts = uniform_points(9, 3000);
         let bbox = crate::geometry::bounding_box(&pts);
-        let (order, rounds) = brio_order(&pts, &bbox, 1, Isa::Detect);
+        let (order, rounds, _) = brio_order(&pts, &bbox, 1, Isa::Detect);
         let init = initial_simplex(&pts, &order).unwrap();
         let input = Input::new(&pts, &order, &rounds, init, None, bbox);
         let filter = StaticFilter::for_box(&bbox.0, &bbox.1);

@@ -52,10 +52,18 @@ pub(crate) fn run_owned<'p, K: Kernel>(
     let mut b = Builder::<K, _>::new(&input.pts, store, filter, grid, limits, SEED);
     b.last = first_tet(&mut b.store)?;
     let mut dups = Vec::new();
+    // The previous point and the vertex it became (the first tet's last
+    // vertex before the first insertion).
+    let mut prev = (3, 3);
     for vid in 4..end as u32 {
-        if let Some(w) = b.insert(vid)? {
-            dups.push((vid, w));
-        }
+        let w = match b.insert_after(vid, Some(prev))? {
+            Some(w) => {
+                dups.push((vid, w));
+                w
+            }
+            None => vid,
+        };
+        prev = (vid, w);
     }
     Ok((b, dups))
 }
