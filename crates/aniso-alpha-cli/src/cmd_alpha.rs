@@ -100,10 +100,9 @@ pub fn run(args: &AlphaArgs, timings: &mut Timings) -> Result<(), CliError> {
             .filter(|e| in_tri.binary_search(e).is_err())
             .collect();
         let mesh = Mesh {
-            points: &cloud.points,
-            labels: None,
             edges: &edges,
             faces: &faces,
+            ..Mesh::new(&cloud.points)
         };
         common::write_mesh(path, &mesh, timings)?;
         common::info(format_args!(

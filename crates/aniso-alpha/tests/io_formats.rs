@@ -42,10 +42,10 @@ fn ply_round_trip_ascii_and_binary_exact_bits() {
     let edges = [[0u32, 1], [4, 5]];
     let faces = [[0u32, 1, 2], [3, 4, 5]];
     let mesh = Mesh {
-        points: &pts,
         labels: Some(&labels),
         edges: &edges,
         faces: &faces,
+        ..Mesh::new(&pts)
     };
     for (enc, name) in [
         (PlyEncoding::Ascii, "a.ply"),

@@ -538,10 +538,17 @@ pub struct Mesh<'a> {
     /// One label per point (written as the int vertex property
     /// `structure`), if any.
     pub labels: Option<&'a [i64]>,
+    /// One part id per point (the int vertex property `part`), if any
+    /// (PLY only).
+    pub parts: Option<&'a [i64]>,
     /// Edges (PLY element `edge`, OBJ `l` lines).
     pub edges: &'a [[u32; 2]],
     /// Triangles (PLY element `face`, OBJ `f` lines).
     pub faces: &'a [[u32; 3]],
+    /// Per edge, then per face: (structure, part), written as the int
+    /// properties `structure` and `part` of the `edge` and `face` elements
+    /// (PLY only). Either empty or one per edge and face.
+    pub element_labels: &'a [[i64; 2]],
 }
 
 impl<'a> Mesh<'a> {
@@ -550,8 +557,10 @@ impl<'a> Mesh<'a> {
         Mesh {
             points,
             labels: None,
+            parts: None,
             edges: &[],
             faces: &[],
+            element_labels: &[],
         }
     }
 
@@ -559,13 +568,28 @@ impl<'a> Mesh<'a> {
     pub(crate) fn validate(&self) -> std::io::Result<()> {
         let invalid = |m: String| std::io::Error::new(std::io::ErrorKind::InvalidInput, m);
         let n = self.points.len();
-        if let Some(l) = self.labels {
+        for l in [self.labels, self.parts].into_iter().flatten() {
             if l.len() != n {
                 return Err(invalid(format!("{} labels for {} points", l.len(), n)));
             }
             if let Some(v) = l.iter().find(|v| i32::try_from(**v).is_err()) {
                 return Err(invalid(format!("label {v} does not fit a PLY int")));
             }
+        }
+        let ne = self.edges.len() + self.faces.len();
+        if !self.element_labels.is_empty() && self.element_labels.len() != ne {
+            return Err(invalid(format!(
+                "{} element labels for {ne} edges and faces",
+                self.element_labels.len()
+            )));
+        }
+        if let Some(v) = self
+            .element_labels
+            .iter()
+            .flatten()
+            .find(|v| i32::try_from(**v).is_err())
+        {
+            return Err(invalid(format!("label {v} does not fit a PLY int")));
         }
         let limit = n.min(i32::MAX as usize);
         let bad = self
@@ -624,12 +648,22 @@ pub fn write_ply_to(
     if mesh.labels.is_some() {
         w.write_all(b"property int structure\n")?;
     }
+    if mesh.parts.is_some() {
+        w.write_all(b"property int part\n")?;
+    }
+    let el = !mesh.element_labels.is_empty();
+    let el_props: &[u8] = if el {
+        b"property int structure\nproperty int part\n"
+    } else {
+        b""
+    };
     if !mesh.edges.is_empty() {
         write!(
             w,
             "element edge {}\nproperty int vertex1\nproperty int vertex2\n",
             mesh.edges.len()
         )?;
+        w.write_all(el_props)?;
     }
     if !mesh.faces.is_empty() {
         write!(
@@ -637,22 +671,36 @@ pub fn write_ply_to(
             "element face {}\nproperty list uchar int vertex_indices\n",
             mesh.faces.len()
         )?;
+        w.write_all(el_props)?;
     }
+    let (edge_labels, face_labels) = if el {
+        mesh.element_labels.split_at(mesh.edges.len())
+    } else {
+        (&[][..], &[][..])
+    };
     w.write_all(b"end_header\n")?;
     match encoding {
         PlyEncoding::Ascii => {
             for (i, p) in mesh.points.iter().enumerate() {
                 write!(w, "{} {} {}", p[0], p[1], p[2])?;
-                if let Some(l) = mesh.labels {
+                for l in [mesh.labels, mesh.parts].into_iter().flatten() {
                     write!(w, " {}", l[i])?;
                 }
                 w.write_all(b"\n")?;
             }
-            for e in mesh.edges {
-                writeln!(w, "{} {}", e[0], e[1])?;
+            for (k, e) in mesh.edges.iter().enumerate() {
+                write!(w, "{} {}", e[0], e[1])?;
+                if let Some([s, p]) = edge_labels.get(k) {
+                    write!(w, " {s} {p}")?;
+                }
+                w.write_all(b"\n")?;
             }
-            for f in mesh.faces {
-                writeln!(w, "3 {} {} {}", f[0], f[1], f[2])?;
+            for (k, f) in mesh.faces.iter().enumerate() {
+                write!(w, "3 {} {} {}", f[0], f[1], f[2])?;
+                if let Some([s, p]) = face_labels.get(k) {
+                    write!(w, " {s} {p}")?;
+                }
+                w.write_all(b"\n")?;
             }
         }
         PlyEncoding::BinaryLittleEndian => {
@@ -668,21 +716,31 @@ pub fn write_ply_to(
                 for c in p {
                     buf.extend_from_slice(&c.to_le_bytes());
                 }
-                if let Some(l) = mesh.labels {
+                for l in [mesh.labels, mesh.parts].into_iter().flatten() {
                     buf.extend_from_slice(&(l[i] as i32).to_le_bytes());
                 }
                 flush(&mut buf, false)?;
             }
-            for e in mesh.edges {
+            for (k, e) in mesh.edges.iter().enumerate() {
                 for v in e {
                     buf.extend_from_slice(&(*v as i32).to_le_bytes());
                 }
+                if let Some(sp) = edge_labels.get(k) {
+                    for x in sp {
+                        buf.extend_from_slice(&(*x as i32).to_le_bytes());
+                    }
+                }
                 flush(&mut buf, false)?;
             }
-            for f in mesh.faces {
+            for (k, f) in mesh.faces.iter().enumerate() {
                 buf.push(3);
                 for v in f {
                     buf.extend_from_slice(&(*v as i32).to_le_bytes());
+                }
+                if let Some(sp) = face_labels.get(k) {
+                    for x in sp {
+                        buf.extend_from_slice(&(*x as i32).to_le_bytes());
+                    }
                 }
                 flush(&mut buf, false)?;
             }
