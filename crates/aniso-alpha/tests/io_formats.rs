@@ -354,6 +354,28 @@ fn pcd_ascii_binary_compressed() {
         ),
         ("FIELDS x y z\nDATA ascii\n1 2 3\n".to_string(), "no POINTS"),
         ("FIELDS x y z\nPOINTS 1\n".to_string(), "no DATA"),
+        // Issue 19 §1: a field of COUNT 0 (ascii: index out of bounds;
+        // binary: zero stride, 10M points from 12 bytes, or 96 GB reserved).
+        (
+            "FIELDS x y z i\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 0\nPOINTS 1\nDATA ascii\n1 2 3\n"
+                .to_string(),
+            "field 'i' has SIZE 4 and COUNT 0",
+        ),
+        (
+            "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 0 0 0\nPOINTS 10000000\nDATA binary\n\0\0\0\0\0\0\0\0\0\0\0\0"
+                .to_string(),
+            "COUNT 0",
+        ),
+        (
+            "FIELDS x y z\nSIZE 4 4 0\nTYPE F F F\nPOINTS 4000000000\nDATA binary_compressed\n"
+                .to_string(),
+            "SIZE 0",
+        ),
+        (
+            "FIELDS x y z\nWIDTH 2\nHEIGHT 2\nPOINTS 3\nDATA ascii\n1 2 3\n1 2 3\n1 2 3\n"
+                .to_string(),
+            "POINTS 3 differs from WIDTH × HEIGHT = 2 × 2 = 4",
+        ),
     ];
     for (text, want) in errors {
         let e = read_pcd_bytes(Path::new("c.pcd"), text.as_bytes(), &labels).unwrap_err();

@@ -150,11 +150,39 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header, IoError> {
     {
         return Err(IoError::format(path, "PCD header: field too large"));
     }
-    let points = match (points, width, height) {
-        (Some(p), _, _) => p,
-        (None, Some(w), Some(h)) => w
-            .checked_mul(h)
-            .ok_or_else(|| IoError::format(path, "PCD header: WIDTH × HEIGHT overflows"))?,
+    // A zero-size field would make a zero stride: any POINTS would then
+    // "fit" in no data (issue 19: 12 bytes read as 10M points).
+    if let Some(f) = fields.iter().find(|f| f.size == 0 || f.count == 0) {
+        return Err(IoError::format(
+            path,
+            format!(
+                "PCD header: field '{}' has SIZE {} and COUNT {} (both must be at least 1)",
+                show_token(f.name.as_bytes()),
+                f.size,
+                f.count
+            ),
+        ));
+    }
+    let area = match (width, height) {
+        (Some(w), Some(h)) => Some(
+            w.checked_mul(h)
+                .ok_or_else(|| IoError::format(path, "PCD header: WIDTH × HEIGHT overflows"))?,
+        ),
+        _ => None,
+    };
+    let points = match (points, area) {
+        (Some(p), Some(a)) if p != a => {
+            return Err(IoError::format(
+                path,
+                format!(
+                    "PCD header: POINTS {p} differs from WIDTH × HEIGHT = {} × {} = {a}",
+                    width.unwrap_or(0),
+                    height.unwrap_or(0)
+                ),
+            ))
+        }
+        (Some(p), _) => p,
+        (None, Some(a)) => a,
         _ => return Err(IoError::format(path, "PCD header has no POINTS line")),
     };
     Ok(Header {
