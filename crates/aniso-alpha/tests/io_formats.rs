@@ -534,7 +534,9 @@ fn las_file(format: u8, extra: u16, compressed: bool, n: usize) -> Option<Vec<u8
             number_of_returns: 1,
             classification: las::point::Classification::new((i % 7) as u8).ok()?,
             gps_time: f.has_gps_time.then_some(i as f64 * 0.001),
-            color: f.has_color.then_some(las::Color::new(i as u16, 2 * i as u16, 3)),
+            color: f
+                .has_color
+                .then_some(las::Color::new(i as u16, 2 * i as u16, 3)),
             nir: f.has_nir.then_some(i as u16),
             waveform: f.has_waveform.then(las::raw::point::Waveform::default),
             extra_bytes: (0..extra).map(|k| (i + k as usize) as u8).collect(),
@@ -573,8 +575,8 @@ fn laz_of_every_point_format_reads_like_las() {
             ) else {
                 panic!("format {format}: the las crate could not write it");
             };
-            let a = read_points_bytes(Path::new("a.las"), &las, &ReadOptions::with_labels(0))
-                .unwrap();
+            let a =
+                read_points_bytes(Path::new("a.las"), &las, &ReadOptions::with_labels(0)).unwrap();
             let b = read_points_bytes(Path::new("a.laz"), &laz, &ReadOptions::with_labels(0))
                 .unwrap_or_else(|e| panic!("format {format} extra {extra}: {e}"));
             assert_eq!(a, b, "format {format} extra {extra}");

@@ -181,7 +181,9 @@ fn u32_at(b: &[u8], o: usize) -> Option<u64> {
 }
 
 fn u64_at(b: &[u8], o: usize) -> Option<u64> {
-    Some(u64::from_le_bytes(b.get(o..o.checked_add(8)?)?.try_into().ok()?))
+    Some(u64::from_le_bytes(
+        b.get(o..o.checked_add(8)?)?.try_into().ok()?,
+    ))
 }
 
 /// Checks the header fields that the `las` crate trusts for allocations

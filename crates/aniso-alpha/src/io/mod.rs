@@ -40,7 +40,9 @@ use std::fs::File;
 use std::io::Read;
 use std::path::Path;
 
-pub use atomic::{atomic_write, check_output_path};
+pub use atomic::{
+    atomic_write, check_output_path, output_key, remove_temp_files, resolve_output, same_file,
+};
 pub use error::IoError;
 pub use labels::{read_labels, read_labels_bytes, write_labels};
 pub use obj::write_obj;
