@@ -107,15 +107,20 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
         std::fs::create_dir_all(&dir)
             .map_err(|e| CliError::msg(format!("{}: cannot create folder: {e}", dir.display())))?;
     }
-    common::check_outputs([
-        labels_path.as_deref(),
-        parts_path.as_deref(),
-        report_path.as_deref(),
-        scene_path.as_deref(),
-    ])?;
     if let Some(out) = &output_path {
-        common::check_mesh_output(out)?;
+        common::mesh_format(out)?;
     }
+    let inputs: Vec<&std::path::Path> = args.input.iter().map(|p| p.as_path()).collect();
+    common::check_io(
+        &inputs,
+        &[
+            ("--labels", labels_path.as_deref()),
+            ("--part-labels", parts_path.as_deref()),
+            ("--output", output_path.as_deref()),
+            ("--report", report_path.as_deref()),
+            ("(scene)", scene_path.as_deref()),
+        ],
+    )?;
     let (points, truth, name) = match &args.input {
         Some(input) => {
             let cloud = common::read_input(input, &ReadOptions::default(), timings)?;

@@ -67,7 +67,7 @@ pub struct SynthArgs {
 
 /// Runs `synth`.
 pub fn run(args: &SynthArgs, timings: &mut Timings) -> Result<(), CliError> {
-    common::check_output(&args.output)?;
+    common::check_io(&[], &[("--output", Some(&args.output))])?;
     let mut opts = match args.scene {
         Scene::Lines => SceneOptions::lines(),
         Scene::Planes => SceneOptions::planes(),

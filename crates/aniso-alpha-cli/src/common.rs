@@ -235,19 +235,62 @@ pub fn read_truth(
 }
 
 /// Fails early, before any long computation, when `path` cannot be an
-/// output (missing folder, a directory).
+/// output (missing or read-only folder, a directory, a device node or a
+/// FIFO).
 pub fn check_output(path: &Path) -> Result<(), CliError> {
     Ok(aio::check_output_path(path)?)
 }
 
-/// [`check_output`] for each given optional output.
-pub fn check_outputs<'a>(
-    paths: impl IntoIterator<Item = Option<&'a Path>>,
-) -> Result<(), CliError> {
-    for p in paths.into_iter().flatten() {
-        check_output(p)?;
+/// Checks a command's files before any work: every output can be written
+/// ([`check_output`]), no output is also an input (the same file, through
+/// any link), and no two outputs write the same file. `outputs` pairs each
+/// output with the option that names it.
+pub fn check_io(inputs: &[&Path], outputs: &[(&str, Option<&Path>)]) -> Result<(), CliError> {
+    let given: Vec<(&str, &Path)> = outputs
+        .iter()
+        .filter_map(|(flag, p)| p.map(|p| (*flag, p)))
+        .collect();
+    let mut keys: Vec<(std::path::PathBuf, &str)> = Vec::new();
+    for &(flag, out) in &given {
+        for input in inputs {
+            if aio::same_file(input, out) {
+                return Err(CliError::msg(format!(
+                    "{flag} {}: is the input file {}; refusing to overwrite an input",
+                    out.display(),
+                    input.display()
+                )));
+            }
+        }
+        let key = aio::output_key(out);
+        if let Some((_, other)) = keys.iter().find(|(k, _)| *k == key) {
+            return Err(CliError::msg(format!(
+                "{other} and {flag} name the same file {}: give each output its own path",
+                out.display()
+            )));
+        }
+        keys.push((key, flag));
+    }
+    for &(_, out) in &given {
+        check_output(out)?;
     }
     Ok(())
+}
+
+/// Removes the temporary files of unfinished outputs on SIGINT, SIGTERM
+/// and SIGHUP, then exits with status 128 + the signal number.
+pub fn install_signal_cleanup() {
+    #[cfg(unix)]
+    {
+        use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+        if let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) {
+            std::thread::spawn(move || {
+                if let Some(sig) = signals.forever().next() {
+                    aio::remove_temp_files();
+                    std::process::exit(128 + sig);
+                }
+            });
+        }
+    }
 }
 
 /// Output formats for simplices.
@@ -273,12 +316,6 @@ pub fn mesh_format(path: &Path) -> Result<MeshFormat, CliError> {
             path.display()
         ))),
     }
-}
-
-/// [`check_output`] plus a known mesh extension; call it early.
-pub fn check_mesh_output(path: &Path) -> Result<(), CliError> {
-    mesh_format(path)?;
-    check_output(path)
 }
 
 /// Writes simplices as PLY (binary) or OBJ by extension, atomically, as
@@ -414,8 +451,8 @@ mod tests {
             .contains("f 1 2 3"));
         let e = write_mesh(&dir.join("m.stl"), &mesh, &mut t).unwrap_err();
         assert!(e.to_string().contains("m.stl: unknown output extension"));
-        assert!(check_mesh_output(&dir.join("m.txt")).is_err());
-        assert!(check_mesh_output(&dir.join("nope").join("m.ply")).is_err());
+        assert!(mesh_format(&dir.join("m.txt")).is_err());
+        assert!(check_output(&dir.join("nope").join("m.ply")).is_err());
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
