@@ -159,7 +159,17 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
         Structure::Planes => Detector::planes(alpha, lambda2, lambda3, nb_c),
     }
     .sampler(sampler);
-    let n_orient = detector.orientation_set()?.len();
+    let n_orient = detector
+        .orientation_set()
+        .map_err(|e| {
+            let flags = match sampler {
+                Sampler::Box { m1, m2 } => format!("--m1 {m1} --m2 {m2}"),
+                Sampler::Fibonacci { step_degrees } => format!("--step {step_degrees}"),
+            };
+            CliError::msg(format!("{flags}: {e}"))
+        })?
+        .len();
+    warn_if_huge(points.len(), n_orient);
     let bar = common::progress(n_orient as u64, "orientations");
     let tick = |done: usize, _total: usize| {
         bar.set_position(done as u64);
@@ -255,6 +265,25 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
         ));
     }
     common::print_stdout(&out)
+}
+
+/// Point insertions above which a run is announced as long: at roughly a
+/// microsecond each, about half an hour of one core.
+const HUGE_RUN: f64 = 2e9;
+
+/// Says so before starting when `points × orientations` triangulation
+/// work is huge (issue 19: `--m2 100000` showed an 8-hour progress bar).
+fn warn_if_huge(points: usize, orientations: usize) {
+    let work = points as f64 * orientations as f64;
+    if work > HUGE_RUN {
+        let threads = rayon::current_num_threads().max(1) as f64;
+        let hours = work * 1e-6 / threads / 3600.0;
+        common::warn(format_args!(
+            "a large run: {points} points × {orientations} orientations = {work:.2e} point \
+             insertions, very roughly {hours:.1} hour(s) on {threads} thread(s); fewer orientations \
+             (--m1, --m2, --step) or fewer points make it shorter"
+        ));
+    }
 }
 
 fn write_ints(w: &mut dyn std::io::Write, values: &[i64]) -> std::io::Result<()> {

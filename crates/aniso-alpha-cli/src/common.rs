@@ -55,6 +55,22 @@ impl<E: std::error::Error> From<E> for CliError {
 
 static QUIET: AtomicBool = AtomicBool::new(false);
 
+static FORMAT: std::sync::OnceLock<aio::Format> = std::sync::OnceLock::new();
+
+/// Sets `--format`: the input format, overriding file extensions.
+pub fn set_format(format: Option<aio::Format>) {
+    if let Some(f) = format {
+        let _ = FORMAT.set(f);
+    }
+}
+
+/// clap parser for `--format`.
+pub fn parse_format(s: &str) -> Result<aio::Format, String> {
+    aio::Format::from_name(s).ok_or_else(|| {
+        format!("unknown format '{s}' (expected xyz, txt, csv, pts, ply, las, laz or pcd)")
+    })
+}
+
 /// Sets `--quiet`: no progress bars, no informational messages.
 pub fn set_quiet(quiet: bool) {
     QUIET.store(quiet, Ordering::Relaxed);
@@ -199,22 +215,48 @@ fn round_json(s: f64) -> serde_json::Value {
 
 // ------------------------------------------------------------ input/output
 
-/// Reads a point file (format by extension) with a progress bar, as
-/// phase `read`. Errors name the file and, for text, the line.
+/// Reads a point file (format by extension, or `--format`; `-` is
+/// standard input) with a progress bar, as phase `read`. Errors name the
+/// file and, for text, the line; the reader's warnings are printed unless
+/// `--quiet`.
 pub fn read_input(
     path: &Path,
     options: &ReadOptions,
     timings: &mut Timings,
 ) -> Result<PointCloud, CliError> {
-    timings.phase("read", || {
+    let options = ReadOptions {
+        format: options.format.or(FORMAT.get().copied()),
+        ..*options
+    };
+    let cloud = timings.phase("read", || {
         let bar = progress_bytes(0, "reading");
-        let cloud = aio::read_points_with_progress(path, options, &mut |done, total| {
+        let cloud = aio::read_points_with_progress(path, &options, &mut |done, total| {
             bar.set_length(total);
             bar.set_position(done);
         });
         bar.finish_and_clear();
-        Ok(cloud?)
-    })
+        cloud
+    })?;
+    for w in &cloud.warnings {
+        warn(format_args!("{}: {w}", display_input(path)));
+    }
+    Ok(cloud)
+}
+
+/// How an input path is named in messages (`-` is standard input).
+pub fn display_input(path: &Path) -> String {
+    if aio::is_stdin(path) {
+        "<stdin>".to_string()
+    } else {
+        path.display().to_string()
+    }
+}
+
+/// Prints `warning: <message>` on stderr, unless `--quiet`.
+pub fn warn(message: impl fmt::Display) {
+    if !quiet() {
+        eprintln!("warning: {message}");
+    }
 }
 
 /// Reads a point file that must carry labels (ground truth): text column

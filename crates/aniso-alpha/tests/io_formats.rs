@@ -32,6 +32,7 @@ fn bits(p: &[[f64; 3]]) -> Vec<[u64; 3]> {
 const NO_LABELS: ReadOptions = ReadOptions {
     label_column: None,
     read_labels: false,
+    format: None,
 };
 
 #[test]

@@ -317,6 +317,7 @@ fn decode(
     let mut cloud = PointCloud {
         points: Vec::with_capacity(n),
         labels: label.map(|_| Vec::with_capacity(n)),
+        ..Default::default()
     };
     for i in 0..n {
         let p = [get(xyz[0], i)?, get(xyz[1], i)?, get(xyz[2], i)?];
@@ -348,6 +349,7 @@ fn read_ascii(
     let mut cloud = PointCloud {
         points: Vec::with_capacity(h.points.min(data.len() / 6)),
         labels: label.map(|_| Vec::new()),
+        ..Default::default()
     };
     let mut last = h.lines;
     let mut toks: Vec<&[u8]> = Vec::with_capacity(acc);
