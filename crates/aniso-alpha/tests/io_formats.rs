@@ -663,3 +663,45 @@ fn write_fuzz_seeds() {
         }
     }
 }
+
+/// Issue 19 §4: PLY values outside their declared type are errors.
+#[test]
+fn ply_values_must_fit_their_type() {
+    let head = |ty: &str, label: &str| {
+        format!(
+            "ply\nformat ascii 1.0\nelement vertex 1\nproperty {ty} x\nproperty float y\n\
+             property float z\nproperty {label} label\nend_header\n"
+        )
+    };
+    let labels = ReadOptions::with_labels(3);
+    for (ty, value, want) in [
+        ("uchar", "300", "out of range for a uchar"),
+        ("uchar", "-5", "out of range for a uchar"),
+        ("uchar", "1.5", "not an integer"),
+        ("int", "1e20", "not an integer"),
+        ("short", "40000", "out of range for a short"),
+    ] {
+        let text = head(ty, "int") + &format!("{value} 0 0 1\n");
+        let e = read_ply_bytes(Path::new("t.ply"), text.as_bytes(), &labels).unwrap_err();
+        let e = e.to_string();
+        assert!(e.starts_with("t.ply:9: invalid value"), "{ty} {value}: {e}");
+        assert!(e.contains(want), "{ty} {value}: {e}");
+    }
+    let ok = head("uchar", "int") + "255 0 0 -7\n";
+    let c = read_ply_bytes(Path::new("t.ply"), ok.as_bytes(), &labels).unwrap();
+    assert_eq!((c.points[0][0], c.labels.unwrap()[0]), (255.0, -7));
+    // A NaN or fractional float label is an error, not 0 (ascii and binary).
+    for v in ["nan", "1.5"] {
+        let text = head("float", "float") + &format!("1 0 0 {v}\n");
+        let e = read_ply_bytes(Path::new("t.ply"), text.as_bytes(), &labels).unwrap_err();
+        assert!(e.to_string().contains("is not an integer"), "{v}: {e}");
+    }
+    let mut b = b"ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\n\
+property float y\nproperty float z\nproperty float label\nend_header\n"
+        .to_vec();
+    for v in [1.0f32, 2.0, 3.0, f32::NAN] {
+        b.extend_from_slice(&v.to_le_bytes());
+    }
+    let e = read_ply_bytes(Path::new("b.ply"), &b, &labels).unwrap_err();
+    assert!(e.to_string().contains("label NaN is not an integer"), "{e}");
+}
