@@ -7,8 +7,8 @@ use std::time::Instant;
 use aniso_alpha::detect::detector::{Detection, Detector, Primitive};
 use aniso_alpha::detect::orientations::Sampler;
 use aniso_alpha::eval::evaluate;
-use aniso_alpha::io::{Mesh, ReadOptions};
-use aniso_alpha::synth::{write_xyz_labels_parts, SceneOptions};
+use aniso_alpha::io::{write_scene, Mesh, ReadOptions};
+use aniso_alpha::synth::SceneOptions;
 use clap::{Args, ValueEnum};
 use serde_json::json;
 
@@ -129,11 +129,7 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
         None => {
             let scene = timings.phase("synth", || SceneOptions::polyhedron().seed(1).generate())?;
             if let Some(p) = &scene_path {
-                common::write_output(p, timings, |w| {
-                    let mut w = std::io::BufWriter::new(w);
-                    write_xyz_labels_parts(&scene, &mut w)?;
-                    std::io::Write::flush(&mut w)
-                })?;
+                timings.phase("write", || write_scene(p, &scene, true))?;
             }
             let name = "built-in example (Fig. 10-like polyhedron in background)".to_string();
             (scene.points.clone(), Some(scene), name)

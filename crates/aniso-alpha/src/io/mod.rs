@@ -34,6 +34,7 @@ mod lzf;
 mod obj;
 mod pcd;
 mod ply;
+mod scene;
 mod text;
 
 use std::fs::File;
@@ -47,6 +48,7 @@ pub use error::IoError;
 pub use labels::{read_labels, read_labels_bytes, write_labels};
 pub use obj::write_obj;
 pub use ply::{write_ply, write_ply_to, Mesh, PlyEncoding};
+pub use scene::{write_scene, write_xyz_labels, write_xyz_labels_parts};
 
 /// A point cloud read from a file.
 #[derive(Debug, Clone, PartialEq, Default)]
