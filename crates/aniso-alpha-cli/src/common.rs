@@ -264,9 +264,14 @@ pub fn warn(message: impl fmt::Display) {
 pub fn read_truth(
     path: &Path,
     label_column: usize,
+    background_classes: aio::ClassSet,
     timings: &mut Timings,
 ) -> Result<(PointCloud, Vec<i64>), CliError> {
-    let mut cloud = read_input(path, &ReadOptions::with_labels(label_column), timings)?;
+    let options = ReadOptions {
+        background_classes,
+        ..ReadOptions::with_labels(label_column)
+    };
+    let mut cloud = read_input(path, &options, timings)?;
     match cloud.labels.take() {
         Some(labels) => Ok((cloud, labels)),
         None => Err(CliError::in_file(
@@ -435,6 +440,22 @@ pub fn parse_positive_triple(s: &str) -> Result<[f64; 3], String> {
     Ok(t)
 }
 
+/// clap parser for `--background-classes`: `7,18`, or `none`.
+pub fn parse_classes(s: &str) -> Result<aio::ClassSet, String> {
+    if s.trim().eq_ignore_ascii_case("none") {
+        return Ok(aio::ClassSet::EMPTY);
+    }
+    let classes = s
+        .split(',')
+        .map(|t| {
+            t.trim()
+                .parse::<u8>()
+                .map_err(|_| format!("'{}' is not a LAS class (0-255)", t.trim()))
+        })
+        .collect::<Result<Vec<u8>, _>>()?;
+    Ok(aio::ClassSet::from_classes(&classes))
+}
+
 /// clap parser for a finite number > 0.
 pub fn parse_positive(s: &str) -> Result<f64, String> {
     match s.trim().parse::<f64>() {
@@ -460,6 +481,12 @@ mod tests {
         assert!(parse_triple("1,nan,2").is_err());
         assert!(parse_positive_triple("1,0,2").is_err());
         assert!(parse_positive("-1").is_err());
+        assert_eq!(parse_classes("none"), Ok(aio::ClassSet::EMPTY));
+        assert_eq!(
+            parse_classes("7, 18"),
+            Ok(aio::ClassSet::from_classes(&[7, 18]))
+        );
+        assert!(parse_classes("7,256").is_err());
     }
 
     #[test]

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use aniso_alpha::io::{
     read_labels, read_pcd_bytes, read_ply_bytes, read_points, read_points_bytes, write_labels,
-    write_obj, write_ply, IoError, Mesh, PlyEncoding, ReadOptions,
+    write_obj, write_ply, ClassSet, IoError, Mesh, PlyEncoding, ReadOptions,
 };
 
 fn tmp_dir(name: &str) -> PathBuf {
@@ -33,6 +33,7 @@ const NO_LABELS: ReadOptions = ReadOptions {
     label_column: None,
     read_labels: false,
     format: None,
+    background_classes: ClassSet::LAS_BACKGROUND,
 };
 
 #[test]
@@ -490,7 +491,14 @@ fn las_and_laz_round_trip() {
         let c = read_points(&path, &ReadOptions::with_labels(0)).unwrap();
         assert_eq!(c.points.len(), 5);
         assert_eq!(c.points[2], [1000.25, -3.0, 4.0]);
-        assert_eq!(c.labels, Some(vec![1, 2, 3, 4, 5]));
+        // Class 1 (unclassified) is background by default.
+        assert_eq!(c.labels, Some(vec![-1, 2, 3, 4, 5]));
+        let custom = ReadOptions {
+            background_classes: ClassSet::from_classes(&[3, 5]),
+            ..ReadOptions::with_labels(0)
+        };
+        let c = read_points(&path, &custom).unwrap();
+        assert_eq!(c.labels, Some(vec![1, 2, -1, 4, -1]));
         let bytes = std::fs::read(&path).unwrap();
         for cut in (0..bytes.len()).step_by(7) {
             let r = aniso_alpha::io::read_las_bytes(&path, &bytes[..cut], &NO_LABELS);

@@ -17,7 +17,7 @@ use std::io::Cursor;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::Path;
 
-use super::{check_finite, non_empty, IoError, PointCloud};
+use super::{check_finite, non_empty, ClassSet, IoError, PointCloud};
 
 /// The largest accepted ratio of decompressed point bytes to compressed
 /// bytes in a LAZ file. LASzip reaches 5–20:1 on real scans and about
@@ -36,11 +36,15 @@ pub(crate) struct Layout {
     pub(crate) offset: [f64; 3],
 }
 
+/// Reads a LAS/LAZ file; with `labels`, the classification gives the
+/// labels, the classes in the set read as background (-1).
 pub(crate) fn read_las(
     path: &Path,
     bytes: &[u8],
-    read_labels: bool,
+    labels_with: Option<ClassSet>,
 ) -> Result<PointCloud, IoError> {
+    let read_labels = labels_with.is_some();
+    let background = labels_with.unwrap_or(ClassSet::EMPTY);
     let bad = |m: String| IoError::format(path, format!("invalid LAS/LAZ file: {m}"));
     precheck(bytes).map_err(bad)?;
     let (layout, laz) = contain(path, || header_layout(bytes))?.map_err(bad)?;
@@ -69,7 +73,12 @@ pub(crate) fn read_las(
             check_finite(path, &p, cloud.points.len(), None)?;
             cloud.points.push(p);
             if read_labels {
-                labels.push(i64::from(rec[class_at] & class_mask));
+                let class = rec[class_at] & class_mask;
+                labels.push(if background.contains(class) {
+                    -1
+                } else {
+                    i64::from(class)
+                });
             }
         }
         Ok(())
@@ -518,7 +527,7 @@ mod tests {
         // libFuzzer: an extended VLR of length ~2^64 made the `las` crate
         // panic ("capacity overflow").
         let bytes = include_bytes!("../../tests/fuzz_regressions/las-evlr-capacity-overflow.las");
-        let e = read_las(Path::new("evlr.las"), bytes, true).unwrap_err();
+        let e = read_las(Path::new("evlr.las"), bytes, Some(ClassSet::EMPTY)).unwrap_err();
         assert!(
             e.to_string().starts_with("evlr.las: invalid LAS/LAZ file"),
             "{e}"
@@ -530,6 +539,6 @@ mod tests {
         // libFuzzer found a header with a huge record length and point
         // count: the reader allocated 2.7 GB at once.
         let bytes = include_bytes!("../../tests/fuzz_regressions/las-oom-record-length.las");
-        let _ = read_las(Path::new("oom.las"), bytes, true);
+        let _ = read_las(Path::new("oom.las"), bytes, Some(ClassSet::EMPTY));
     }
 }

@@ -99,6 +99,52 @@ pub struct ReadOptions {
     /// The format, overriding the file's extension (`None`: by extension;
     /// standard input, `-`, is text unless given).
     pub format: Option<Format>,
+    /// LAS classes read as background (-1) when the classification gives
+    /// the labels; by default 0 and 1 (never classified, unclassified), 7
+    /// (low noise) and 18 (high noise), see [`ClassSet::LAS_BACKGROUND`].
+    pub background_classes: ClassSet,
+}
+
+/// A set of LAS classification codes (0–255).
+///
+/// ```
+/// use aniso_alpha::io::ClassSet;
+/// let s = ClassSet::from_classes(&[7, 18]);
+/// assert!(s.contains(18) && !s.contains(1));
+/// assert!(ClassSet::default().contains(1));
+/// assert_eq!(ClassSet::default(), ClassSet::LAS_BACKGROUND);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ClassSet([u64; 4]);
+
+impl ClassSet {
+    /// No class.
+    pub const EMPTY: ClassSet = ClassSet([0; 4]);
+    /// The classes that are not structures when a LAS classification is
+    /// used as truth: 0 (created, never classified), 1 (unclassified), 7
+    /// (low point, noise) and 18 (high noise).
+    pub const LAS_BACKGROUND: ClassSet = ClassSet([1 | 1 << 1 | 1 << 7 | 1 << 18, 0, 0, 0]);
+
+    /// The set of these classes.
+    pub fn from_classes(classes: &[u8]) -> ClassSet {
+        let mut s = ClassSet::EMPTY;
+        for &c in classes {
+            s.0[usize::from(c / 64)] |= 1 << (c % 64);
+        }
+        s
+    }
+
+    /// Whether `class` is in the set.
+    pub fn contains(&self, class: u8) -> bool {
+        self.0[usize::from(class / 64)] >> (class % 64) & 1 == 1
+    }
+}
+
+impl Default for ClassSet {
+    /// [`ClassSet::LAS_BACKGROUND`].
+    fn default() -> Self {
+        ClassSet::LAS_BACKGROUND
+    }
 }
 
 impl ReadOptions {
@@ -115,6 +161,7 @@ impl ReadOptions {
             label_column: Some(label_column),
             read_labels: true,
             format: None,
+            background_classes: ClassSet::LAS_BACKGROUND,
         }
     }
 }
@@ -372,7 +419,11 @@ pub fn read_las_bytes(
 ) -> Result<PointCloud, IoError> {
     #[cfg(feature = "las")]
     {
-        las::read_las(name, bytes, options.read_labels)
+        las::read_las(
+            name,
+            bytes,
+            options.read_labels.then_some(options.background_classes),
+        )
     }
     #[cfg(not(feature = "las"))]
     {
