@@ -47,10 +47,16 @@ pub struct AlphaArgs {
 
 /// Runs `alpha`.
 pub fn run(args: &AlphaArgs, timings: &mut Timings) -> Result<(), CliError> {
-    common::check_outputs([args.intervals.as_deref()])?;
     if let Some(out) = &args.output {
-        common::check_mesh_output(out)?;
+        common::mesh_format(out)?;
     }
+    common::check_io(
+        &[&args.input],
+        &[
+            ("--intervals", args.intervals.as_deref()),
+            ("--output", args.output.as_deref()),
+        ],
+    )?;
     let cloud = common::read_input(&args.input, &ReadOptions::default(), timings)?;
     let e = args.elongation.unwrap_or([1.0, 1.0, 1.0]);
     let [theta, psi, phi] = args.euler.unwrap_or([0.0, 0.0, 0.0]);

@@ -8,9 +8,9 @@ use aniso_alpha::detect::detector::{Detection, Detector, Given, OrientationSet, 
 use aniso_alpha::detect::orientations::Sampler;
 use aniso_alpha::detect::StructureKind;
 use aniso_alpha::eval::evaluate;
-use aniso_alpha::io::{Mesh, ReadOptions};
+use aniso_alpha::io::{write_scene, Mesh, ReadOptions};
 use aniso_alpha::report::detection_json;
-use aniso_alpha::synth::{write_xyz_labels_parts, SceneOptions};
+use aniso_alpha::synth::SceneOptions;
 use clap::{Args, ValueEnum};
 use serde_json::json;
 
@@ -194,15 +194,21 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
         std::fs::create_dir_all(&dir)
             .map_err(|e| CliError::msg(format!("{}: cannot create folder: {e}", dir.display())))?;
     }
-    common::check_outputs([
-        labels_path.as_deref(),
-        parts_path.as_deref(),
-        report_path.as_deref(),
-        scene_path.as_deref(),
-    ])?;
     for out in [&output_path, &args.union].into_iter().flatten() {
-        common::check_mesh_output(out)?;
+        common::mesh_format(out)?;
     }
+    let inputs: Vec<&std::path::Path> = args.input.iter().map(|p| p.as_path()).collect();
+    common::check_io(
+        &inputs,
+        &[
+            ("--labels", labels_path.as_deref()),
+            ("--part-labels", parts_path.as_deref()),
+            ("--output", output_path.as_deref()),
+            ("--union", args.union.as_deref()),
+            ("--report", report_path.as_deref()),
+            ("(scene)", scene_path.as_deref()),
+        ],
+    )?;
     let (points, truth, name) = match &args.input {
         Some(input) => {
             let cloud = common::read_input(input, &ReadOptions::default(), timings)?;
@@ -211,11 +217,7 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
         None => {
             let scene = timings.phase("synth", || SceneOptions::polyhedron().seed(1).generate())?;
             if let Some(p) = &scene_path {
-                common::write_output(p, timings, |w| {
-                    let mut w = std::io::BufWriter::new(w);
-                    write_xyz_labels_parts(&scene, &mut w)?;
-                    std::io::Write::flush(&mut w)
-                })?;
+                timings.phase("write", || write_scene(p, &scene, true))?;
             }
             let name = "built-in example (Fig. 10-like polyhedron in background)".to_string();
             (scene.points.clone(), Some(scene), name)
@@ -227,13 +229,14 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
     };
     let start = Instant::now();
     let detector = timings.phase("estimate", || detector(args, &points, example))?;
-    let n_orient = detector.orientation_count().map_err(in_file)?;
-    if n_orient > 20_000 {
-        common::info(format!(
-            "{n_orient} orientations: each triangulates the cloud; this will take long \
-             (coarser --m1, fewer --m2 or a larger --step scan fewer)"
-        ));
-    }
+    let n_orient = detector.orientation_count().map_err(|e| {
+        let flags = match args.sampler {
+            Some(SamplerKind::Fibonacci) => format!("--step {}", args.step),
+            _ => format!("--m1 {} --m2 {}", args.m1, args.m2),
+        };
+        CliError::msg(format!("{flags}: {e}"))
+    })?;
+    warn_if_huge(points.len(), n_orient);
     let bar = common::progress(n_orient as u64, "orientations");
     let tick = |done: usize, _total: usize| {
         bar.set_position(done as u64);
@@ -318,6 +321,25 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
         ));
     }
     common::print_stdout(&out)
+}
+
+/// Point insertions above which a run is announced as long: at roughly a
+/// microsecond each, about half an hour of one core.
+const HUGE_RUN: f64 = 2e9;
+
+/// Says so before starting when `points × orientations` triangulation
+/// work is huge (issue 19: `--m2 100000` showed an 8-hour progress bar).
+fn warn_if_huge(points: usize, orientations: usize) {
+    let work = points as f64 * orientations as f64;
+    if work > HUGE_RUN {
+        let threads = rayon::current_num_threads().max(1) as f64;
+        let hours = work * 1e-6 / threads / 3600.0;
+        common::warn(format_args!(
+            "a large run: {points} points × {orientations} orientations = {work:.2e} point \
+             insertions, very roughly {hours:.1} hour(s) on {threads} thread(s); fewer orientations \
+             (--m1, --m2, --step) or fewer points make it shorter"
+        ));
+    }
 }
 
 fn write_ints(w: &mut dyn std::io::Write, values: &[i64]) -> std::io::Result<()> {

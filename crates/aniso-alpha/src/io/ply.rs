@@ -4,7 +4,7 @@ use std::io::Write;
 use std::path::Path;
 
 use super::error::show_token;
-use super::text::{parse_f64, parse_label};
+use super::text::parse_f64;
 use super::{atomic_write, check_finite, non_empty, IoError, PointCloud};
 
 /// A PLY scalar type.
@@ -48,6 +48,62 @@ impl Scalar {
         !matches!(self, Scalar::F32 | Scalar::F64)
     }
 
+    /// The range of an integer type.
+    fn int_range(self) -> Option<(i64, i64)> {
+        Some(match self {
+            Scalar::I8 => (i8::MIN.into(), i8::MAX.into()),
+            Scalar::U8 => (0, u8::MAX.into()),
+            Scalar::I16 => (i16::MIN.into(), i16::MAX.into()),
+            Scalar::U16 => (0, u16::MAX.into()),
+            Scalar::I32 => (i32::MIN.into(), i32::MAX.into()),
+            Scalar::U32 => (0, u32::MAX.into()),
+            Scalar::F32 | Scalar::F64 => return None,
+        })
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            Scalar::I8 => "char",
+            Scalar::U8 => "uchar",
+            Scalar::I16 => "short",
+            Scalar::U16 => "ushort",
+            Scalar::I32 => "int",
+            Scalar::U32 => "uint",
+            Scalar::F32 => "float",
+            Scalar::F64 => "double",
+        }
+    }
+
+    /// Parses an ascii value of this type: integers must be plain
+    /// integers within the type's range (`300`, `-5` and `1.5` are not
+    /// `uchar`s, `1e20` is not an `int`).
+    pub(crate) fn parse(self, tok: &[u8]) -> Result<f64, String> {
+        match self.int_range() {
+            None => parse_f64(tok).ok_or_else(|| "not a number".to_string()),
+            Some((lo, hi)) => {
+                let v = std::str::from_utf8(tok)
+                    .ok()
+                    .and_then(|s| s.strip_prefix('+').unwrap_or(s).parse::<i64>().ok())
+                    .ok_or_else(|| format!("not an integer ({} property)", self.name()))?;
+                if v < lo || v > hi {
+                    return Err(format!(
+                        "out of range for a {} property ({lo}..={hi})",
+                        self.name()
+                    ));
+                }
+                Ok(v as f64)
+            }
+        }
+    }
+}
+
+/// A label value read from a number: it must be an integer (a float
+/// label of NaN or 1.5 is an error, not 0 or 1).
+pub(crate) fn label_of(v: f64) -> Option<i64> {
+    (v.is_finite() && v.fract() == 0.0 && v.abs() < 9.0e18).then_some(v as i64)
+}
+
+impl Scalar {
     /// Decodes `b` (exactly `size()` bytes) as a number.
     #[inline]
     pub(crate) fn decode(self, b: &[u8], big: bool) -> f64 {
@@ -374,6 +430,9 @@ fn read_fixed_vertices(
     if stride == 0 {
         return Ok(());
     }
+    let bad_label = |i: usize, v: f64| {
+        IoError::format(path, format!("PLY vertex {i}: label {v} is not an integer"))
+    };
     cloud.points.reserve(el.count);
     let mut labels = Vec::new();
     for rec in data.chunks_exact(stride) {
@@ -385,7 +444,8 @@ fn read_fixed_vertices(
         check_finite(path, &p, cloud.points.len(), None)?;
         cloud.points.push(p);
         if let Some((o, s)) = fl {
-            labels.push(s.decode(&rec[o..], big) as i64);
+            let v = s.decode(&rec[o..], big);
+            labels.push(label_of(v).ok_or_else(|| bad_label(cloud.points.len() - 1, v))?);
         }
     }
     if fl.is_some() {
@@ -405,10 +465,18 @@ fn push_vertex(
     check_finite(path, &p, cloud.points.len(), line)?;
     cloud.points.push(p);
     if let Some(i) = layout.label {
-        cloud
-            .labels
-            .get_or_insert_with(Vec::new)
-            .push(values[i] as i64);
+        let v = values[i];
+        let label = label_of(v).ok_or_else(|| {
+            let at = cloud.points.len() - 1;
+            match line {
+                Some(line) => IoError::parse(path, line, format!("label {v} is not an integer")),
+                None => IoError::format(
+                    path,
+                    format!("PLY vertex {at}: label {v} is not an integer"),
+                ),
+            }
+        })?;
+        cloud.labels.get_or_insert_with(Vec::new).push(label);
     }
     Ok(())
 }
@@ -460,22 +528,17 @@ fn read_ascii(
             };
             for (pi, p) in el.props.iter().enumerate() {
                 match p.kind {
-                    Kind::Scalar(_) => {
+                    Kind::Scalar(s) => {
                         let t = toks.next().ok_or_else(missing)?;
                         let wanted =
                             is_vertex && (layout.xyz.contains(&pi) || layout.label == Some(pi));
                         if wanted {
-                            values[pi] = if layout.label == Some(pi) {
-                                parse_label(t).map(|v| v as f64)
-                            } else {
-                                parse_f64(t)
-                            }
-                            .ok_or_else(|| {
+                            values[pi] = s.parse(t).map_err(|why| {
                                 IoError::parse(
                                     path,
                                     ln,
                                     format!(
-                                        "invalid value '{}' for property '{}'",
+                                        "invalid value '{}' for property '{}': {why}",
                                         show_token(t),
                                         p.name
                                     ),
