@@ -19,10 +19,11 @@ use std::path::PathBuf;
 use aniso_alpha::alpha::AlphaComplex;
 use aniso_alpha::aniso::Anisotropy;
 use aniso_alpha::delaunay::Triangulation;
-use aniso_alpha::detect::detector::Detector;
+use aniso_alpha::detect::detector::{Detector, Given};
+use aniso_alpha::detect::StructureKind;
 use aniso_alpha::io::{read_points, ReadOptions};
 use numpy::{IntoPyArray, PyArray1, PyArray2};
-use pyo3::exceptions::{PyNotImplementedError, PyValueError};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use convert::{rows_to_numpy, Points};
@@ -113,8 +114,10 @@ fn alpha_intervals<'py>(
 /// `{"structures": [...], "parameters": {...}}`.
 type DetectOut<'py> = (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<i64>>, String);
 
-/// Structure detection (SPEC §4): `structure` is "lines" or "planes"; a
-/// parameter left `None` is estimated from the data.
+/// Structure detection (SPEC §4): `structure` is "lines" or "planes". With
+/// alpha, lambda3 and min_size all given, the CLI's explicit run (the
+/// paper's box sampler); otherwise [`Detector::auto`] estimates what is
+/// missing and scans the data orientation set.
 #[pyfunction]
 #[pyo3(signature = (points, structure, alpha = None, lambda2 = None, lambda3 = None, min_size = None, threads = None))]
 #[allow(clippy::too_many_arguments)]
@@ -154,27 +157,36 @@ fn detect<'py>(
         .transpose()?;
     let points = Points::extract(points)?;
     let threads = thread_count(threads)?;
-    let (Some(alpha), Some(lambda3), Some(min_size)) = (alpha, lambda3, min_size) else {
-        return Err(PyNotImplementedError::new_err(
-            "parameters from the data are not available yet: give alpha, lambda3 and min_size",
-        ));
+    let kind = if planes {
+        StructureKind::Planes
+    } else {
+        StructureKind::Lines
     };
-    // As the CLI: lambda2 of planes defaults to lambda3.
-    let given = report::Given {
+    let given = Given {
         alpha,
-        lambda2: lambda2.unwrap_or(lambda3),
+        lambda2,
         lambda3,
         min_size,
     };
     let pts = points.as_slice();
+    // The whole call (estimation included) runs on the pool of `detached`,
+    // which the library's parallel loops use: no `Detector::threads`, which
+    // would start a second pool.
     let (labels, parts, json) = detached(py, threads, |_| {
-        let detector = if planes {
-            Detector::planes(given.alpha, given.lambda2, given.lambda3, given.min_size)
-        } else {
-            Detector::lines(given.alpha, given.lambda3, given.min_size)
+        let detector = match (alpha, lambda3, min_size) {
+            // Explicit, as `aniso-alpha detect`: the paper's box sampler;
+            // lambda2 of planes defaults to lambda3.
+            (Some(alpha), Some(lambda3), Some(min_size)) => match kind {
+                StructureKind::Planes => {
+                    Detector::planes(alpha, lambda2.unwrap_or(lambda3), lambda3, min_size)
+                }
+                StructureKind::Lines => Detector::lines(alpha, lambda3, min_size),
+            },
+            // Parameters and orientations from the data, the given ones kept.
+            _ => Detector::auto(kind, pts, &given).map_err(value_error)?,
         };
         let det = detector.run(pts).map_err(value_error)?;
-        let json = report::detection_json(&det, &detector, &given).to_string();
+        let json = report::detection_json(&det, &detector).to_string();
         let parts = det.part_labels();
         Ok((det.labels, parts, json))
     })?;

@@ -1,38 +1,75 @@
 //! The JSON of a detection: `{"structures": [...], "parameters": {...}}`,
 //! as in the report `aniso-alpha detect --report` writes.
 //!
-//! Interim: a copy of the CLI's current `structure_json` until the library
-//! has `aniso_alpha::report::detection_json` (feature `json`), which the
-//! CLI and these bindings will then share.
+//! Interim: the structures are a copy of the CLI's current `structure_json`
+//! (so that the bindings' structures equal the CLI's report), until the
+//! library has `aniso_alpha::report::detection_json` (feature `json`), which
+//! the CLI and these bindings will then share.
 
-use aniso_alpha::detect::detector::{Detection, Detector, Primitive, Structure};
+use aniso_alpha::detect::detector::{Detection, Detector, Param, Primitive, Structure};
 use aniso_alpha::detect::StructureKind;
-use serde_json::{json, Value};
+use serde_json::{json, Map, Value};
 
-/// The report's `structures` and `parameters`.
-pub fn detection_json(det: &Detection, detector: &Detector, params: &Given) -> Value {
+/// The report's `structures` and `parameters`. With explicit parameters the
+/// `parameters` are the CLI's (structure, k, alpha, lambda2, lambda3,
+/// min_size, sampler, elongation); when [`Detector::auto`] estimated some,
+/// `"sampler"` is `"data"` (the data orientation set: `"modes"` counts its
+/// modes, `"orientations"` its rotations) and `"estimated"` and `"reasons"`
+/// say, for each of alpha, lambda2, lambda3 and min_size, whether it was
+/// estimated and why it has its value.
+pub fn detection_json(det: &Detection, detector: &Detector) -> Value {
     let planes = det.kind == StructureKind::Planes;
+    let (lambda2, lambda3) = detector.lambdas();
+    let mut params = Map::new();
+    params.insert(
+        "structure".into(),
+        json!(if planes { "planes" } else { "lines" }),
+    );
+    params.insert("k".into(), json!(det.kind.k()));
+    params.insert("alpha".into(), json!(detector.alpha()));
+    params.insert("lambda2".into(), json!(planes.then_some(lambda2)));
+    params.insert("lambda3".into(), json!(lambda3));
+    params.insert("min_size".into(), json!(detector.min_size()));
+    match detector.estimate() {
+        None => {
+            params.insert(
+                "sampler".into(),
+                json!({"kind": "box", "m1": 0.3, "m2": 12}),
+            );
+        }
+        Some(e) => {
+            params.insert(
+                "sampler".into(),
+                json!({
+                    "kind": "data",
+                    "modes": e.modes.len(),
+                    "orientations": e.modes.iter().map(|m| m.rotations.len()).sum::<usize>(),
+                }),
+            );
+            let named: [(&str, &Param); 4] = [
+                ("alpha", &e.alpha),
+                ("lambda2", &e.lambda2),
+                ("lambda3", &e.lambda3),
+                ("min_size", &e.min_size),
+            ];
+            let named = named.into_iter().filter(|(n, _)| planes || *n != "lambda2");
+            let (estimated, reasons): (Map<_, _>, Map<_, _>) = named
+                .map(|(n, p)| {
+                    (
+                        (n.to_string(), json!(p.estimated)),
+                        (n.to_string(), json!(p.reason)),
+                    )
+                })
+                .unzip();
+            params.insert("estimated".into(), Value::Object(estimated));
+            params.insert("reasons".into(), Value::Object(reasons));
+        }
+    }
+    params.insert("elongation".into(), json!(detector.elongation()));
     json!({
         "structures": det.structures.iter().map(structure_json).collect::<Vec<_>>(),
-        "parameters": {
-            "structure": if planes { "planes" } else { "lines" },
-            "k": det.kind.k(),
-            "alpha": params.alpha,
-            "lambda2": if planes { Some(params.lambda2) } else { None },
-            "lambda3": params.lambda3,
-            "min_size": params.min_size,
-            "sampler": {"kind": "box", "m1": 0.3, "m2": 12},
-            "elongation": detector.elongation(),
-        },
+        "parameters": params,
     })
-}
-
-/// The parameters of an explicit run.
-pub struct Given {
-    pub alpha: f64,
-    pub lambda2: f64,
-    pub lambda3: f64,
-    pub min_size: u32,
 }
 
 fn primitive_json(p: &Primitive) -> Value {
@@ -49,20 +86,10 @@ fn primitive_json(p: &Primitive) -> Value {
     }
 }
 
-fn kind_name(s: &Structure) -> &'static str {
-    match (&s.primitive, s.parts.len()) {
-        (Primitive::Line(_), 1) => "line",
-        (Primitive::Line(_), _) => "polyline",
-        (Primitive::Plane(_), 1) => "plane",
-        (Primitive::Plane(_), _) => "surface",
-        (Primitive::None, _) => "?",
-    }
-}
-
 fn structure_json(s: &Structure) -> Value {
     json!({
         "id": s.id,
-        "kind": kind_name(s),
+        "kind": s.kind_name(),
         "points": s.vertices.len(),
         "simplices": s.simplices.len(),
         "primitive": primitive_json(&s.primitive),

@@ -76,8 +76,8 @@ def test_out_of_range_coordinates():
         ("lines", dict(alpha=0.0, lambda3=10.0, min_size=4), "alpha must be positive and finite, got 0"),
         ("lines", dict(alpha=-1.0, lambda3=10.0, min_size=4), "alpha must be positive and finite, got -1"),
         ("lines", dict(alpha=np.nan, lambda3=10.0, min_size=4), "alpha must be positive and finite"),
-        ("lines", dict(alpha=1.0, lambda3=-10.0, min_size=4), "lambda3 must be positive and finite, got -10"),
-        ("planes", dict(alpha=1.0, lambda2=0.0, lambda3=8.0, min_size=4), "lambda2 must be positive"),
+        ("lines", dict(alpha=1.0, lambda3=-10.0, min_size=4), "lambda3 must be between 0.001 and 10000, got -10"),
+        ("planes", dict(alpha=1.0, lambda2=0.0, lambda3=8.0, min_size=4), "lambda2 must be between 0.001 and 10000, got 0"),
         ("lines", dict(alpha=1.0, lambda3=10.0, min_size=0), r"min-size \(nb_c\) must be at least 1"),
         ("lines", dict(alpha=1.0, lambda3=10.0, min_size=-3), "min_size must be between 1 and"),
         ("lines", dict(alpha=1.0, lambda2=4.0, lambda3=10.0, min_size=4), "lambda2 is a parameter of planes"),
@@ -87,6 +87,29 @@ def test_out_of_range_coordinates():
 def test_parameter_out_of_range(structure, params, text):
     with pytest.raises(ValueError, match=text):
         aa.detect(CUBE, structure, **params)
+
+
+@pytest.mark.parametrize(
+    "params, text",
+    [
+        (dict(alpha=-1.0), "alpha must be positive and finite, got -1"),
+        (dict(lambda2=4.0, lambda3=1e9), "lambda3 must be between 0.001 and 10000, got 1000000000"),
+        (dict(min_size=0), r"min-size \(nb_c\) must be at least 1"),
+    ],
+)
+def test_given_parameter_out_of_range_with_estimation(params, text):
+    # Some parameters given, the others estimated: the given ones are checked.
+    with pytest.raises(ValueError, match=text):
+        aa.detect(CUBE, "planes", **params)
+
+
+def test_bad_points_with_estimation():
+    pts = CUBE.copy()
+    pts[3, 1] = np.nan
+    with pytest.raises(ValueError, match="point 3 has a non-finite"):
+        aa.detect(pts, "planes")
+    with pytest.raises(ValueError, match="no points"):
+        aa.detect(np.zeros((0, 3)), "lines")
 
 
 @pytest.mark.parametrize(

@@ -215,8 +215,14 @@ def detect(
         threads: threads to use (default: all cores); the result does not
             depend on it.
 
-    A parameter left ``None`` is estimated from the data; the ones given are
-    kept. ``Detection.parameters`` says which were estimated.
+    With ``alpha``, ``lambda3`` and ``min_size`` all given, this is the
+    CLI's run with explicit parameters (the paper's box of orientations):
+    the same labels as ``aniso-alpha detect --alpha ... --lambda3 ...
+    --min-size ...``. With any of them left ``None``, the missing ones are
+    estimated from the data (point spacing, noise, the modes of the local
+    normals or directions, which also give the orientations scanned), and
+    the given ones are kept; ``Detection.parameters["estimated"]`` says
+    which were estimated and ``["reasons"]`` why each has its value.
 
     Returns:
         a :class:`Detection`: per-point ``labels`` and ``part_labels``, the
@@ -228,7 +234,7 @@ def detect(
 
     The GIL is released during the detection.
 
-    The paper's Fig. 12 parameters, on five lines of points:
+    The paper's Fig. 12 parameters, on three lines of points:
 
     >>> import numpy as np, aniso_alpha as aa
     >>> t = np.arange(30, dtype=float) * 7.0
@@ -238,6 +244,15 @@ def detect(
     (3, [0, 1, 2])
     >>> det.structures[0]["kind"], det.structures[0]["points"]
     ('line', 30)
+
+    Parameters from the data, on two perpendicular planes of grid points:
+
+    >>> g = np.arange(30.0)
+    >>> x, y = (a.ravel() for a in np.meshgrid(g, g))
+    >>> planes = np.vstack([np.c_[x, y, np.full(900, 10.0)], np.c_[x, np.full(900, 15.0), y]])
+    >>> det = aa.detect(planes + np.random.default_rng(1).normal(0, 0.01, planes.shape), "planes")
+    >>> len(det.structures), det.parameters["estimated"]["alpha"]
+    (2, True)
     """
     labels, part_labels, report = _native.detect(
         points, structure, alpha, lambda2, lambda3, min_size, threads
