@@ -47,10 +47,16 @@ pub struct AlphaArgs {
 
 /// Runs `alpha`.
 pub fn run(args: &AlphaArgs, timings: &mut Timings) -> Result<(), CliError> {
-    common::check_outputs([args.intervals.as_deref()])?;
     if let Some(out) = &args.output {
-        common::check_mesh_output(out)?;
+        common::mesh_format(out)?;
     }
+    common::check_io(
+        &[&args.input],
+        &[
+            ("--intervals", args.intervals.as_deref()),
+            ("--output", args.output.as_deref()),
+        ],
+    )?;
     let cloud = common::read_input(&args.input, &ReadOptions::default(), timings)?;
     let e = args.elongation.unwrap_or([1.0, 1.0, 1.0]);
     let [theta, psi, phi] = args.euler.unwrap_or([0.0, 0.0, 0.0]);
@@ -100,10 +106,9 @@ pub fn run(args: &AlphaArgs, timings: &mut Timings) -> Result<(), CliError> {
             .filter(|e| in_tri.binary_search(e).is_err())
             .collect();
         let mesh = Mesh {
-            points: &cloud.points,
-            labels: None,
             edges: &edges,
             faces: &faces,
+            ..Mesh::new(&cloud.points)
         };
         common::write_mesh(path, &mesh, timings)?;
         common::info(format_args!(

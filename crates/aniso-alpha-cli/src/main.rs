@@ -25,7 +25,8 @@ use common::{CliError, Timings};
 #[derive(Debug, Parser)]
 #[command(name = "aniso-alpha", version, propagate_version = true)]
 #[command(
-    after_help = "Point files: .xyz .txt .csv .pts (text), .ply, .las/.laz, .pcd.\n\
+    after_help = "Point files: .xyz .txt .csv .pts (text), .ply, .las/.laz, .pcd; `-` reads text from \
+standard input; --format overrides the extension.\n\
 Errors exit with status 1 and one line on stderr; bad usage exits with 2.\n\n\
 Example:\n  aniso-alpha synth planes --seed 1 --output scene.xyz\n  \
 aniso-alpha detect scene.xyz --structure planes --alpha 1 --lambda3 8 --min-size 20 --labels labels.txt\n  \
@@ -50,6 +51,10 @@ struct GlobalArgs {
     /// Print the wall time of each phase (seconds) as one JSON object on stderr
     #[arg(long, global = true)]
     timings: bool,
+    /// Input format, overriding the extension: xyz, ply, las, laz, pcd
+    /// (an INPUT of `-` is standard input, text unless --format says otherwise)
+    #[arg(long, global = true, value_name = "FMT", value_parser = common::parse_format)]
+    format: Option<aniso_alpha::io::Format>,
 }
 
 #[derive(Debug, Subcommand)]
@@ -92,6 +97,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
     // With --timings, stderr carries exactly one JSON object for scripts:
     // no informational lines around it.
     common::set_quiet(cli.global.quiet || cli.global.timings);
+    common::set_format(cli.global.format);
     if let Some(n) = cli.global.threads {
         rayon::ThreadPoolBuilder::new()
             .num_threads(n.get())
@@ -114,6 +120,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
 
 fn main() -> ExitCode {
     install_panic_hook();
+    common::install_signal_cleanup();
     let cli = Cli::parse();
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,

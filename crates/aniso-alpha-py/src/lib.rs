@@ -186,7 +186,7 @@ fn detect<'py>(
             _ => Detector::auto(kind, pts, &given).map_err(value_error)?,
         };
         let det = detector.run(pts).map_err(value_error)?;
-        let json = report::detection_json(&det, &detector).to_string();
+        let json = report::detection_json(&det, &detector);
         let parts = det.part_labels();
         Ok((det.labels, parts, json))
     })?;
