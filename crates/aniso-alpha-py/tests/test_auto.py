@@ -41,9 +41,10 @@ def test_planes_without_parameters(planes_auto):
     assert det.part_labels.shape == (len(pts),)
     p = det.parameters
     assert p["structure"] == "planes"
-    assert p["estimated"] == {"alpha": True, "lambda2": True, "lambda3": True, "min_size": True}
-    assert p["sampler"]["kind"] == "data" and p["sampler"]["modes"] >= 2
-    assert all(isinstance(r, str) and r for r in p["reasons"].values())
+    names = ("alpha", "lambda2", "lambda3", "min_size")
+    assert all(p[n]["estimated"] is True for n in names)
+    assert all(isinstance(p[n]["reason"], str) and p[n]["reason"] for n in names)
+    assert p["orientations"]["kind"] == "data" and len(p["orientations"]["modes"]) >= 2
     # The two planes are found, and little else.
     assert len(det.structures) == 2
     assert np.count_nonzero((det.labels >= 0) & (truth >= 0)) >= 0.95 * np.count_nonzero(truth >= 0)
@@ -55,8 +56,9 @@ def test_planes_without_parameters(planes_auto):
 def test_lines_without_parameters():
     pts, truth = two_lines()
     det = aa.detect(pts, "lines")
-    assert det.parameters["estimated"] == {"alpha": True, "lambda3": True, "min_size": True}
-    assert "lambda2" not in det.parameters["estimated"]
+    p = det.parameters
+    assert all(p[n]["estimated"] is True for n in ("alpha", "lambda3", "min_size"))
+    assert p["lambda2"] is None
     assert sorted(s["points"] for s in det.structures) == [200, 200]
     np.testing.assert_array_equal(det.labels >= 0, truth >= 0)
 
@@ -65,13 +67,18 @@ def test_given_values_are_kept():
     pts, _ = two_planes()
     det = aa.detect(pts, "planes", alpha=0.3, min_size=6)
     p = det.parameters
-    assert p["alpha"] == 0.3 and p["min_size"] == 6
-    assert p["estimated"] == {"alpha": False, "lambda2": True, "lambda3": True, "min_size": False}
-    assert p["reasons"]["alpha"] == "given"
+    assert p["alpha"]["value"] == 0.3 and p["min_size"]["value"] == 6
+    assert {n: p[n]["estimated"] for n in ("alpha", "lambda2", "lambda3", "min_size")} == {
+        "alpha": False,
+        "lambda2": True,
+        "lambda3": True,
+        "min_size": False,
+    }
+    assert p["alpha"]["reason"] == "given"
     det = aa.detect(pts, "planes", lambda3=5.0)
     # lambda2 of planes follows a given lambda3.
-    assert det.parameters["lambda3"] == 5.0 and det.parameters["lambda2"] == 5.0
-    assert det.parameters["estimated"]["lambda3"] is False
+    assert det.parameters["lambda3"]["value"] == 5.0 and det.parameters["lambda2"]["value"] == 5.0
+    assert det.parameters["lambda3"]["estimated"] is False
 
 
 def test_estimation_does_not_depend_on_threads(planes_auto):

@@ -221,8 +221,9 @@ def detect(
     --min-size ...``. With any of them left ``None``, the missing ones are
     estimated from the data (point spacing, noise, the modes of the local
     normals or directions, which also give the orientations scanned), and
-    the given ones are kept; ``Detection.parameters["estimated"]`` says
-    which were estimated and ``["reasons"]`` why each has its value.
+    the given ones are kept. Each of ``Detection.parameters["alpha"]``,
+    ``["lambda2"]``, ``["lambda3"]`` and ``["min_size"]`` is a dict with its
+    ``"value"``, whether it was ``"estimated"``, and the ``"reason"`` for it.
 
     Returns:
         a :class:`Detection`: per-point ``labels`` and ``part_labels``, the
@@ -251,7 +252,7 @@ def detect(
     >>> x, y = (a.ravel() for a in np.meshgrid(g, g))
     >>> planes = np.vstack([np.c_[x, y, np.full(900, 10.0)], np.c_[x, np.full(900, 15.0), y]])
     >>> det = aa.detect(planes + np.random.default_rng(1).normal(0, 0.01, planes.shape), "planes")
-    >>> len(det.structures), det.parameters["estimated"]["alpha"]
+    >>> len(det.structures), det.parameters["alpha"]["estimated"]
     (2, True)
     """
     labels, part_labels, report = _native.detect(
