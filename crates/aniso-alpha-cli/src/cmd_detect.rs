@@ -79,6 +79,14 @@ pub struct DetectArgs {
     /// Angular step (degrees) of the Fibonacci sampler
     #[arg(long, value_name = "DEG", default_value_t = 10.0, value_parser = parse_positive)]
     pub step: f64,
+    /// Write an interactive 3D view of the result (one self-contained HTML file)
+    #[arg(long, value_name = "OUT.html")]
+    pub html: Option<PathBuf>,
+    /// Write a picture of the result (PNG, fixed view)
+    #[arg(long, value_name = "OUT.png")]
+    pub png: Option<PathBuf>,
+    #[command(flatten)]
+    pub common: crate::CommonArgs,
 }
 
 /// The orientation sampler.
@@ -102,6 +110,7 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
     let parts_path = pick(&args.part_labels, "parts.txt");
     let output_path = pick(&args.output, "structures.ply");
     let report_path = pick(&args.report, "report.json");
+    let html_path = pick(&args.html, "view.html");
     let scene_path = example.then(|| dir.join("scene.xyz"));
     if example {
         std::fs::create_dir_all(&dir)
@@ -112,6 +121,8 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
         parts_path.as_deref(),
         report_path.as_deref(),
         scene_path.as_deref(),
+        html_path.as_deref(),
+        args.png.as_deref(),
     ])?;
     if let Some(out) = &output_path {
         common::check_mesh_output(out)?;
@@ -209,7 +220,7 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
         )
         .ok()
     });
-    if let Some(p) = &report_path {
+    {
         let mut report = json!({
             "input": name,
             "points": points.len(),
@@ -237,7 +248,30 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
                 "parts_found": ev.parts_found, "parts_total": ev.parts_total,
             });
         }
-        common::write_json(p, &report, timings)?;
+        if let Some(p) = &report_path {
+            common::write_json(p, &report, timings)?;
+        }
+        if let Some(p) = &html_path {
+            crate::view::write_html(
+                p,
+                &name,
+                &points,
+                &det.labels,
+                &part_labels,
+                &report,
+                timings,
+            )?;
+        }
+    }
+    if let Some(p) = &args.png {
+        crate::picture::write_detection_png(
+            p,
+            &points,
+            &det.labels,
+            &part_labels,
+            &det.simplices,
+            timings,
+        )?;
     }
     let mut out = summary(&name, &det, &params, seconds);
     if let Some(ev) = &scores {
@@ -245,11 +279,11 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
     }
     if example {
         out.push_str(&format!(
-            "\nWrote {}: scene.xyz (x y z label part), labels.txt, parts.txt, structures.ply, report.json\n",
+            "\nWrote {}: scene.xyz (x y z label part), labels.txt, parts.txt, structures.ply, report.json, view.html\n",
             dir.display()
         ));
     }
-    common::print_stdout(&out)
+    common::print_summary(&out)
 }
 
 fn write_ints(w: &mut dyn std::io::Write, values: &[i64]) -> std::io::Result<()> {

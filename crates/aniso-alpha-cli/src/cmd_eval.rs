@@ -41,6 +41,8 @@ pub struct EvalArgs {
     /// Detected part labels, one per line (`detect --part-labels`)
     #[arg(long, value_name = "PARTS.txt", requires = "part_column")]
     pub part_labels: Option<PathBuf>,
+    #[command(flatten)]
+    pub common: crate::QuietArgs,
 }
 
 /// Runs `eval`.
