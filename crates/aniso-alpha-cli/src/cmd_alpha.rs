@@ -16,10 +16,14 @@ use crate::common::{
 /// Arguments of `alpha`.
 #[derive(Debug, Args)]
 #[command(
+    // Something to do; --alpha alone then asks for an output of the shape.
     group(ArgGroup::new("action").required(true).multiple(true)
-        .args(["intervals", "output", "png", "optimal_alpha"])),
+        .args(["intervals", "alpha", "output", "png", "optimal_alpha"])),
     group(ArgGroup::new("shape_out").multiple(true).args(["output", "png"])),
     group(ArgGroup::new("which_alpha").args(["alpha", "optimal_alpha"])),
+    override_usage = "aniso-alpha alpha <INPUT> --intervals <OUT.csv> [--elongation <e1,e2,e3>] [--euler <theta,psi,phi>]\n       \
+aniso-alpha alpha <INPUT> (--alpha <A> | --optimal-alpha) [--surface] (--output <shape.ply> | --png <OUT.png>)\n       \
+aniso-alpha alpha <INPUT> --optimal-alpha",
     after_help = "Alpha is a radius: the ball (or, with --elongation, the ellipsoid's unit \
 semi-axis) of radius alpha. CGAL's Alpha_shape_3 and Open3D's alpha parameter differ: CGAL takes \
 the squared radius, so alpha 0.5 here is CGAL's alpha 0.25.\n\

@@ -337,7 +337,11 @@ fn synth_detect_eval_chain() {
 #[test]
 fn detect_without_input_runs_the_example() {
     let dir = TempDir::new("example");
+    // --quiet means quiet: no summary either.
     let o = run_in(Some(&dir.0), &["detect", "--quiet"]);
+    assert_eq!(o.status.code(), Some(0));
+    assert!(o.stdout.is_empty() && o.stderr.is_empty(), "{o:?}");
+    let o = run_in(Some(&dir.0), &["detect"]);
     assert_eq!(
         o.status.code(),
         Some(0),
@@ -353,6 +357,7 @@ fn detect_without_input_runs_the_example() {
         "parts.txt",
         "structures.ply",
         "report.json",
+        "view.html",
     ] {
         assert!(dir.0.join("aniso-alpha-example").join(f).exists(), "{f}");
     }
@@ -400,4 +405,57 @@ fn bad_parameters_are_clean_errors() {
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert_eq!(err.lines().count(), 1, "{err}");
     assert!(err.contains("s.xyz") && err.contains("min-size"), "{err}");
+}
+
+fn ply_count(p: &Path, element: &str) -> Option<usize> {
+    let bytes = std::fs::read(p).unwrap();
+    let header = String::from_utf8_lossy(&bytes[..bytes.len().min(2048)]).to_string();
+    header
+        .lines()
+        .take_while(|l| *l != "end_header")
+        .find_map(|l| l.strip_prefix(&format!("element {element} ")))
+        .map(|n| n.trim().parse().unwrap())
+}
+
+/// `alpha --optimal-alpha` prints the library's optimal alpha; `--surface`
+/// writes exactly the regular triangles, and no edges.
+#[test]
+fn alpha_optimal_and_boundary_surface() {
+    use aniso_alpha::alpha::AlphaComplex;
+    let input = fixture("random_500.xyz");
+    let pts = aniso_alpha::io::read_points(&input, &Default::default())
+        .unwrap()
+        .points;
+    let ac = AlphaComplex::from_points(&pts).unwrap();
+    let want = ac.optimal_alpha().unwrap();
+    let o = ok(&["alpha", input.to_str().unwrap(), "--optimal-alpha"]);
+    assert_eq!(
+        String::from_utf8_lossy(&o.stdout),
+        format!("optimal alpha {want:?}\n")
+    );
+    let dir = TempDir::new("surface");
+    let (all, surf) = (dir.path("all.ply"), dir.path("surf.ply"));
+    ok(&[
+        "alpha",
+        input.to_str().unwrap(),
+        "--optimal-alpha",
+        "--surface",
+        "--output",
+        surf.to_str().unwrap(),
+    ]);
+    ok(&[
+        "alpha",
+        input.to_str().unwrap(),
+        "--alpha",
+        &format!("{want:?}"),
+        "--output",
+        all.to_str().unwrap(),
+    ]);
+    let n_surface = ac.regular_surface(want).len();
+    assert!(n_surface > 0);
+    assert_eq!(ply_count(&surf, "face"), Some(n_surface));
+    assert!(matches!(ply_count(&surf, "edge"), None | Some(0)));
+    // F_alpha holds the boundary and more (interior singular triangles).
+    assert_eq!(ply_count(&all, "face"), Some(ac.triangles_at(want).count()));
+    assert!(ply_count(&all, "face").unwrap() >= n_surface);
 }
