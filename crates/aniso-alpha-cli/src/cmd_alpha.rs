@@ -25,12 +25,12 @@ use crate::common::{
 aniso-alpha alpha <INPUT> (--alpha <A> | --optimal-alpha) [--surface] (--output <shape.ply> | --png <OUT.png>)\n       \
 aniso-alpha alpha <INPUT> --optimal-alpha",
     after_help = "Alpha is a radius: the ball (or, with --elongation, the ellipsoid's unit \
-semi-axis) of radius alpha. CGAL's Alpha_shape_3 and Open3D's alpha parameter differ: CGAL takes \
-the squared radius, so alpha 0.5 here is CGAL's alpha 0.25.\n\
+semi-axis) of radius alpha. CGAL's Alpha_shape_3 takes the squared radius instead: alpha 0.5 \
+here is CGAL's alpha 0.25.\n\
 With --intervals: CSV with header `dim,v0,v1,v2,alpha_min,alpha_max`, one row \
 per Delaunay edge (dim 1, v2 empty) and triangle (dim 2) of Del(Q·P), vertex indices ascending, \
 `inf` for an unbounded alpha_max (radii, like --alpha). Q = diag(e1,e2,e3)·R(theta,psi,phi), \
-R = Rz(theta)·Rx(psi)·Ry(phi); the default is the identity (Euclidean). See docs/method.md.\n\
+R = Rz(theta)·Rx(psi)·Ry(phi); the default is the identity (Euclidean). See docs/method.md §1-§2.\n\
 With --alpha A --output shape.ply: the alpha-shape F_alpha of the paper, every edge and triangle \
 with alpha_min <= A <= alpha_max (unoriented triangles, plus the edges that bound no triangle). \
 With --surface: only the boundary of the alpha-complex's solid part, triangles oriented outward \

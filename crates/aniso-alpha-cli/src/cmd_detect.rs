@@ -1,4 +1,4 @@
-//! `aniso-alpha detect`: structures by anisotropic alpha-shapes (SPEC §4).
+//! `aniso-alpha detect`: structures by anisotropic alpha-shapes (docs/method.md §4).
 
 use std::path::PathBuf;
 
@@ -42,7 +42,8 @@ pub struct DetectArgs {
     /// Look for lines or planes
     #[arg(long, value_enum)]
     pub structure: Option<Structure>,
-    /// Alpha (ball radius before elongation)
+    /// Alpha, a radius: the ellipsoid's short semi-axis (CGAL's Alpha_shape_3
+    /// takes the squared radius; docs/method.md §5)
     #[arg(long, value_name = "A", value_parser = parse_positive)]
     pub alpha: Option<f64>,
     /// Elongation lambda2 of planes (default: lambda3)

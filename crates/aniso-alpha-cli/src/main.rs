@@ -48,8 +48,8 @@ pub struct CommonArgs {
     /// Worker threads (default: all cores)
     #[arg(long, value_name = "N")]
     pub threads: Option<NonZeroUsize>,
-    /// Nothing on stdout or stderr but errors and the files asked for: no
-    /// progress bars, messages or summary
+    /// No progress bars, messages or summary: nothing but errors, the files
+    /// asked for, and a value asked for on stdout (alpha --optimal-alpha)
     #[arg(long)]
     pub quiet: bool,
     /// Print the wall time of each phase (seconds) as one JSON object on stderr
@@ -180,6 +180,42 @@ mod tests {
     #[test]
     fn cli_is_consistent() {
         Cli::command().debug_assert();
+    }
+
+    /// The help cites the method page that is in the repository, groups
+    /// the common options, and says what α is.
+    #[test]
+    fn help_is_grouped_and_cites_what_exists() {
+        let mut cmd = Cli::command();
+        cmd.build();
+        for sub in cmd.get_subcommands_mut() {
+            let name = sub.get_name().to_string();
+            if name == "help" {
+                continue;
+            }
+            let help = sub.render_long_help().to_string();
+            assert!(!help.contains("SPEC"), "{name}");
+            let common = help
+                .find("Common options:")
+                .unwrap_or_else(|| panic!("{name}"));
+            // Every common option is listed under that heading, after the
+            // subcommand's own options.
+            for opt in ["--quiet", "--timings"] {
+                assert!(help[common..].contains(opt), "{name} {opt}");
+                assert!(
+                    !help[..common].contains(&format!("      {opt}")),
+                    "{name} {opt}"
+                );
+            }
+            let threads = matches!(name.as_str(), "delaunay" | "alpha" | "detect");
+            assert_eq!(help.contains("--threads"), threads, "{name}");
+            if matches!(name.as_str(), "alpha" | "detect") {
+                assert!(help.contains("radius") && help.contains("square"), "{name}");
+            }
+        }
+        assert!(std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../docs/method.md")
+            .is_file());
     }
 
     #[test]

@@ -337,10 +337,6 @@ fn synth_detect_eval_chain() {
 #[test]
 fn detect_without_input_runs_the_example() {
     let dir = TempDir::new("example");
-    // --quiet means quiet: no summary either.
-    let o = run_in(Some(&dir.0), &["detect", "--quiet"]);
-    assert_eq!(o.status.code(), Some(0));
-    assert!(o.stdout.is_empty() && o.stderr.is_empty(), "{o:?}");
     let o = run_in(Some(&dir.0), &["detect"]);
     assert_eq!(
         o.status.code(),
@@ -458,4 +454,65 @@ fn alpha_optimal_and_boundary_surface() {
     // F_alpha holds the boundary and more (interior singular triangles).
     assert_eq!(ply_count(&all, "face"), Some(ac.triangles_at(want).count()));
     assert!(ply_count(&all, "face").unwrap() >= n_surface);
+}
+
+/// --quiet means quiet: no messages, no progress, no summary; only what
+/// was asked for as the result (eval's scores) still prints.
+#[test]
+fn quiet_means_quiet() {
+    let dir = TempDir::new("quiet");
+    let silent = |args: &[&str]| {
+        let o = run_in(Some(&dir.0), args);
+        assert_eq!(o.status.code(), Some(0), "{args:?}");
+        assert!(
+            o.stdout.is_empty() && o.stderr.is_empty(),
+            "{args:?}: {o:?}"
+        );
+    };
+    silent(&[
+        "synth", "lines", "--seed", "4", "--output", "l.xyz", "--quiet",
+    ]);
+    silent(&[
+        "detect",
+        "l.xyz",
+        "--structure",
+        "lines",
+        "--alpha",
+        "1",
+        "--lambda3",
+        "10",
+        "--min-size",
+        "4",
+        "--labels",
+        "labels.txt",
+        "--quiet",
+    ]);
+    silent(&["view", "l.xyz", "--output", "v.html", "--quiet"]);
+    silent(&["delaunay", "l.xyz", "--tets", "t.tets", "--quiet"]);
+    let o = ok(&[
+        "eval",
+        "--truth",
+        dir.path("l.xyz").to_str().unwrap(),
+        "--labels",
+        dir.path("labels.txt").to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(String::from_utf8_lossy(&o.stdout).contains("F1"));
+    // Without --quiet, detect prints its summary.
+    let o = run_in(
+        Some(&dir.0),
+        &[
+            "detect",
+            "l.xyz",
+            "--structure",
+            "lines",
+            "--alpha",
+            "1",
+            "--lambda3",
+            "10",
+            "--min-size",
+            "4",
+        ],
+    );
+    assert!(String::from_utf8_lossy(&o.stdout).contains("structure(s)"));
 }
