@@ -298,45 +298,120 @@ impl UnionFind {
     }
 }
 
-/// The path filter (module docs): `mask[i]` is true when input simplex `i`
-/// survives `filter(S, nb_c)`. `nb_c ≤ 1` keeps everything.
+/// The path filter's verdict per input simplex (true = kept); see the
+/// module doc for the definition.
 ///
-/// ```
-/// use aniso_alpha::detect::filter::filter_mask;
-/// // A fin (triangle 1-2-9) on the inner edge 1-2 of a 4-triangle patch.
-/// let s = [[0, 1, 2], [1, 2, 3], [1, 3, 4], [0, 2, 5], [1, 2, 9]];
-/// assert_eq!(filter_mask(&s, 2).unwrap(), vec![true, true, true, true, false]);
-/// ```
+/// Near-linear in the number of simplices, whatever `nb_c` is. The naive
+/// reading recomputes every path at every level l = 1 … nb_c − 1; here:
+/// * all paths of length ≤ l are deleted at once, as the definition says,
+///   and then the faces whose degree dropped to exactly 2 join their two
+///   surviving simplices (union-find, paths only merge);
+/// * a merged path is longer than each of the paths it joins, and those
+///   survived level l, so it is longer than l: the repeat "at the same l"
+///   never deletes anything, and each level is one round;
+/// * paths are kept in buckets by length (below nb_c); level l deletes
+///   bucket l (entries that are still a live root of that length), so a
+///   level costs the simplices it deletes, not a pass over all of them.
+///
+/// Total: one sort to build the incidences, then O((n + nb_c)·α(n)).
+///
+/// # Errors
+/// A simplex with a repeated vertex, or too many simplices.
 pub fn filter_mask<S: Simplex>(simplices: &[S], nb_c: u32) -> Result<Vec<bool>, FilterError> {
     let inc = Incidence::new(simplices)?;
     let n = inc.n;
     let mut alive = vec![true; n];
     let mut degree = inc.degrees();
     let mut uf = UnionFind::new();
-    let mut l = 1u32;
-    let mut n_alive = n;
-    while l < nb_c && n_alive > 0 {
-        inc.unite(&alive, &degree, true, &mut uf);
-        // Length of the shortest alive path.
-        let mut shortest = u32::MAX;
-        for (s, _) in alive.iter().enumerate().filter(|(_, &a)| a) {
-            shortest = shortest.min(uf.size_of(s as u32));
+    inc.unite(&alive, &degree, true, &mut uf);
+    if nb_c <= 1 || n == 0 {
+        return Ok(inc
+            .input_to_unique
+            .iter()
+            .map(|&u| alive[u as usize])
+            .collect());
+    }
+    let top = nb_c as usize; // lengths 1 ..= nb_c − 1 can be deleted
+                             // Members of each path (linked lists through `next`, by root).
+    let mut tail: Vec<u32> = (0..n as u32).collect();
+    let mut next: Vec<u32> = vec![u32::MAX; n];
+    let mut bucket: Vec<Vec<u32>> = vec![Vec::new(); top];
+    for s in 0..n as u32 {
+        let r = uf.find(s);
+        if r != s {
+            // Append s to r's list.
+            next[tail[r as usize] as usize] = s;
+            tail[r as usize] = s;
         }
-        if shortest > l {
-            // Levels l .. shortest − 1 delete nothing (paths only merge).
-            l = shortest;
-            continue;
+    }
+    for s in 0..n as u32 {
+        if uf.find(s) == s {
+            let len = uf.size_of(s) as usize;
+            if len < top {
+                bucket[len].push(s);
+            }
         }
-        for (s, a) in alive.iter_mut().enumerate() {
-            if *a && uf.size_of(s as u32) <= l {
-                *a = false;
-                n_alive -= 1;
-                for &f in inc.faces_of(s) {
-                    degree[f as usize] -= 1;
+    }
+    let mut doomed: Vec<u32> = Vec::new();
+    let mut touched: Vec<u32> = Vec::new();
+    for l in 1..top {
+        // The live paths of length exactly l (shorter ones went before).
+        let roots = std::mem::take(&mut bucket[l]);
+        doomed.clear();
+        for r in roots {
+            if alive[r as usize] && uf.find(r) == r && uf.size_of(r) as usize == l {
+                let mut s = r;
+                loop {
+                    doomed.push(s);
+                    if next[s as usize] == u32::MAX {
+                        break;
+                    }
+                    s = next[s as usize];
                 }
             }
         }
-        // Repeat at the same l (the next pass finds shortest > l and moves on).
+        if doomed.is_empty() {
+            continue;
+        }
+        // Delete them all at once, then join across the faces left with
+        // degree 2.
+        touched.clear();
+        for &s in &doomed {
+            alive[s as usize] = false;
+            for &f in inc.faces_of(s as usize) {
+                degree[f as usize] -= 1;
+                if degree[f as usize] == 2 {
+                    touched.push(f);
+                }
+            }
+        }
+        for &f in &touched {
+            if degree[f as usize] != 2 {
+                continue;
+            }
+            let mut pair = inc
+                .face(f as usize)
+                .iter()
+                .copied()
+                .filter(|&s| alive[s as usize]);
+            let (Some(a), Some(b)) = (pair.next(), pair.next()) else {
+                continue;
+            };
+            let (ra, rb) = (uf.find(a), uf.find(b));
+            if ra == rb {
+                continue;
+            }
+            uf.union(ra, rb);
+            let root = uf.find(ra);
+            let other = if root == ra { rb } else { ra };
+            // Concatenate the member lists under the new root.
+            next[tail[root as usize] as usize] = other;
+            tail[root as usize] = tail[other as usize];
+            let len = uf.size_of(root) as usize;
+            if len < top {
+                bucket[len].push(root);
+            }
+        }
     }
     Ok(inc
         .input_to_unique

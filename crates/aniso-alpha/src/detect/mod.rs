@@ -15,6 +15,8 @@ pub mod detector;
 pub mod faces;
 pub mod filter;
 pub mod fit;
+pub mod local;
+pub mod modes;
 pub mod orientations;
 pub mod parts;
 pub mod prune;

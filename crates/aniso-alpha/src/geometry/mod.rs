@@ -4,6 +4,7 @@
 //! Nothing here knows about triangulation topology.
 
 pub mod circum;
+pub mod kdtree;
 pub mod predicates;
 
 pub use predicates::Point3;

@@ -1,0 +1,477 @@
+//! The local shape of a point cloud: for every point, a principal component
+//! analysis of its neighbourhood at the scale where it looks most planar
+//! (k = 2) or most linear (k = 1). This is what the parameters and the
+//! orientation set are estimated from (see [`super::estimate`] and
+//! [`super::modes`]).
+//!
+//! **Scales.** A neighbourhood is the [`NEIGHBOURS`] nearest points of a
+//! subsample: scale 0 uses every point, scale j keeps one point in 4^j
+//! (chosen by a hash of its index, so the subsample has no grid pattern of
+//! its own). On a surface, 4× fewer points make the same number of
+//! neighbours reach 2× farther, so the scales double the radius: a noisy
+//! wall or a thick pole, which looks like a blob at the sampling scale,
+//! looks like a plane or a line a few scales up. Scales stop at
+//! [`MAX_SCALES`] or when the subsample is too small.
+//!
+//! **Choosing the scale.** With σ₁ ≥ σ₂ ≥ σ₃ the principal standard
+//! deviations of the neighbourhood, the dimensionality features of Demantké
+//! et al. (2011) are a₁ = (σ₁ − σ₂)/σ₁ (linear), a₂ = (σ₂ − σ₃)/σ₁
+//! (planar) and a₃ = σ₃/σ₁ (scattered). Each point keeps the scale that
+//! maximises a₂ when planes are sought and a₁ when lines are (the smallest
+//! such scale on ties).
+//!
+//! ```
+//! use aniso_alpha::detect::local::local_shapes;
+//! use aniso_alpha::detect::StructureKind;
+//! // A 20 × 20 grid on the plane z = 0.
+//! let pts: Vec<[f64; 3]> = (0..400).map(|i| [(i % 20) as f64, (i / 20) as f64, 0.0]).collect();
+//! let shapes = local_shapes(&pts, StructureKind::Planes);
+//! assert!(shapes.iter().all(|s| s.normal[2].abs() > 0.99 && s.planarity() > 0.5));
+//! assert!(shapes.iter().all(|s| (s.spacing - 1.0).abs() < 1e-6));
+//! ```
+
+use super::StructureKind;
+use crate::geometry::kdtree::KdTree;
+
+/// Neighbours per neighbourhood: the usual choice for PCA normals (CGAL's
+/// examples use 12–24, PCL's 10–30): enough for a stable covariance of 3
+/// coordinates, few enough to stay local.
+pub const NEIGHBOURS: usize = 16;
+
+/// Number of scales at most (radii 1, 2, 4, 8, 16 and 32 times the
+/// sampling scale, on a surface).
+pub const MAX_SCALES: usize = 6;
+
+/// A score at which a point stops looking at larger scales: 0.8 is the
+/// planarity of a clean plane sampled irregularly (σ₂/σ₁ ≈ 0.8–0.9, σ₃ ≈ 0)
+/// and the linearity of a line with points a little off it.
+pub const GOOD: f32 = 0.8;
+
+/// The local shape of the cloud around one point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LocalShape {
+    /// Unit normal of the local plane (the smallest principal axis).
+    pub normal: [f32; 3],
+    /// Unit direction of the local line (the largest principal axis).
+    pub direction: [f32; 3],
+    /// Principal standard deviations σ₁ ≥ σ₂ ≥ σ₃ of the neighbourhood.
+    pub sigma: [f32; 3],
+    /// The chosen scale (0 = every point).
+    pub scale: u8,
+    /// Distance to the nearest other point with other coordinates (∞ when
+    /// there is none).
+    pub spacing: f32,
+}
+
+impl LocalShape {
+    /// a₂ = (σ₂ − σ₃)/σ₁: 1 on a clean plane, 0 on a line or a blob.
+    pub fn planarity(&self) -> f32 {
+        let [s1, s2, s3] = self.sigma;
+        if s1 > 0.0 {
+            (s2 - s3) / s1
+        } else {
+            0.0
+        }
+    }
+
+    /// a₁ = (σ₁ − σ₂)/σ₁: 1 on a clean line, 0 on a plane or a blob.
+    pub fn linearity(&self) -> f32 {
+        let [s1, s2, _] = self.sigma;
+        if s1 > 0.0 {
+            (s1 - s2) / s1
+        } else {
+            0.0
+        }
+    }
+
+    /// The spread across the local structure: σ₃ for a plane (its noise),
+    /// √(σ₂² + σ₃²) for a line (its radius of scatter).
+    pub fn spread(&self, kind: StructureKind) -> f32 {
+        let [_, s2, s3] = self.sigma;
+        match kind {
+            StructureKind::Planes => s3,
+            StructureKind::Lines => (s2 * s2 + s3 * s3).sqrt(),
+        }
+    }
+
+    /// The feature the scale was chosen by: planarity (k = 2) or linearity
+    /// (k = 1).
+    pub fn score(&self, kind: StructureKind) -> f32 {
+        match kind {
+            StructureKind::Planes => self.planarity(),
+            StructureKind::Lines => self.linearity(),
+        }
+    }
+
+    /// The local axis of the structure kind: the normal (k = 2) or the
+    /// direction (k = 1).
+    pub fn axis(&self, kind: StructureKind) -> [f32; 3] {
+        match kind {
+            StructureKind::Planes => self.normal,
+            StructureKind::Lines => self.direction,
+        }
+    }
+}
+
+/// A well-mixed 64-bit hash of a point index (splitmix64's finaliser), for
+/// subsamples without a pattern of their own.
+fn mix(i: u64) -> u64 {
+    let mut z = i.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+/// The indices kept at scale `j`: one point in 4^j.
+fn subsample(n: usize, j: usize) -> Vec<u32> {
+    let keep = 1u64 << (2 * j);
+    (0..n as u32)
+        .filter(|&i| mix(u64::from(i)) % keep == 0)
+        .collect()
+}
+
+/// Eigen-decomposition of a symmetric 3×3 matrix in closed form (the
+/// trigonometric solution of the characteristic cubic, then eigenvectors
+/// as cross products of rows of A − λI): eigenvalues descending, matching
+/// unit eigenvectors as rows. About ten times cheaper than the Jacobi
+/// iteration of [`super::fit::symmetric_eigen`], and accurate to about
+/// 1e-8 of the largest eigenvalue, plenty for local normals; where two
+/// eigenvalues are nearly equal their eigenvectors are arbitrary in their
+/// plane (as they are for any method).
+pub fn eigen_sym3(a: [[f64; 3]; 3]) -> ([f64; 3], [[f64; 3]; 3]) {
+    let p1 = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
+    let q = (a[0][0] + a[1][1] + a[2][2]) / 3.0;
+    let p2 = (a[0][0] - q).powi(2) + (a[1][1] - q).powi(2) + (a[2][2] - q).powi(2) + 2.0 * p1;
+    let p = (p2 / 6.0).sqrt();
+    if !(p.is_finite() && p > 1e-300) {
+        // A multiple of the identity (or not finite): any basis.
+        return ([q; 3], [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
+    }
+    let mut b = a;
+    for i in 0..3 {
+        b[i][i] -= q;
+        for j in 0..3 {
+            b[i][j] /= p;
+        }
+    }
+    let det = b[0][0] * (b[1][1] * b[2][2] - b[1][2] * b[2][1])
+        - b[0][1] * (b[1][0] * b[2][2] - b[1][2] * b[2][0])
+        + b[0][2] * (b[1][0] * b[2][1] - b[1][1] * b[2][0]);
+    let phi = (det / 2.0).clamp(-1.0, 1.0).acos() / 3.0;
+    let l1 = q + 2.0 * p * phi.cos();
+    let l3 = q + 2.0 * p * (phi + 2.0 * std::f64::consts::PI / 3.0).cos();
+    let l2 = 3.0 * q - l1 - l3;
+    // Eigenvector of λ: the largest cross product of two rows of A − λI.
+    let vector = |l: f64| -> Option<[f64; 3]> {
+        let r = [
+            [a[0][0] - l, a[0][1], a[0][2]],
+            [a[0][1], a[1][1] - l, a[1][2]],
+            [a[0][2], a[1][2], a[2][2] - l],
+        ];
+        let mut best = [0.0; 3];
+        let mut bn = -1.0;
+        for (i, j) in [(0, 1), (0, 2), (1, 2)] {
+            let c = cross(r[i], r[j]);
+            let n = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+            if n > bn {
+                bn = n;
+                best = c;
+            }
+        }
+        let n = bn.sqrt();
+        (n > 0.0).then(|| best.map(|x| x / n))
+    };
+    // The better separated end first; the other is made orthogonal to it
+    // (its own cross products are unreliable when its eigenvalue is close
+    // to the middle one).
+    let orthogonal_to = |u: [f64; 3], v: [f64; 3]| -> [f64; 3] {
+        let d = u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+        let w = [v[0] - d * u[0], v[1] - d * u[1], v[2] - d * u[2]];
+        let n = (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt();
+        if n > 1e-6 {
+            w.map(|x| x / n)
+        } else {
+            any_orthogonal(u)
+        }
+    };
+    let (v1, v3) = if l1 - l2 >= l2 - l3 {
+        let v1 = vector(l1).unwrap_or([1.0, 0.0, 0.0]);
+        (
+            v1,
+            orthogonal_to(v1, vector(l3).unwrap_or_else(|| any_orthogonal(v1))),
+        )
+    } else {
+        let v3 = vector(l3).unwrap_or([0.0, 0.0, 1.0]);
+        (
+            orthogonal_to(v3, vector(l1).unwrap_or_else(|| any_orthogonal(v3))),
+            v3,
+        )
+    };
+    let v2 = cross(v3, v1);
+    ([l1, l2, l3], [v1, v2, v3])
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn any_orthogonal(u: [f64; 3]) -> [f64; 3] {
+    let t = if u[0].abs() < 0.9 {
+        [1.0, 0.0, 0.0]
+    } else {
+        [0.0, 1.0, 0.0]
+    };
+    let c = cross(u, t);
+    let n = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+    c.map(|x| x / n)
+}
+
+/// Principal standard deviations (descending) and axes (rows, matching) of
+/// the points `ids`.
+fn pca(points: &[[f64; 3]], ids: &[(f64, u32)]) -> ([f64; 3], [[f64; 3]; 3]) {
+    let n = ids.len() as f64;
+    let mut c = [0.0; 3];
+    for &(_, i) in ids {
+        let p = points[i as usize];
+        for k in 0..3 {
+            c[k] += p[k];
+        }
+    }
+    c = c.map(|x| x / n);
+    let mut m = [[0.0; 3]; 3];
+    for &(_, i) in ids {
+        let p = points[i as usize];
+        let d = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
+        for r in 0..3 {
+            for s in r..3 {
+                m[r][s] += d[r] * d[s];
+            }
+        }
+    }
+    for r in 0..3 {
+        for s in r..3 {
+            m[r][s] /= n;
+            m[s][r] = m[r][s];
+        }
+    }
+    let (vals, vecs) = eigen_sym3(m);
+    (vals.map(|v| v.max(0.0).sqrt()), vecs)
+}
+
+fn to_f32(v: [f64; 3]) -> [f32; 3] {
+    v.map(|x| x as f32)
+}
+
+/// Runs `f` over `0..n` (in parallel with the `parallel` feature), with a
+/// neighbour buffer per worker, and collects in order.
+fn map_points<T: Send>(n: usize, f: impl Fn(&mut Vec<(f64, u32)>, usize) -> T + Sync) -> Vec<T> {
+    #[cfg(feature = "parallel")]
+    {
+        use rayon::prelude::*;
+        (0..n)
+            .into_par_iter()
+            .map_init(Vec::new, |nb, i| f(nb, i))
+            .collect()
+    }
+    #[cfg(not(feature = "parallel"))]
+    {
+        let mut nb = Vec::new();
+        (0..n).map(|i| f(&mut nb, i)).collect()
+    }
+}
+
+/// The shape of the neighbourhood `nb` (at least 3 points).
+fn shape_of(points: &[[f64; 3]], nb: &[(f64, u32)], scale: usize, spacing: f32) -> LocalShape {
+    let (sigma, axes) = pca(points, nb);
+    LocalShape {
+        normal: to_f32(axes[2]),
+        direction: to_f32(axes[0]),
+        sigma: to_f32(sigma),
+        scale: scale as u8,
+        spacing,
+    }
+}
+
+/// The local shape of every point (see the module doc). Deterministic;
+/// runs on the current rayon pool with the `parallel` feature.
+///
+/// Cost: the neighbourhoods of scale j ≥ 1 are analysed at the points of
+/// the scale-j subsample only (n/4^j of them), and a point that needs
+/// them takes those of its nearest subsample point: about 1.4 n
+/// 16-nearest queries in all, however many scales there are. A point whose
+/// score at scale 0 already reaches [`GOOD`] looks no further.
+pub fn local_shapes(points: &[[f64; 3]], kind: StructureKind) -> Vec<LocalShape> {
+    let n = points.len();
+    // Nested subsamples (mix(i) % 4^j == 0 implies the same for j − 1).
+    let mut samples: Vec<Vec<u32>> = vec![Vec::new()];
+    let mut trees: Vec<KdTree> = vec![KdTree::new(points, None)];
+    for j in 1..MAX_SCALES {
+        let ids = subsample(n, j);
+        if ids.len() < 4 * NEIGHBOURS {
+            break;
+        }
+        trees.push(KdTree::new(points, Some(ids.clone())));
+        samples.push(ids);
+    }
+    let scales = trees.len();
+    // Shapes of the subsample points at their own scale, and the link from
+    // each point of subsample j − 1 to its nearest point of subsample j.
+    let mut coarse: Vec<Vec<LocalShape>> = vec![Vec::new()];
+    let mut up: Vec<Vec<u32>> = vec![Vec::new(), Vec::new()];
+    for j in 1..scales {
+        let ids = &samples[j];
+        coarse.push(map_points(ids.len(), |nb, t| {
+            trees[j].nearest(&points[ids[t] as usize], NEIGHBOURS, nb);
+            shape_of(points, nb, j, f32::INFINITY)
+        }));
+        if j >= 2 {
+            let below = &samples[j - 1];
+            up.push(map_points(below.len(), |nb, t| {
+                trees[j].nearest(&points[below[t] as usize], 1, nb);
+                ids.binary_search(&nb[0].1).unwrap_or(0) as u32
+            }));
+        }
+    }
+    map_points(n, |nb, i| {
+        let q = &points[i];
+        trees[0].nearest(q, NEIGHBOURS, nb);
+        let spacing = nb
+            .iter()
+            .map(|&(d, _)| d)
+            .find(|&d| d > 0.0)
+            .map_or(f32::INFINITY, |d| d.sqrt() as f32);
+        let mut best = if nb.len() >= 3 {
+            shape_of(points, nb, 0, spacing)
+        } else {
+            LocalShape {
+                normal: [0.0, 0.0, 1.0],
+                direction: [1.0, 0.0, 0.0],
+                sigma: [0.0; 3],
+                scale: 0,
+                spacing,
+            }
+        };
+        let mut score = best.score(kind);
+        if score >= GOOD || scales < 2 {
+            return best;
+        }
+        trees[1].nearest(q, 1, nb);
+        let mut t = samples[1].binary_search(&nb[0].1).unwrap_or(0);
+        for j in 1..scales {
+            if j >= 2 {
+                t = up[j][t] as usize;
+            }
+            let c = coarse[j][t];
+            let s = c.score(kind);
+            if s > score {
+                score = s;
+                best = LocalShape { spacing, ..c };
+            }
+            if s >= GOOD {
+                break;
+            }
+        }
+        best
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A deterministic pseudo-random stream in [0, 1).
+    fn uniform(seed: u64) -> impl FnMut() -> f64 {
+        let mut i = seed;
+        move || {
+            i += 1;
+            (mix(i) >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    #[test]
+    fn closed_form_eigen_agrees_with_jacobi() {
+        let mut r = uniform(3);
+        for t in 0..2000 {
+            // Random symmetric matrices, including near-degenerate spectra.
+            let mut m = [[0.0; 3]; 3];
+            for i in 0..3 {
+                for j in i..3 {
+                    m[i][j] = r() - 0.5;
+                    m[j][i] = m[i][j];
+                }
+            }
+            if t % 3 == 0 {
+                // Thin planes' and lines' covariances: repeated and tiny
+                // eigenvalues.
+                m = match t % 9 {
+                    0 => [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1e-6]],
+                    3 => [[1e-6, 0.0, 0.0], [0.0, 1e-6, 0.0], [0.0, 0.0, 1.0]],
+                    _ => [[0.5, 0.5, 0.0], [0.5, 0.5, 0.0], [0.0, 0.0, 0.25]],
+                };
+            }
+            let (lv, lx) = eigen_sym3(m);
+            let (jv, _) = super::super::fit::symmetric_eigen(m);
+            for k in 0..3 {
+                assert!((lv[k] - jv[k]).abs() < 1e-9, "{t}: {lv:?} vs {jv:?}");
+            }
+            // A·v = λ·v for the well-separated ends; an orthonormal basis.
+            for i in 0..3 {
+                for j in 0..3 {
+                    let d: f64 = (0..3).map(|c| lx[i][c] * lx[j][c]).sum();
+                    assert!((d - f64::from(u8::from(i == j))).abs() < 1e-9, "{t}: basis");
+                }
+            }
+            for k in [0, 2] {
+                let v = lx[k];
+                let sep = if k == 0 { lv[0] - lv[1] } else { lv[1] - lv[2] };
+                if sep < 1e-3 {
+                    continue;
+                }
+                for i in 0..3 {
+                    let av = m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2];
+                    assert!((av - lv[k] * v[i]).abs() < 1e-7, "{t} {k}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn noisy_plane_is_planar_at_a_larger_scale() {
+        // A plane sampled at spacing 1 with noise of 2 spacings across it:
+        // a blob at 16 neighbours, a plane a few scales up.
+        let mut r = uniform(7);
+        let mut gauss = move || {
+            let (u, v) = (r().max(1e-300), r());
+            (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * v).cos()
+        };
+        let pts: Vec<[f64; 3]> = (0..40_000)
+            .map(|i| [(i % 200) as f64, (i / 200) as f64, 2.0 * gauss()])
+            .collect();
+        let shapes = local_shapes(&pts, StructureKind::Planes);
+        let good = shapes
+            .iter()
+            .filter(|s| s.normal[2].abs() > 0.95 && s.scale >= 2)
+            .count();
+        assert!(good > 30_000, "{good} of 40000 points see the plane");
+        let mut spread: Vec<f32> = shapes.iter().map(|s| s.sigma[2]).collect();
+        spread.sort_by(|a, b| a.partial_cmp(b).unwrap());
+        let median = spread[spread.len() / 2];
+        assert!((1.5..2.5).contains(&median), "noise estimate {median}");
+    }
+
+    #[test]
+    fn line_direction_and_duplicates() {
+        let mut pts: Vec<[f64; 3]> = (0..300).map(|i| [0.5 * i as f64, 0.0, 0.0]).collect();
+        pts.extend_from_within(0..10); // exact duplicates
+        let shapes = local_shapes(&pts, StructureKind::Lines);
+        for s in &shapes {
+            assert!(s.direction[0].abs() > 0.99);
+            assert!(s.linearity() > 0.9);
+            assert!((s.spacing - 0.5).abs() < 1e-6, "{}", s.spacing);
+        }
+    }
+}

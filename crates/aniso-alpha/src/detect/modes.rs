@@ -1,0 +1,230 @@
+//! Modes of a distribution of axes on the sphere: the dominant normals of a
+//! scan's planes (k = 2) or directions of its lines (k = 1). An axis and its
+//! opposite are the same (a normal has no sign).
+//!
+//! Mean shift with a flat kernel of angular radius `h`:
+//! 1. at most [`MAX_SAMPLES`] axes are drawn (every axis when there are
+//!    fewer; otherwise a fixed stride through them, deterministic);
+//! 2. the density at a sample is the number of samples within `h` of it
+//!    (either sign), counted with a kd-tree over the samples and their
+//!    opposites;
+//! 3. a sample is a seed when no sample within `h` has a higher density
+//!    (ties: the smaller index wins);
+//! 4. each seed moves to the normalised mean of the samples within `h`
+//!    (signs aligned with it) until it moves less than 0.01°, at most 50
+//!    times;
+//! 5. modes closer than `h` are merged (the denser one stays), and modes
+//!    holding fewer than `min_support` samples are dropped.
+//!
+//! Modes come out densest first, each with its support (samples within `h`)
+//! scaled back to the number of axes given.
+//!
+//! ```
+//! use aniso_alpha::detect::modes::modes;
+//! // Two clusters of normals, around z and around x, and their opposites.
+//! let mut axes = Vec::new();
+//! for i in 0..200 {
+//!     let t = 0.02 * ((i % 7) as f64 - 3.0);
+//!     axes.push([t, 0.0, if i % 2 == 0 { 1.0 } else { -1.0 }]);
+//!     axes.push([1.0, t, 0.0]);
+//! }
+//! let m = modes(&axes, 5f64.to_radians(), 10);
+//! assert_eq!(m.len(), 2);
+//! assert!(m.iter().any(|m| m.axis[2].abs() > 0.999));
+//! assert!(m.iter().any(|m| m.axis[0].abs() > 0.999));
+//! ```
+
+use crate::geometry::kdtree::KdTree;
+
+/// Samples used for the mode search at most.
+pub const MAX_SAMPLES: usize = 20_000;
+
+/// A mode of a distribution of axes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Mode {
+    /// Unit axis (largest |component| positive).
+    pub axis: [f64; 3],
+    /// Axes within the kernel radius of it (scaled to the whole input).
+    pub support: usize,
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn unit(a: [f64; 3]) -> Option<[f64; 3]> {
+    let n = dot(a, a).sqrt();
+    (n > 0.0 && n.is_finite()).then(|| a.map(|x| x / n))
+}
+
+/// `u` with its largest |component| (first on ties) positive.
+pub fn canonical(u: [f64; 3]) -> [f64; 3] {
+    let mut k = 0;
+    for i in 1..3 {
+        if u[i].abs() > u[k].abs() {
+            k = i;
+        }
+    }
+    if u[k] < 0.0 {
+        u.map(|x| -x)
+    } else {
+        u
+    }
+}
+
+/// The modes of `axes` (unit vectors; zero or non-finite ones are skipped)
+/// for a kernel of angular radius `h` radians (see the module doc).
+pub fn modes(axes: &[[f64; 3]], h: f64, min_support: usize) -> Vec<Mode> {
+    let valid: Vec<[f64; 3]> = axes.iter().filter_map(|&a| unit(a)).collect();
+    if valid.is_empty() {
+        return Vec::new();
+    }
+    let stride = valid.len().div_ceil(MAX_SAMPLES);
+    let samples: Vec<[f64; 3]> = valid.iter().step_by(stride).copied().collect();
+    let scale = valid.len() as f64 / samples.len() as f64;
+    let ns = samples.len();
+    // Both signs in one tree: index t < ns is +sample t, ≥ ns its opposite.
+    let mut both = samples.clone();
+    both.extend(samples.iter().map(|a| a.map(|x| -x)));
+    let tree = KdTree::new(&both, None);
+    // Chord length of the angle h.
+    let chord = 2.0 * (h / 2.0).sin();
+    let neighbours = |a: [f64; 3], f: &mut dyn FnMut(usize, f64)| {
+        tree.within(&a, chord, |t| {
+            let t = t as usize;
+            let (s, sign) = if t < ns { (t, 1.0) } else { (t - ns, -1.0) };
+            f(s, sign);
+        });
+    };
+    let density: Vec<u32> = samples
+        .iter()
+        .map(|&a| {
+            let mut c = 0u32;
+            neighbours(a, &mut |_, _| c += 1);
+            c
+        })
+        .collect();
+    let mut found: Vec<Mode> = Vec::new();
+    for (i, &a) in samples.iter().enumerate() {
+        let mut peak = true;
+        neighbours(a, &mut |s, _| {
+            if density[s] > density[i] || (density[s] == density[i] && s < i) {
+                peak = false;
+            }
+        });
+        if !peak {
+            continue;
+        }
+        // Mean shift from the seed.
+        let mut m = a;
+        for _ in 0..50 {
+            let mut sum = [0.0; 3];
+            neighbours(m, &mut |s, sign| {
+                for k in 0..3 {
+                    sum[k] += sign * samples[s][k];
+                }
+            });
+            let Some(next) = unit(sum) else { break };
+            let moved = dot(next, m).clamp(-1.0, 1.0).acos();
+            m = next;
+            if moved < 0.01f64.to_radians() {
+                break;
+            }
+        }
+        let mut support = 0usize;
+        neighbours(m, &mut |_, _| support += 1);
+        found.push(Mode {
+            axis: canonical(m),
+            support: (support as f64 * scale).round() as usize,
+        });
+    }
+    // Densest first (ties by axis, for determinism); merge close ones.
+    found.sort_by(|a, b| {
+        b.support.cmp(&a.support).then(
+            a.axis
+                .partial_cmp(&b.axis)
+                .unwrap_or(std::cmp::Ordering::Equal),
+        )
+    });
+    let cos_h = h.cos();
+    let mut out: Vec<Mode> = Vec::new();
+    for m in found {
+        if m.support < min_support {
+            continue;
+        }
+        if out.iter().all(|o| dot(o.axis, m.axis).abs() < cos_h) {
+            out.push(m);
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rng(seed: u64) -> impl FnMut() -> f64 {
+        let mut s = seed;
+        move || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    /// Axes scattered by about `spread` radians around `c`, random signs.
+    fn cluster(c: [f64; 3], spread: f64, n: usize, r: &mut impl FnMut() -> f64) -> Vec<[f64; 3]> {
+        (0..n)
+            .map(|_| {
+                let v = [
+                    c[0] + spread * (r() - 0.5),
+                    c[1] + spread * (r() - 0.5),
+                    c[2] + spread * (r() - 0.5),
+                ];
+                let v = unit(v).unwrap();
+                if r() < 0.5 {
+                    v.map(|x| -x)
+                } else {
+                    v
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn finds_clusters_and_ignores_uniform_background() {
+        let mut r = rng(4);
+        let s = 0.5f64.sqrt();
+        let centres = [[0.0, 0.0, 1.0], [s, s, 0.0], [s, -s, 0.0], [0.6, 0.0, 0.8]];
+        let mut axes = Vec::new();
+        for (k, c) in centres.iter().enumerate() {
+            axes.extend(cluster(*c, 0.08, 3000 / (k + 1), &mut r));
+        }
+        // Uniform background axes: 3000 of them.
+        for _ in 0..3000 {
+            let v = [r() - 0.5, r() - 0.5, r() - 0.5];
+            if let Some(u) = unit(v) {
+                axes.push(u);
+            }
+        }
+        let m = modes(&axes, 6f64.to_radians(), 300);
+        assert_eq!(m.len(), 4, "{m:?}");
+        for c in centres {
+            let best = m.iter().map(|m| dot(m.axis, c).abs()).fold(0.0, f64::max);
+            assert!(best > 0.9995, "{c:?} missed: {m:?}");
+        }
+        // Densest first.
+        assert!(m.windows(2).all(|w| w[0].support >= w[1].support));
+    }
+
+    #[test]
+    fn opposite_axes_are_one_mode_and_empty_input_is_none() {
+        let axes = vec![[0.0, 0.0, 1.0], [0.0, 0.0, -1.0], [0.0, 0.001, 1.0]];
+        let m = modes(&axes, 0.1, 1);
+        assert_eq!(m.len(), 1);
+        assert_eq!(m[0].support, 3);
+        assert!(modes(&[], 0.1, 1).is_empty());
+        assert!(modes(&[[0.0; 3], [f64::NAN; 3]], 0.1, 1).is_empty());
+    }
+}
