@@ -202,12 +202,10 @@ fn fill_triangle(pixmap: &mut Pixmap, t: [(f32, f32); 3], paint: &Paint<'_>) {
     }
 }
 
-fn stroke_segments(
-    pixmap: &mut Pixmap,
-    segs: &[((f32, f32), (f32, f32))],
-    paint: &Paint<'_>,
-    width: f32,
-) {
+/// A point of the image, in pixels (y down).
+type Px = (f32, f32);
+
+fn stroke_segments(pixmap: &mut Pixmap, segs: &[(Px, Px)], paint: &Paint<'_>, width: f32) {
     if segs.is_empty() {
         return;
     }
@@ -327,9 +325,9 @@ pub fn detection_png(
                 continue;
             }
             if let Some(o) = crate::view::outline_of_points(points, m, false) {
-                let n = o.0.len().max(1) as f64;
-                let depth = o.0.iter().map(|&p| cam.depth(p)).sum::<f64>() / n;
-                polys.push((depth, part_color(k, j), o.0));
+                let n = o.vertices.len().max(1) as f64;
+                let depth = o.vertices.iter().map(|&p| cam.depth(p)).sum::<f64>() / n;
+                polys.push((depth, part_color(k, j), o.vertices));
             }
         }
         polys.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -366,7 +364,7 @@ pub fn detection_png(
             }
         }
     }
-    let mut by_color: BTreeMap<[u8; 3], Vec<((f32, f32), (f32, f32))>> = BTreeMap::new();
+    let mut by_color: BTreeMap<[u8; 3], Vec<(Px, Px)>> = BTreeMap::new();
     for s in simplices.iter().filter(|s| s.len() == 2) {
         let c = colors[s[0] as usize].unwrap_or(BACKGROUND_LIGHT);
         by_color
@@ -496,8 +494,8 @@ mod tests {
             r[2] * u[0] - r[0] * u[2],
             r[0] * u[1] - r[1] * u[0],
         ];
-        for k in 0..3 {
-            assert!((x[k] - cam.back[k]).abs() < 1e-12);
+        for (a, b) in x.iter().zip(cam.back) {
+            assert!((a - b).abs() < 1e-12);
         }
         // z up on screen: a higher point is higher in the image (smaller y).
         assert!(cam.project([0.0, 0.0, 1.0]).1 < cam.project([0.0, 0.0, 0.0]).1);

@@ -159,8 +159,11 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
+/// A plane `[a, b, c, d]`, a segment, and an outline's vertices.
+type Geometry = (Option<[f64; 4]>, Option<[[f64; 3]; 2]>, Vec<[f64; 3]>);
+
 /// Plane, segment and outline of an older report's `primitive` object.
-fn from_primitive(p: &Value) -> (Option<[f64; 4]>, Option<[[f64; 3]; 2]>, Vec<[f64; 3]>) {
+fn from_primitive(p: &Value) -> Geometry {
     let c = vec3(&p["centroid"]);
     match (p["type"].as_str(), c) {
         (Some("plane"), Some(c)) => {
@@ -325,21 +328,24 @@ fn hull_2d(pts: &[[f64; 2]]) -> Vec<usize> {
     h
 }
 
+/// The outline of a part computed from its points.
+pub(crate) struct Outline {
+    /// Polygon (closed) or segment (open) vertices.
+    pub vertices: Vec<[f64; 3]>,
+    closed: bool,
+    plane: Option<[f64; 4]>,
+    segment: Option<[[f64; 3]; 2]>,
+    rms: f64,
+}
+
 /// Outline of a set of points from their own fit: the convex hull of
 /// their projection on the least-squares plane, or the extreme
 /// projections on the least-squares line.
-#[allow(clippy::type_complexity)]
 pub(crate) fn outline_of_points(
     points: &[[f64; 3]],
     members: &[u32],
     linear: bool,
-) -> Option<(
-    Vec<[f64; 3]>,
-    bool,
-    Option<[f64; 4]>,
-    Option<[[f64; 3]; 2]>,
-    f64,
-)> {
+) -> Option<Outline> {
     if linear {
         let f = fit_line_indices(points, members).ok()?;
         let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
@@ -360,7 +366,13 @@ pub(crate) fn outline_of_points(
             add(f.centroid, f.direction, lo),
             add(f.centroid, f.direction, hi),
         ];
-        Some((seg.to_vec(), false, None, Some(seg), f.rms_residual))
+        Some(Outline {
+            vertices: seg.to_vec(),
+            closed: false,
+            plane: None,
+            segment: Some(seg),
+            rms: f.rms_residual,
+        })
     } else {
         let f = fit_plane_indices(points, members).ok()?;
         let [u, v] = f.axes;
@@ -374,18 +386,17 @@ pub(crate) fn outline_of_points(
             })
             .collect();
         let hull = hull_2d(&flat);
-        let poly: Vec<[f64; 3]> = hull
-            .iter()
-            .map(|&k| add(add(c, u, flat[k][0]), v, flat[k][1]))
-            .collect();
         let n = f.normal;
-        Some((
-            poly,
-            true,
-            Some([n[0], n[1], n[2], -dot(n, c)]),
-            None,
-            f.rms_residual,
-        ))
+        Some(Outline {
+            vertices: hull
+                .iter()
+                .map(|&k| add(add(c, u, flat[k][0]), v, flat[k][1]))
+                .collect(),
+            closed: true,
+            plane: Some([n[0], n[1], n[2], -dot(n, c)]),
+            segment: None,
+            rms: f.rms_residual,
+        })
     }
 }
 
@@ -637,15 +648,13 @@ pub fn html(input: &ViewInput<'_>) -> Result<String, CliError> {
             }
             let pts: Option<&Vec<u32>> = own.or(if n_parts == 1 { Some(members) } else { None });
             if let Some(pts) = pts.filter(|p| p.len() >= 2) {
-                if let Some((poly, closed, plane, seg, rms)) =
-                    outline_of_points(input.points, pts, linear)
-                {
-                    part.outline = poly;
-                    part.closed = closed;
+                if let Some(o) = outline_of_points(input.points, pts, linear) {
+                    part.outline = o.vertices;
+                    part.closed = o.closed;
                     part.outline_source = "points";
-                    part.plane = part.plane.or(plane);
-                    part.segment = part.segment.or(seg);
-                    part.rms = part.rms.or(Some(rms));
+                    part.plane = part.plane.or(o.plane);
+                    part.segment = part.segment.or(o.segment);
+                    part.rms = part.rms.or(Some(o.rms));
                     if part.points.is_none() {
                         part.points = Some(pts.len() as u64);
                     }
@@ -653,17 +662,15 @@ pub fn html(input: &ViewInput<'_>) -> Result<String, CliError> {
             }
         }
         if s.parts.is_empty() && members.len() >= 3 {
-            if let Some((poly, closed, plane, seg, rms)) =
-                outline_of_points(input.points, members, linear)
-            {
+            if let Some(o) = outline_of_points(input.points, members, linear) {
                 s.parts.push(PartView {
                     id: None,
                     points: Some(members.len() as u64),
-                    rms: Some(rms),
-                    plane,
-                    segment: seg,
-                    outline: poly,
-                    closed,
+                    rms: Some(o.rms),
+                    plane: o.plane,
+                    segment: o.segment,
+                    outline: o.vertices,
+                    closed: o.closed,
                     outline_source: "points",
                 });
             }
