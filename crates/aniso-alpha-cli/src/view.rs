@@ -1025,7 +1025,7 @@ font:13px/1.4 system-ui,sans-serif;overflow:hidden}\
 #gl{position:absolute;left:0;top:0;width:calc(100% - 340px);height:100%;cursor:grab;display:block}\
 #panel{position:absolute;right:0;top:0;width:340px;height:100%;box-sizing:border-box;padding:10px 12px;\
 overflow-y:auto;background:#1e2228;border-left:1px solid #333}\
-h1{font-size:15px;margin:0 0 6px;word-break:break-all}\
+h1{font-size:15px;margin:0 0 6px;overflow-wrap:anywhere}\
 p{margin:4px 0}.help,.params{color:#8a939e;font-size:12px}\
 .ctl{margin:6px 0}.ctl label{margin-right:10px}\
 #legend{list-style:none;padding:0;margin:8px 0}\
@@ -1088,7 +1088,7 @@ pub const VIEWER_JS: &str = r##""use strict";
   var state = { bg: true, outl: true, size: 4, hl: -1 };
   var cam = {};
   function reset() {
-    cam.yaw = -Math.PI / 3; cam.pitch = 0.45; cam.dist = 2.6 * M.focus.radius; cam.t = M.focus.center.slice();
+    cam.yaw = -Math.PI / 3; cam.pitch = 0.45; cam.dist = 2.2 * M.focus.radius; cam.t = M.focus.center.slice();
   }
   reset();
   function mul(a, b) {
