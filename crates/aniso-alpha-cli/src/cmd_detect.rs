@@ -265,14 +265,7 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
         }
     }
     if let Some(p) = &args.png {
-        crate::picture::write_detection_png(
-            p,
-            &points,
-            &det.labels,
-            &part_labels,
-            &det.simplices,
-            timings,
-        )?;
+        crate::picture::write_detection_png(p, &points, &det, &part_labels, timings)?;
     }
     let mut out = summary(&name, &det, &params, seconds);
     if let Some(ev) = &scores {

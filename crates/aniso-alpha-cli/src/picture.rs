@@ -294,6 +294,7 @@ pub fn detection_png(
     labels: &[i64],
     parts: Option<&[i64]>,
     simplices: &[Vec<u32>],
+    outlines: &BTreeMap<(usize, usize), Vec<[f64; 3]>>,
 ) -> Result<Vec<u8>, CliError> {
     let (colors, members) = point_colors(labels, parts);
     // Framed on the structures (with room around them), or on everything.
@@ -324,10 +325,14 @@ pub fn detection_png(
             if m.len() < 3 {
                 continue;
             }
-            if let Some(o) = crate::view::outline_of_points(points, m, false) {
-                let n = o.vertices.len().max(1) as f64;
-                let depth = o.vertices.iter().map(|&p| cam.depth(p)).sum::<f64>() / n;
-                polys.push((depth, part_color(k, j), o.vertices));
+            // The detection's own outline, else the hull of the points.
+            let given = outlines.get(&(k, j)).filter(|o| o.len() >= 3).cloned();
+            let outline = given
+                .or_else(|| crate::view::outline_of_points(points, m, false).map(|o| o.vertices));
+            if let Some(vertices) = outline {
+                let n = vertices.len().max(1) as f64;
+                let depth = vertices.iter().map(|&p| cam.depth(p)).sum::<f64>() / n;
+                polys.push((depth, part_color(k, j), vertices));
             }
         }
         polys.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -384,17 +389,26 @@ pub fn detection_png(
     encode(&pm)
 }
 
-/// [`detection_png`] written to `path` (atomically, phase `write`).
+/// [`detection_png`] of a detection written to `path` (atomically, phase
+/// `write`): planar parts outlined by the detection's own outlines (the
+/// boundary of each part's 2D α-shape), where it has them.
 pub fn write_detection_png(
     path: &std::path::Path,
     points: &[[f64; 3]],
-    labels: &[i64],
+    det: &aniso_alpha::detect::detector::Detection,
     parts: &[i64],
-    simplices: &[Vec<u32>],
     timings: &mut crate::common::Timings,
 ) -> Result<(), CliError> {
+    let mut outlines = BTreeMap::new();
+    for s in &det.structures {
+        for (j, p) in s.parts.iter().enumerate() {
+            if p.plane().is_some() && p.outline.len() >= 3 {
+                outlines.insert((s.id as usize, j), p.outline.clone());
+            }
+        }
+    }
     let png = timings.phase("picture", || {
-        detection_png(points, labels, Some(parts), simplices)
+        detection_png(points, &det.labels, Some(parts), &det.simplices, &outlines)
     })?;
     crate::common::write_output(path, timings, |w| w.write_all(&png))
 }
@@ -514,8 +528,8 @@ mod tests {
             .map(|i| if i < 100 { 0 } else { -1 })
             .collect();
         let simplices: Vec<Vec<u32>> = vec![vec![0, 1, 10], vec![1, 11, 10], vec![2, 3]];
-        let a = detection_png(&pts, &labels, None, &simplices).unwrap();
-        let b = detection_png(&pts, &labels, None, &simplices).unwrap();
+        let a = detection_png(&pts, &labels, None, &simplices, &BTreeMap::new()).unwrap();
+        let b = detection_png(&pts, &labels, None, &simplices, &BTreeMap::new()).unwrap();
         assert_eq!(a, b);
         let pm = Pixmap::decode_png(&a).unwrap();
         assert_eq!((pm.width(), pm.height()), (WIDTH, HEIGHT));
