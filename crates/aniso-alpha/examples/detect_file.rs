@@ -28,12 +28,8 @@ pub fn detect_file(
     } else {
         Detector::planes(1.0, 4.0, 8.0, 20) // alpha, lambda2, lambda3, nb_c
     };
-    // The orientations are scanned on rayon's threads: run in a pool of
-    // our own to choose how many.
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()?;
-    let detection = pool.install(|| detector.run(&cloud.points))?;
+    // The orientations are scanned in parallel, on this many threads.
+    let detection = detector.threads(threads).run(&cloud.points)?;
     write_labels(labels, &detection.labels)?;
     Ok(detection)
 }
