@@ -73,15 +73,24 @@ pub struct AlphaArgs {
     #[arg(long, value_name = "OUT.png", requires = "which_alpha")]
     pub png: Option<PathBuf>,
     #[command(flatten)]
+    pub input_format: crate::FormatArgs,
+    #[command(flatten)]
     pub common: crate::CommonArgs,
 }
 
 /// Runs `alpha`.
 pub fn run(args: &AlphaArgs, timings: &mut Timings) -> Result<(), CliError> {
-    common::check_outputs([args.intervals.as_deref(), args.png.as_deref()])?;
     if let Some(out) = &args.output {
-        common::check_mesh_output(out)?;
+        common::mesh_format(out)?;
     }
+    common::check_io(
+        &[&args.input],
+        &[
+            ("--intervals", args.intervals.as_deref()),
+            ("--output", args.output.as_deref()),
+            ("--png", args.png.as_deref()),
+        ],
+    )?;
     let cloud = common::read_input(&args.input, &ReadOptions::default(), timings)?;
     let e = args.elongation.unwrap_or([1.0, 1.0, 1.0]);
     let [theta, psi, phi] = args.euler.unwrap_or([0.0, 0.0, 0.0]);
@@ -158,10 +167,9 @@ pub fn run(args: &AlphaArgs, timings: &mut Timings) -> Result<(), CliError> {
     };
     if let Some(path) = &args.output {
         let mesh = Mesh {
-            points: &cloud.points,
-            labels: None,
             edges: &edges,
             faces: &faces,
+            ..Mesh::new(&cloud.points)
         };
         common::write_mesh(path, &mesh, timings)?;
     }

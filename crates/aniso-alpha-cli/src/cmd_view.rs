@@ -45,6 +45,8 @@ pub struct ViewArgs {
     #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_POINTS)]
     pub max_points: usize,
     #[command(flatten)]
+    pub input_format: crate::FormatArgs,
+    #[command(flatten)]
     pub common: QuietArgs,
 }
 
@@ -61,7 +63,14 @@ fn read_labels(path: &Path, n: usize, timings: &mut Timings) -> Result<Vec<i64>,
 
 /// Runs `view`.
 pub fn run(args: &ViewArgs, timings: &mut Timings) -> Result<(), CliError> {
-    common::check_output(&args.output)?;
+    let mut inputs: Vec<&Path> = vec![&args.input];
+    inputs.extend(
+        [&args.labels, &args.part_labels, &args.report]
+            .into_iter()
+            .flatten()
+            .map(PathBuf::as_path),
+    );
+    common::check_io(&inputs, &[("--output", Some(&args.output))])?;
     if args.max_points == 0 {
         return Err(CliError::msg("--max-points must be at least 1"));
     }

@@ -28,7 +28,8 @@ use common::{CliError, Timings};
 #[derive(Debug, Parser)]
 #[command(name = "aniso-alpha", version, propagate_version = true)]
 #[command(
-    after_help = "Point files: .xyz .txt .csv .pts (text), .ply, .las/.laz, .pcd.\n\
+    after_help = "Point files: .xyz .txt .csv .pts (text), .ply, .las/.laz, .pcd; `-` reads text from \
+standard input; --format overrides the extension.\n\
 Alpha is a radius throughout (CGAL's Alpha_shape_3 takes its square). The method: docs/method.md.\n\
 Errors exit with status 1 and one line on stderr; bad usage exits with 2.\n\n\
 Example:\n  aniso-alpha synth planes --seed 1 --output scene.xyz\n  \
@@ -71,6 +72,16 @@ pub struct QuietArgs {
     pub timings: bool,
 }
 
+/// The input format option of the subcommands that read a point file.
+#[derive(Debug, Clone, Copy, Args)]
+#[command(next_help_heading = "Common options")]
+pub struct FormatArgs {
+    /// Input format, overriding the extension: xyz, ply, las, laz, pcd
+    /// (an INPUT of `-` is standard input, text unless --format says otherwise)
+    #[arg(long, value_name = "FMT", value_parser = common::parse_format)]
+    pub format: Option<aniso_alpha::io::Format>,
+}
+
 impl From<QuietArgs> for CommonArgs {
     fn from(q: QuietArgs) -> Self {
         CommonArgs {
@@ -99,6 +110,18 @@ enum Command {
 }
 
 impl Command {
+    /// `--format`, for the subcommands that read a point file.
+    fn format(&self) -> Option<aniso_alpha::io::Format> {
+        match self {
+            Command::Delaunay(a) => a.input_format.format,
+            Command::Alpha(a) => a.input_format.format,
+            Command::Detect(a) => a.input_format.format,
+            Command::Eval(a) => a.input_format.format,
+            Command::View(a) => a.input_format.format,
+            Command::Synth(_) => None,
+        }
+    }
+
     fn common(&self) -> CommonArgs {
         match self {
             Command::Delaunay(a) => a.common,
@@ -139,6 +162,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
     let global = cli.command.common();
     common::set_quiet(global.quiet || global.timings);
     common::set_silent(global.quiet);
+    common::set_format(cli.command.format());
     if let Some(n) = global.threads {
         rayon::ThreadPoolBuilder::new()
             .num_threads(n.get())
@@ -162,6 +186,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
 
 fn main() -> ExitCode {
     install_panic_hook();
+    common::install_signal_cleanup();
     let cli = Cli::parse();
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,

@@ -54,7 +54,7 @@ pub struct ViewInput<'a> {
     /// `detect --part-labels` writes them).
     pub parts: Option<&'a [i64]>,
     /// A `detect --report` JSON: both the current schema (parts with
-    /// `plane`/`polygon` or `segment`, structure `rms`/`nfa`) and the older
+    /// `plane`/`polygon` or `segment`, `rms`, `log10_nfa` or `nfa`) and the older
     /// one (a `primitive` object per structure and part) are read.
     pub report: Option<&'a Value>,
     /// Cap on the points drawn.
@@ -105,6 +105,7 @@ struct PartView {
     id: Option<i64>,
     points: Option<u64>,
     rms: Option<f64>,
+    log10_nfa: Option<f64>,
     plane: Option<[f64; 4]>,
     segment: Option<[[f64; 3]; 2]>,
     /// Closed polygon (planes) or open polyline (a segment): vertices.
@@ -120,7 +121,8 @@ struct StructureView {
     kind: Kind,
     points: Option<u64>,
     rms: Option<f64>,
-    nfa: Option<f64>,
+    /// log₁₀ of the number of false alarms.
+    log10_nfa: Option<f64>,
     plane: Option<[f64; 4]>,
     segment: Option<[[f64; 3]; 2]>,
     parts: Vec<PartView>,
@@ -208,6 +210,7 @@ fn part_from_report(p: &Value, running_id: i64) -> PartView {
         id: Some(p["id"].as_i64().unwrap_or(running_id)),
         points: p["points"].as_u64(),
         rms: f64_of(&p["rms"]),
+        log10_nfa: log10_nfa(p),
         plane: vec4(&p["plane"]),
         segment: None,
         outline: Vec::new(),
@@ -283,7 +286,7 @@ fn structures_from_report(report: &Value) -> Vec<StructureView> {
             kind: Kind::parse(s["kind"].as_str().unwrap_or("")),
             points: s["points"].as_u64(),
             rms: f64_of(&s["rms"]).or_else(|| f64_of(&prim["rms_residual"])),
-            nfa: f64_of(&s["nfa"]),
+            log10_nfa: log10_nfa(s),
             plane,
             segment,
             parts,
@@ -466,6 +469,21 @@ fn fmt_plane(p: [f64; 4]) -> String {
     s
 }
 
+/// A number of false alarms from its log₁₀.
+fn fmt_nfa(log10: f64) -> String {
+    let x = 10f64.powf(log10);
+    if x > 0.0 && x.is_finite() {
+        format!("{x:.2e}")
+    } else {
+        format!("10^{log10:.1}")
+    }
+}
+
+/// `log10_nfa` of a report's structure or part (or `nfa`, older).
+fn log10_nfa(v: &Value) -> Option<f64> {
+    f64_of(&v["log10_nfa"]).or_else(|| f64_of(&v["nfa"]).filter(|x| *x > 0.0).map(f64::log10))
+}
+
 fn fmt_point(p: [f64; 3]) -> String {
     format!("({}, {}, {})", fmt_num(p[0]), fmt_num(p[1]), fmt_num(p[2]))
 }
@@ -559,7 +577,7 @@ pub fn html(input: &ViewInput<'_>) -> Result<String, CliError> {
                     kind: Kind::Unknown,
                     points: None,
                     rms: None,
-                    nfa: None,
+                    log10_nfa: None,
                     plane: None,
                     segment: None,
                     parts: Vec::new(),
@@ -667,6 +685,7 @@ pub fn html(input: &ViewInput<'_>) -> Result<String, CliError> {
                     id: None,
                     points: Some(members.len() as u64),
                     rms: Some(o.rms),
+                    log10_nfa: None,
                     plane: o.plane,
                     segment: o.segment,
                     outline: o.vertices,
@@ -855,8 +874,8 @@ pub fn html(input: &ViewInput<'_>) -> Result<String, CliError> {
         if let Some(r) = s.rms {
             let _ = write!(line, " · rms {}", fmt_num(r));
         }
-        if let Some(x) = s.nfa {
-            let _ = write!(line, " · NFA {x:.2e}");
+        if let Some(x) = s.log10_nfa {
+            let _ = write!(line, " · NFA {}", fmt_nfa(x));
         }
         let _ = write!(
             legend,
@@ -901,6 +920,9 @@ pub fn html(input: &ViewInput<'_>) -> Result<String, CliError> {
                 if let Some(r) = p.rms {
                     let _ = write!(t, " · rms {}", fmt_num(r));
                 }
+                if let Some(x) = p.log10_nfa {
+                    let _ = write!(t, " · NFA {}", fmt_nfa(x));
+                }
                 let eq = match (p.plane, p.segment) {
                     (Some(pl), _) => fmt_plane(pl),
                     (None, Some(g)) => fmt_segment(g),
@@ -942,11 +964,21 @@ pub fn html(input: &ViewInput<'_>) -> Result<String, CliError> {
             let mut s = String::new();
             if let Some(o) = p.as_object() {
                 for (key, v) in o {
+                    // `{"value", "estimated", "reason"}` objects, or plain values.
+                    let (v, estimated) = match v.get("value") {
+                        Some(x) => (x, v["estimated"].as_bool() == Some(true)),
+                        None => (v, false),
+                    };
                     if v.is_object() || v.is_array() || v.is_null() {
                         continue;
                     }
-                    let v = v.as_str().map_or_else(|| v.to_string(), str::to_string);
-                    let _ = write!(s, "{key} {v}, ");
+                    let v = match (v.as_str(), v.as_f64()) {
+                        (Some(t), _) => t.to_string(),
+                        (None, Some(x)) => fmt_num(x),
+                        _ => v.to_string(),
+                    };
+                    let est = if estimated { " (estimated)" } else { "" };
+                    let _ = write!(s, "{key} {v}{est}, ");
                 }
             }
             format!(

@@ -46,4 +46,6 @@ pub mod detect;
 pub mod eval;
 pub mod geometry;
 pub mod io;
+#[cfg(feature = "json")]
+pub mod report;
 pub mod synth;

@@ -85,7 +85,8 @@
 //! costs precision; recall is 1.0 (or one point short) in all these runs.
 //!
 //! ```
-//! use aniso_alpha::synth::{SceneOptions, write_xyz_labels};
+//! use aniso_alpha::synth::SceneOptions;
+//! use aniso_alpha::io::write_xyz_labels;
 //! let scene = SceneOptions::lines().seed(3).generate().unwrap();
 //! assert_eq!(scene.points.len(), 1550);
 //! assert_eq!(scene.labels.iter().filter(|&&l| l >= 0).count(), 50);
@@ -96,7 +97,6 @@
 use crate::aniso::{cross, dot, normalize};
 use std::f64::consts::PI;
 use std::fmt;
-use std::io::{self, Write};
 
 /// A point set with ground truth.
 #[derive(Debug, Clone, PartialEq)]
@@ -714,25 +714,6 @@ fn apply(r: &[[f64; 3]; 3], p: [f64; 3]) -> [f64; 3] {
         o[k] = p[0] * r[0][k] + p[1] * r[1][k] + p[2] * r[2][k];
     }
     o
-}
-
-/// Writes one line `x y z label` per point (shortest round-trip decimal
-/// form of each coordinate), after a `#` comment line naming the columns.
-pub fn write_xyz_labels(scene: &Scene, out: &mut impl Write) -> io::Result<()> {
-    writeln!(out, "# x y z label")?;
-    for (p, l) in scene.points.iter().zip(&scene.labels) {
-        writeln!(out, "{} {} {} {}", p[0], p[1], p[2], l)?;
-    }
-    Ok(())
-}
-
-/// Writes one line `x y z label part` per point (see [`write_xyz_labels`]).
-pub fn write_xyz_labels_parts(scene: &Scene, out: &mut impl Write) -> io::Result<()> {
-    writeln!(out, "# x y z label part")?;
-    for ((p, l), q) in scene.points.iter().zip(&scene.labels).zip(&scene.parts) {
-        writeln!(out, "{} {} {} {} {}", p[0], p[1], p[2], l, q)?;
-    }
-    Ok(())
 }
 
 /// The lines scene of Fig. 12 ([`SceneOptions::lines`]) with `seed`.

@@ -16,8 +16,7 @@
 //!    falls in the footprint claims the candidate (the α-shape's simplices
 //!    reach the structure's points; points of a noisy structure that no
 //!    simplex touched are recovered here). A point claimed by several
-//!    candidates goes to the one it is nearest to, relative to τ: parts are
-//!    disjoint. Candidates that are one plane (normals within the part
+//!    candidates goes to the one it is nearest to: parts are disjoint. Candidates that are one plane (normals within the part
 //!    angle, each centroid within τ of the other's plane) or one line and
 //!    that share claimed points are merged first, so a plane is never
 //!    reported twice. Members are refitted once and claimed again.
@@ -536,11 +535,11 @@ pub(crate) fn assemble<S: Face>(
     // again.
     let mut stamp = Stamps::new(n);
     let claims_of = |cands: &[Cand], stamp: &mut Stamps| -> Vec<(u32, u32, f64)> {
-        // (point, candidate, distance / τ)
+        // (point, candidate, distance)
         let mut claims = Vec::new();
         for (ci, c) in cands.iter().enumerate() {
             for_near(c, c.tau, points, &index, stamp, &mut |i, d| {
-                claims.push((i, ci as u32, d / c.tau));
+                claims.push((i, ci as u32, d));
             });
         }
         claims.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.cmp(&b.1)));

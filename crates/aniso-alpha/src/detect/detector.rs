@@ -50,9 +50,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 /// A 3×3 matrix as rows.
 pub type Mat3 = crate::aniso::Mat3;
 
-/// Largest number of orientations a run may scan (the paper's box sampler
-/// for planes has 1,944; a finer one, m1 = 0.1 and m2 = 36, about 44k).
-pub const MAX_ORIENTATIONS: usize = 100_000;
+pub use super::orientations::MAX_ORIENTATIONS;
 
 /// Range of λ accepted: beyond it the transformed coordinates leave the
 /// range where the arithmetic is exact for the inputs allowed.

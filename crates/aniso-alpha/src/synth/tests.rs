@@ -5,6 +5,7 @@ use crate::aniso::Anisotropy;
 use crate::detect::fit::{fit_line, fit_plane};
 use crate::detect::orientations::{orientations, Sampler};
 use crate::detect::StructureKind;
+use crate::io::{write_xyz_labels, write_xyz_labels_parts};
 
 fn members(scene: &Scene, label: i64) -> Vec<[f64; 3]> {
     scene
