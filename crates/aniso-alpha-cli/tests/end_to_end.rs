@@ -314,13 +314,15 @@ fn synth_detect_eval_chain() {
         serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     assert_eq!(r["orientations"], 162);
     assert!(r["structures"].as_array().unwrap().len() >= 5);
-    assert_eq!(r["structures"][0]["primitive"]["type"], "line");
-    assert!(r["structures"][0]["primitive"]["rms_residual"]
-        .as_f64()
-        .is_some());
+    // The report of SPEC §7 / docs/method.md §7: a line's part is a segment.
+    assert_eq!(r["structures"][0]["kind"], "line");
+    assert!(r["structures"][0]["rms"].as_f64().is_some());
+    let part = &r["structures"][0]["parts"][0];
+    assert_eq!(part["segment"].as_array().map(Vec::len), Some(2));
+    assert!(part["rms"].as_f64().is_some());
     assert!(r["timings"]["read"].as_f64().is_some());
     assert!(r["timings"]["detect"].as_f64().is_some());
-    assert_eq!(r["parameters"]["min_size"], 4);
+    assert_eq!(r["parameters"]["min_size"]["value"], 4.0);
     let o = ok(&[
         "eval",
         "--truth",
