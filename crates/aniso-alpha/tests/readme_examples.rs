@@ -11,7 +11,7 @@ mod detect_file;
 mod alpha_shape;
 
 use aniso_alpha::alpha::AlphaComplex;
-use aniso_alpha::io::{read_labels, read_points, ReadOptions};
+use aniso_alpha::io::{read_labels, read_points, write_scene, ReadOptions};
 use aniso_alpha::synth;
 
 struct TempDir(std::path::PathBuf);
@@ -33,9 +33,7 @@ impl Drop for TempDir {
 fn lines_scene(dir: &TempDir) -> (std::path::PathBuf, synth::Scene) {
     let input = dir.0.join("lines.xyz");
     let scene = synth::lines(1);
-    let mut text = Vec::new();
-    synth::write_xyz_labels(&scene, &mut text).unwrap();
-    std::fs::write(&input, text).unwrap();
+    write_scene(&input, &scene, false).unwrap();
     (input, scene)
 }
 
