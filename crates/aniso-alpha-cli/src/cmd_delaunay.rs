@@ -22,11 +22,15 @@ pub struct DelaunayArgs {
     /// Output file of tetrahedra
     #[arg(long, value_name = "OUT")]
     pub tets: PathBuf,
+    #[command(flatten)]
+    pub input_format: crate::FormatArgs,
+    #[command(flatten)]
+    pub common: crate::CommonArgs,
 }
 
 /// Runs `delaunay`: input is read (and its errors reported) before anything else.
 pub fn run(args: &DelaunayArgs, timings: &mut Timings) -> Result<(), CliError> {
-    common::check_output(&args.tets)?;
+    common::check_io(&[&args.input], &[("--tets", Some(&args.tets))])?;
     let cloud = common::read_input(&args.input, &ReadOptions::default(), timings)?;
     let bar = common::spinner("triangulating");
     let tri = timings

@@ -1,14 +1,16 @@
-//! `aniso-alpha detect`: structures by anisotropic alpha-shapes (SPEC §4).
+//! `aniso-alpha detect`: structures by anisotropic alpha-shapes (method
+//! doc §4, §7, §8).
 
 use std::path::PathBuf;
-
 use std::time::Instant;
 
-use aniso_alpha::detect::detector::{Detection, Detector, Primitive};
+use aniso_alpha::detect::detector::{Detection, Detector, Given, OrientationSet, Primitive};
 use aniso_alpha::detect::orientations::Sampler;
+use aniso_alpha::detect::StructureKind;
 use aniso_alpha::eval::evaluate;
-use aniso_alpha::io::{Mesh, ReadOptions};
-use aniso_alpha::synth::{write_xyz_labels_parts, SceneOptions};
+use aniso_alpha::io::{write_scene, Mesh, ReadOptions};
+use aniso_alpha::report::detection_json;
+use aniso_alpha::synth::SceneOptions;
 use clap::{Args, ValueEnum};
 use serde_json::json;
 
@@ -26,68 +28,163 @@ pub enum Structure {
 /// Arguments of `detect`.
 #[derive(Debug, Args)]
 #[command(
-    after_help = "Without INPUT, runs on a built-in example scene (a Fig. 10-like polyhedron in \
-uniform background, planes, alpha 1, lambda2 4, lambda3 8, min-size 20) and says where it wrote \
-its results.\n\
---labels writes one integer per input point, one per line: its structure id, or -1.\n\n\
+    after_help = "With INPUT and --structure alone, every parameter is estimated from the data \
+(spacing, noise, the modes of the local normals or directions) and printed with its reason; any of \
+--alpha, --lambda2, --lambda3, --min-size given overrides its estimate. With --alpha, --lambda3 and \
+--min-size all given, the paper's box orientation sampler is used by default (--sampler data for the \
+orientations from the data).\n\
+alpha is a radius (the short semi-axis of the ellipsoid), not CGAL's squared alpha.\n\
+Without INPUT, runs on a built-in example scene (a Fig. 10-like polyhedron in uniform background, \
+planes, alpha 1, lambda2 4, lambda3 8, min-size 20) and says where it wrote its results.\n\
+--labels writes one integer per input point: its structure id, or -1; --part-labels its part \
+(plane or segment) id, or -1. Parts are disjoint.\n\n\
 Examples:\n  aniso-alpha detect\n  \
+aniso-alpha detect scan.ply --structure planes --labels labels.txt --part-labels parts.txt --report report.json\n  \
 aniso-alpha detect scene.xyz --structure lines --alpha 1 --lambda3 10 --min-size 4 --labels labels.txt\n  \
 aniso-alpha detect scan.ply --structure planes --alpha 1 --lambda2 4 --lambda3 8 --min-size 20 \
 --output planes.ply --report report.json --threads 2"
 )]
 pub struct DetectArgs {
     /// Input point file; omit it to run the built-in example
-    #[arg(requires_all = ["structure", "alpha", "lambda3", "min_size"])]
+    #[arg(requires = "structure")]
     pub input: Option<PathBuf>,
     /// Look for lines or planes
     #[arg(long, value_enum)]
     pub structure: Option<Structure>,
-    /// Alpha (ball radius before elongation)
+    /// Alpha: the ellipsoid's short semi-axis, a radius (default: estimated)
     #[arg(long, value_name = "A", value_parser = parse_positive)]
     pub alpha: Option<f64>,
     /// Elongation lambda2 of planes (default: lambda3)
     #[arg(long, value_name = "L2", value_parser = parse_positive)]
     pub lambda2: Option<f64>,
-    /// Elongation lambda3 (the long axis)
+    /// Elongation lambda3, the long axis (default: estimated)
     #[arg(long, value_name = "L3", value_parser = parse_positive)]
     pub lambda3: Option<f64>,
-    /// Minimum size nb_c of a structure (simplices)
+    /// Minimum size nb_c of a piece, in simplices (default: estimated)
     #[arg(long, value_name = "NBC")]
     pub min_size: Option<usize>,
-    /// Orientation sampling step on the box surface
+    /// Orientations: the data's (modes of normals or directions), the
+    /// paper's box, or near-uniform Fibonacci directions (default: data,
+    /// or box when alpha, lambda3 and min-size are all given)
+    #[arg(long, value_enum)]
+    pub sampler: Option<SamplerKind>,
+    /// Box sampler: sampling step on the box surface
     #[arg(long, value_name = "M1", default_value_t = 0.3, value_parser = parse_positive)]
     pub m1: f64,
-    /// Number of rotations theta about the normal (planes)
+    /// Number of rotations theta about the normal (planes, when lambda2 != lambda3)
     #[arg(long, value_name = "M2", default_value_t = 12)]
     pub m2: usize,
+    /// Fibonacci sampler: angular step in degrees
+    #[arg(long, value_name = "DEG", default_value_t = 10.0, value_parser = parse_positive)]
+    pub step: f64,
+    /// Significance: keep parts with at most EPS expected false alarms
+    #[arg(long, value_name = "EPS", default_value_t = 1.0, value_parser = parse_positive)]
+    pub epsilon: f64,
+    /// Keep every part (no significance test: nb_c alone, as the paper)
+    #[arg(long)]
+    pub no_significance: bool,
+    /// Triangulate in tiles of this side (input units) with halos: bounded
+    /// memory, the same result
+    #[arg(long, value_name = "SIZE", value_parser = parse_positive)]
+    pub tile: Option<f64>,
     /// Write one label per input point (structure id or -1)
     #[arg(long, value_name = "OUT.txt")]
     pub labels: Option<PathBuf>,
-    /// Write the detected simplices (PLY, or OBJ by extension)
-    #[arg(long, value_name = "OUT.ply")]
-    pub output: Option<PathBuf>,
-    /// Write a JSON report of the structures
-    #[arg(long, value_name = "OUT.json")]
-    pub report: Option<PathBuf>,
-    /// Write one part (facet) label per input point, or -1
+    /// Write one part (plane or segment) label per input point, or -1
     #[arg(long, value_name = "OUT.txt")]
     pub part_labels: Option<PathBuf>,
-    /// Orientation sampler: the paper's box (default) or near-uniform
-    /// Fibonacci directions with --step degrees
-    #[arg(long, value_enum, default_value_t = SamplerKind::Box)]
-    pub sampler: SamplerKind,
-    /// Angular step (degrees) of the Fibonacci sampler
-    #[arg(long, value_name = "DEG", default_value_t = 10.0, value_parser = parse_positive)]
-    pub step: f64,
+    /// Write the input points with their structure and part ids and one
+    /// clean mesh per part (PLY faces and edges with structure and part
+    /// ids, or OBJ by extension)
+    #[arg(long, value_name = "OUT.ply")]
+    pub output: Option<PathBuf>,
+    /// Write the raw union of the scanned alpha-shapes (debugging; PLY or OBJ)
+    #[arg(long, value_name = "OUT.ply")]
+    pub union: Option<PathBuf>,
+    /// Write a JSON report: parameters (estimated or given, with reasons),
+    /// structures and their parts (planes, outlines, segments, NFA)
+    #[arg(long, value_name = "OUT.json")]
+    pub report: Option<PathBuf>,
+    /// Write an interactive 3D view of the result (one self-contained HTML file)
+    #[arg(long, value_name = "OUT.html")]
+    pub html: Option<PathBuf>,
+    /// Write a picture of the result (PNG, fixed view)
+    #[arg(long, value_name = "OUT.png")]
+    pub png: Option<PathBuf>,
+    #[command(flatten)]
+    pub input_format: crate::FormatArgs,
+    #[command(flatten)]
+    pub common: crate::CommonArgs,
 }
 
 /// The orientation sampler.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum SamplerKind {
+    /// The modes of the data's local normals (planes) or directions (lines)
+    Data,
     /// The paper's box sampler (--m1, --m2)
     Box,
     /// Near-uniform Fibonacci directions (--step)
     Fibonacci,
+}
+
+fn kind_of(s: Structure) -> StructureKind {
+    match s {
+        Structure::Lines => StructureKind::Lines,
+        Structure::Planes => StructureKind::Planes,
+    }
+}
+
+/// Builds the detector: the example's, explicit parameters, or estimated.
+fn detector<'a>(
+    args: &DetectArgs,
+    points: &[[f64; 3]],
+    example: bool,
+) -> Result<Detector<'a>, CliError> {
+    let structure = args.structure.unwrap_or(Structure::Planes);
+    let kind = kind_of(structure);
+    let m2 = u32::try_from(args.m2).map_err(|_| CliError::msg("--m2 is too large"))?;
+    let nb_c = match args.min_size {
+        Some(n) => Some(u32::try_from(n).map_err(|_| CliError::msg("--min-size is too large"))?),
+        None => None,
+    };
+    let box_sampler = Sampler::Box { m1: args.m1, m2 };
+    let fib = Sampler::Fibonacci {
+        step_degrees: args.step,
+    };
+    let explicit = example || (args.alpha.is_some() && args.lambda3.is_some() && nb_c.is_some());
+    let d = if explicit {
+        let alpha = args.alpha.unwrap_or(1.0);
+        let lambda3 = args.lambda3.unwrap_or(8.0);
+        let lambda2 = args.lambda2.unwrap_or(if example { 4.0 } else { lambda3 });
+        let nb_c = nb_c.unwrap_or(20);
+        let d = match kind {
+            StructureKind::Lines => Detector::lines(alpha, lambda3, nb_c),
+            StructureKind::Planes => Detector::planes(alpha, lambda2, lambda3, nb_c),
+        };
+        match args.sampler.unwrap_or(SamplerKind::Box) {
+            SamplerKind::Box => d.sampler(box_sampler),
+            SamplerKind::Fibonacci => d.sampler(fib),
+            SamplerKind::Data => d.data_orientations(points, m2),
+        }
+    } else {
+        let given = Given {
+            alpha: args.alpha,
+            lambda2: args.lambda2,
+            lambda3: args.lambda3,
+            min_size: nb_c,
+        };
+        let d = Detector::auto_with(kind, points, &given, m2)?;
+        match args.sampler.unwrap_or(SamplerKind::Data) {
+            SamplerKind::Data => d,
+            SamplerKind::Box => d.sampler(box_sampler),
+            SamplerKind::Fibonacci => d.sampler(fib),
+        }
+    };
+    Ok(
+        d.significance((!args.no_significance).then_some(args.epsilon))
+            .tile(args.tile),
+    )
 }
 
 /// Runs `detect`.
@@ -102,20 +199,29 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
     let parts_path = pick(&args.part_labels, "parts.txt");
     let output_path = pick(&args.output, "structures.ply");
     let report_path = pick(&args.report, "report.json");
+    let html_path = pick(&args.html, "view.html");
     let scene_path = example.then(|| dir.join("scene.xyz"));
     if example {
         std::fs::create_dir_all(&dir)
             .map_err(|e| CliError::msg(format!("{}: cannot create folder: {e}", dir.display())))?;
     }
-    common::check_outputs([
-        labels_path.as_deref(),
-        parts_path.as_deref(),
-        report_path.as_deref(),
-        scene_path.as_deref(),
-    ])?;
-    if let Some(out) = &output_path {
-        common::check_mesh_output(out)?;
+    for out in [&output_path, &args.union].into_iter().flatten() {
+        common::mesh_format(out)?;
     }
+    let inputs: Vec<&std::path::Path> = args.input.iter().map(|p| p.as_path()).collect();
+    common::check_io(
+        &inputs,
+        &[
+            ("--labels", labels_path.as_deref()),
+            ("--part-labels", parts_path.as_deref()),
+            ("--output", output_path.as_deref()),
+            ("--union", args.union.as_deref()),
+            ("--report", report_path.as_deref()),
+            ("(scene)", scene_path.as_deref()),
+            ("--html", html_path.as_deref()),
+            ("--png", args.png.as_deref()),
+        ],
+    )?;
     let (points, truth, name) = match &args.input {
         Some(input) => {
             let cloud = common::read_input(input, &ReadOptions::default(), timings)?;
@@ -124,49 +230,34 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
         None => {
             let scene = timings.phase("synth", || SceneOptions::polyhedron().seed(1).generate())?;
             if let Some(p) = &scene_path {
-                common::write_output(p, timings, |w| {
-                    let mut w = std::io::BufWriter::new(w);
-                    write_xyz_labels_parts(&scene, &mut w)?;
-                    std::io::Write::flush(&mut w)
-                })?;
+                timings.phase("write", || write_scene(p, &scene, true))?;
             }
             let name = "built-in example (Fig. 10-like polyhedron in background)".to_string();
             (scene.points.clone(), Some(scene), name)
         }
     };
-    let structure = args.structure.unwrap_or(Structure::Planes);
-    let alpha = args.alpha.unwrap_or(1.0);
-    let lambda3 = args.lambda3.unwrap_or(8.0);
-    let lambda2 = args.lambda2.unwrap_or(if example { 4.0 } else { lambda3 });
-    let nb_c = args.min_size.unwrap_or(20);
-    let nb_c = u32::try_from(nb_c).map_err(|_| CliError::msg("--min-size is too large"))?;
-    let sampler = match args.sampler {
-        SamplerKind::Box => Sampler::Box {
-            m1: args.m1,
-            m2: u32::try_from(args.m2).map_err(|_| CliError::msg("--m2 is too large"))?,
-        },
-        SamplerKind::Fibonacci => Sampler::Fibonacci {
-            step_degrees: args.step,
-        },
+    let in_file = |e: aniso_alpha::detect::detector::DetectError| match &args.input {
+        Some(p) => CliError::in_file(p, e),
+        None => CliError::msg(e.to_string()),
     };
-    let detector = match structure {
-        Structure::Lines => Detector::lines(alpha, lambda3, nb_c),
-        Structure::Planes => Detector::planes(alpha, lambda2, lambda3, nb_c),
-    }
-    .sampler(sampler);
-    let n_orient = detector.orientation_set()?.len();
+    let start = Instant::now();
+    let detector = timings.phase("estimate", || detector(args, &points, example))?;
+    let n_orient = detector.orientation_count().map_err(|e| {
+        let flags = match args.sampler {
+            Some(SamplerKind::Fibonacci) => format!("--step {}", args.step),
+            _ => format!("--m1 {} --m2 {}", args.m1, args.m2),
+        };
+        CliError::msg(format!("{flags}: {e}"))
+    })?;
+    warn_if_huge(points.len(), n_orient);
     let bar = common::progress(n_orient as u64, "orientations");
     let tick = |done: usize, _total: usize| {
         bar.set_position(done as u64);
         true
     };
-    let start = Instant::now();
     let det = timings
         .phase("detect", || detector.clone().progress(&tick).run(&points))
-        .map_err(|e| match &args.input {
-            Some(p) => CliError::in_file(p, e),
-            None => CliError::msg(e.to_string()),
-        })?;
+        .map_err(in_file)?;
     let seconds = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
 
@@ -178,28 +269,27 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
         common::write_output(p, timings, |w| write_ints(w, &part_labels))?;
     }
     if let Some(p) = &output_path {
-        let (edges, faces) = split_simplices(&det);
+        let (edges, faces, element_labels) = part_meshes(&det, &points);
         let mesh = Mesh {
-            points: &points,
             labels: Some(&det.labels),
+            parts: Some(&part_labels),
             edges: &edges,
             faces: &faces,
+            element_labels: &element_labels,
+            ..Mesh::new(&points)
         };
         common::write_mesh(p, &mesh, timings)?;
     }
-    let params = json!({
-        "structure": match structure { Structure::Lines => "lines", Structure::Planes => "planes" },
-        "k": det.kind.k(),
-        "alpha": alpha,
-        "lambda2": if structure == Structure::Planes { Some(lambda2) } else { None },
-        "lambda3": lambda3,
-        "min_size": nb_c,
-        "sampler": match sampler {
-            Sampler::Box { m1, m2 } => json!({"kind": "box", "m1": m1, "m2": m2}),
-            Sampler::Fibonacci { step_degrees } => json!({"kind": "fibonacci", "step_degrees": step_degrees}),
-        },
-        "elongation": detector.elongation(),
-    });
+    if let Some(p) = &args.union {
+        let (edges, faces) = split_simplices(&det);
+        let mesh = Mesh {
+            labels: Some(&det.labels),
+            edges: &edges,
+            faces: &faces,
+            ..Mesh::new(&points)
+        };
+        common::write_mesh(p, &mesh, timings)?;
+    }
     let scores = truth.as_ref().and_then(|scene| {
         evaluate(
             &scene.labels,
@@ -209,47 +299,74 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
         )
         .ok()
     });
-    if let Some(p) = &report_path {
-        let mut report = json!({
-            "input": name,
-            "points": points.len(),
-            "parameters": params,
-            "orientations": det.stats.orientations,
-            "stats": {
-                "triangulated_points": det.stats.triangulated_points,
-                "raw_simplices": det.stats.raw_simplices,
-                "filtered_simplices": det.stats.filtered_simplices,
-                "union_simplices": det.stats.union_simplices,
-                "kept_simplices": det.stats.kept_simplices,
-                "structure_simplices": det.stats.structure_simplices,
-            },
-            "structures": det.structures.iter().map(structure_json).collect::<Vec<_>>(),
-            "background_points": det.labels.iter().filter(|&&l| l < 0).count(),
-            "seconds": seconds,
-        });
-        // Wall seconds of the phases so far (the report itself is the last
-        // output written).
-        report["timings"] = timings.to_value();
+    let report = {
+        let mut r = json!({"input": name});
+        if let (Some(o), serde_json::Value::Object(rest)) =
+            (r.as_object_mut(), detection_json(&det, &detector))
+        {
+            o.extend(rest);
+        }
+        r["seconds"] = json!(seconds);
         if let Some(ev) = &scores {
-            report["scores"] = json!({
+            r["scores"] = json!({
                 "precision": ev.precision, "recall": ev.recall, "f1": ev.f1,
                 "structures_found": ev.structures_found, "structures_total": ev.structures_total,
                 "parts_found": ev.parts_found, "parts_total": ev.parts_total,
             });
         }
-        common::write_json(p, &report, timings)?;
+        r
+    };
+    if let Some(p) = &report_path {
+        let mut r = report.clone();
+        // Wall seconds of the phases so far (the report itself is the last
+        // output written).
+        r["timings"] = timings.to_value();
+        common::write_json(p, &r, timings)?;
     }
-    let mut out = summary(&name, &det, &params, seconds);
+    if let Some(p) = &html_path {
+        crate::view::write_html(
+            p,
+            &name,
+            &points,
+            &det.labels,
+            &part_labels,
+            &report,
+            timings,
+        )?;
+    }
+    if let Some(p) = &args.png {
+        crate::picture::write_detection_png(p, &points, &det, &part_labels, timings)?;
+    }
+    let mut out = summary(&name, &det, &detector, &report, seconds);
     if let Some(ev) = &scores {
         out.push_str(&format!("\nAgainst the scene's ground truth:\n{ev}\n"));
     }
     if example {
         out.push_str(&format!(
-            "\nWrote {}: scene.xyz (x y z label part), labels.txt, parts.txt, structures.ply, report.json\n",
+            "\nWrote {}: scene.xyz (x y z label part), labels.txt, parts.txt, structures.ply, report.json, view.html\n",
             dir.display()
         ));
     }
-    common::print_stdout(&out)
+    common::print_summary(&out)
+}
+
+/// Point insertions above which a run is announced as long: at roughly a
+/// microsecond each, about half an hour of one core.
+const HUGE_RUN: f64 = 2e9;
+
+/// Says so before starting when `points × orientations` triangulation
+/// work is huge (issue 19: `--m2 100000` showed an 8-hour progress bar).
+fn warn_if_huge(points: usize, orientations: usize) {
+    let work = points as f64 * orientations as f64;
+    if work > HUGE_RUN {
+        let threads = rayon::current_num_threads().max(1) as f64;
+        let hours = work * 1e-6 / threads / 3600.0;
+        common::warn(format_args!(
+            "a large run: {points} points × {orientations} orientations = {work:.2e} point \
+             insertions, very roughly {hours:.1} hour(s) on {threads} thread(s); fewer orientations \
+             (--m1, --m2, --step) or fewer points make it shorter"
+        ));
+    }
 }
 
 fn write_ints(w: &mut dyn std::io::Write, values: &[i64]) -> std::io::Result<()> {
@@ -274,88 +391,143 @@ fn split_simplices(det: &Detection) -> (Vec<[u32; 2]>, Vec<[u32; 3]>) {
     (edges, faces)
 }
 
-fn primitive_json(p: &Primitive) -> serde_json::Value {
-    match p {
-        Primitive::Line(f) => json!({
-            "type": "line", "centroid": f.centroid, "direction": f.direction,
-            "rms_residual": f.rms_residual, "extent": f.extent,
-        }),
-        Primitive::Plane(f) => json!({
-            "type": "plane", "centroid": f.centroid, "normal": f.normal, "axes": f.axes,
-            "rms_residual": f.rms_residual, "extent": f.extent,
-        }),
-        Primitive::None => json!(null),
+/// The clean mesh of every part over the input points: a planar part's
+/// triangles (its 2D alpha-shape), a straight part's polyline through its
+/// points in order along the line; with (structure, part) per element.
+type PartMeshes = (Vec<[u32; 2]>, Vec<[u32; 3]>, Vec<[i64; 2]>);
+fn part_meshes(det: &Detection, points: &[[f64; 3]]) -> PartMeshes {
+    let mut edges = Vec::new();
+    let mut edge_labels = Vec::new();
+    let mut faces = Vec::new();
+    let mut face_labels = Vec::new();
+    let mut part = 0i64;
+    for s in &det.structures {
+        for p in &s.parts {
+            let l = [i64::from(s.id), part];
+            faces.extend_from_slice(&p.mesh);
+            face_labels.extend(std::iter::repeat_n(l, p.mesh.len()));
+            if let Primitive::Line(f) = &p.primitive {
+                let mut along: Vec<(f64, u32)> = p
+                    .vertices
+                    .iter()
+                    .map(|&v| {
+                        let q = points[v as usize];
+                        let t = (0..3)
+                            .map(|k| (q[k] - f.centroid[k]) * f.direction[k])
+                            .sum::<f64>();
+                        (t, v)
+                    })
+                    .collect();
+                along.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+                for w in along.windows(2) {
+                    edges.push([w[0].1, w[1].1]);
+                    edge_labels.push(l);
+                }
+            }
+            part += 1;
+        }
+    }
+    edge_labels.extend(face_labels);
+    (edges, faces, edge_labels)
+}
+
+fn fmt_param(r: &serde_json::Value, name: &str) -> String {
+    let p = &r["parameters"][name];
+    match p["value"].as_f64() {
+        Some(v) => format!(
+            "{name} {}{}",
+            trim(v),
+            if p["estimated"].as_bool() == Some(true) {
+                " (estimated)"
+            } else {
+                ""
+            }
+        ),
+        None => String::new(),
     }
 }
 
-fn kind_name(s: &aniso_alpha::detect::detector::Structure) -> &'static str {
-    match (&s.primitive, s.parts.len()) {
-        (Primitive::Line(_), 1) => "line",
-        (Primitive::Line(_), _) => "polyline",
-        (Primitive::Plane(_), 1) => "plane",
-        (Primitive::Plane(_), _) => "surface",
-        (Primitive::None, _) => "?",
+fn trim(v: f64) -> String {
+    if v == v.round() && v.abs() < 1e9 {
+        format!("{v}")
+    } else {
+        format!("{v:.4}")
     }
 }
 
-fn structure_json(s: &aniso_alpha::detect::detector::Structure) -> serde_json::Value {
-    json!({
-        "id": s.id,
-        "kind": kind_name(s),
-        "points": s.vertices.len(),
-        "simplices": s.simplices.len(),
-        "primitive": primitive_json(&s.primitive),
-        "parts": s.parts.iter().map(|p| json!({
-            "points": p.vertices.len(),
-            "simplices": p.simplices.len(),
-            "primitive": primitive_json(&p.primitive),
-        })).collect::<Vec<_>>(),
-    })
-}
-
-fn summary(name: &str, det: &Detection, params: &serde_json::Value, seconds: f64) -> String {
+fn summary(
+    name: &str,
+    det: &Detection,
+    d: &Detector<'_>,
+    report: &serde_json::Value,
+    seconds: f64,
+) -> String {
     let mut o = String::new();
+    let kind = match d.kind() {
+        StructureKind::Lines => "lines",
+        StructureKind::Planes => "planes",
+    };
     o.push_str(&format!("aniso-alpha detect: {name}\n"));
+    let mut params = vec![fmt_param(report, "alpha")];
+    if d.kind() == StructureKind::Planes {
+        params.push(fmt_param(report, "lambda2"));
+    }
+    params.push(fmt_param(report, "lambda3"));
+    params.push(fmt_param(report, "min_size").replace("min_size", "min-size"));
     o.push_str(&format!(
-        "  {} points; {} (k = {}), alpha {}, {}lambda3 {}, min-size {}\n",
+        "  {} points; {kind} (k = {}), {}\n",
         det.labels.len(),
-        params["structure"].as_str().unwrap_or("?"),
-        det.kind.k(),
-        params["alpha"].as_f64().unwrap_or(f64::NAN),
-        params["lambda2"]
-            .as_f64()
-            .map(|l| format!("lambda2 {l}, "))
-            .unwrap_or_default(),
-        params["lambda3"].as_f64().unwrap_or(f64::NAN),
-        params["min_size"],
+        d.kind().k(),
+        params.join(", ")
     ));
+    if let Some(e) = d.estimate() {
+        o.push_str(&format!(
+            "  estimated: spacing {:.4} (90th percentile; median {:.4}), noise {:.4}, {:.0}% of points {}\n",
+            e.spacing,
+            e.spacing_median,
+            e.noise,
+            100.0 * e.structure_fraction,
+            if d.kind() == StructureKind::Planes { "locally planar" } else { "locally linear" }
+        ));
+        o.push_str(&format!("  alpha: {}\n", e.alpha.reason));
+    }
+    if let OrientationSet::Data(modes) = d.orientations() {
+        o.push_str(&format!(
+            "  orientations from the data: {} mode(s) of the local {}s, each with its own alpha and lambda (see --report)\n",
+            modes.len(),
+            if d.kind() == StructureKind::Planes { "normal" } else { "direction" }
+        ));
+    }
     o.push_str(&format!(
-        "  {} orientations in {:.2} s; union {} simplices, {} kept in structures\n\n",
-        det.stats.orientations, seconds, det.stats.union_simplices, det.stats.structure_simplices
+        "  {} orientations in {:.2} s; union {} simplices; {} part(s) kept, {} rejected by the significance test\n\n",
+        det.stats.orientations,
+        seconds,
+        det.stats.union_simplices,
+        det.num_parts(),
+        det.stats.rejected_parts
     ));
-    o.push_str("   id  kind      points  simplices  parts   rms      extent            centroid\n");
+    o.push_str(
+        "   id  kind      points  parts      rms  log10 NFA  plane [a b c d] / segment length\n",
+    );
     for s in det.structures.iter().take(20) {
-        let (rms, extent, c) = match &s.primitive {
-            Primitive::Line(f) => (f.rms_residual, format!("{:.2}", f.extent), f.centroid),
-            Primitive::Plane(f) => (
-                f.rms_residual,
-                format!("{:.2} x {:.2}", f.extent[0], f.extent[1]),
-                f.centroid,
-            ),
-            Primitive::None => (f64::NAN, "-".into(), [f64::NAN; 3]),
+        let what = match (&s.primitive, s.parts.len()) {
+            (Primitive::Plane(_), 1) => s
+                .primitive
+                .plane_equation()
+                .map(|p| format!("[{:.3} {:.3} {:.3} {:.3}]", p[0], p[1], p[2], p[3]))
+                .unwrap_or_default(),
+            (Primitive::Line(f), 1) => format!("{:.3}", f.extent),
+            _ => format!("{} facets", s.parts.len()),
         };
         o.push_str(&format!(
-            "  {:>3}  {:<8} {:>7}  {:>9}  {:>5}  {:>7.3}  {:<16}  ({:.2}, {:.2}, {:.2})\n",
+            "  {:>3}  {:<8} {:>7}  {:>5}  {:>7.3}  {:>9.1}  {}\n",
             s.id,
-            kind_name(s),
+            s.kind_name(),
             s.vertices.len(),
-            s.simplices.len(),
             s.parts.len(),
-            rms,
-            extent,
-            c[0],
-            c[1],
-            c[2]
+            s.primitive.rms(),
+            s.log10_nfa,
+            what
         ));
     }
     if det.structures.len() > 20 {
@@ -366,8 +538,9 @@ fn summary(name: &str, det: &Detection, params: &serde_json::Value, seconds: f64
     }
     let bg = det.labels.iter().filter(|&&l| l < 0).count();
     o.push_str(&format!(
-        "  {} structure(s); {} of {} points are background\n",
+        "  {} structure(s), {} part(s); {} of {} points are background\n",
         det.structures.len(),
+        det.num_parts(),
         bg,
         det.labels.len()
     ));

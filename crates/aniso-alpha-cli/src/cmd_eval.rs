@@ -1,4 +1,4 @@
-//! `aniso-alpha eval`: scores of a detection against ground truth (SPEC §6).
+//! `aniso-alpha eval`: scores of a detection against ground truth (docs/method.md §6).
 
 use std::path::PathBuf;
 
@@ -15,7 +15,7 @@ use crate::common::{self, CliError, Timings};
     after_help = "TRUTH is a point file with labels: text `x y z label` (label column set by \
 --label-column), PLY with a `structure` vertex property, PCD with a `label` field, LAS \
 classification. LABELS has one integer per line, as written by `detect --labels`.\n\n\
-Scores (SPEC §6): per-point precision, recall and F1 of structure vs background, and \
+Scores (docs/method.md §6): per-point precision, recall and F1 of structure vs background, and \
 structures found (one detected structure holds at least half of a true structure's points, \
 and most of its own points are that structure's).\n\n\
 Examples:\n  aniso-alpha eval --truth scene.xyz --labels labels.txt --json\n  \
@@ -41,11 +41,20 @@ pub struct EvalArgs {
     /// Detected part labels, one per line (`detect --part-labels`)
     #[arg(long, value_name = "PARTS.txt", requires = "part_column")]
     pub part_labels: Option<PathBuf>,
+    /// LAS truth: classes read as background (-1), comma-separated, or
+    /// `none` [default: 0,1,7,18: never classified, unclassified, noise]
+    #[arg(long, value_name = "C1,C2,...", value_parser = common::parse_classes)]
+    pub background_classes: Option<aniso_alpha::io::ClassSet>,
+    #[command(flatten)]
+    pub input_format: crate::FormatArgs,
+    #[command(flatten)]
+    pub common: crate::QuietArgs,
 }
 
 /// Runs `eval`.
 pub fn run(args: &EvalArgs, timings: &mut Timings) -> Result<(), CliError> {
-    let (cloud, truth) = common::read_truth(&args.truth, args.label_column, timings)?;
+    let background = args.background_classes.unwrap_or_default();
+    let (cloud, truth) = common::read_truth(&args.truth, args.label_column, background, timings)?;
     let labels = timings.phase("read", || aniso_alpha::io::read_labels(&args.labels))?;
     if labels.len() != truth.len() {
         return Err(CliError::msg(format!(
@@ -57,7 +66,7 @@ pub fn run(args: &EvalArgs, timings: &mut Timings) -> Result<(), CliError> {
         )));
     }
     let truth_parts = match args.part_column {
-        Some(col) => Some(common::read_truth(&args.truth, col, timings)?.1),
+        Some(col) => Some(common::read_truth(&args.truth, col, background, timings)?.1),
         None => None,
     };
     let predicted_parts = match &args.part_labels {

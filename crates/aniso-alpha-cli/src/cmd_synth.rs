@@ -4,7 +4,8 @@ use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
 
-use aniso_alpha::synth::{write_xyz_labels, write_xyz_labels_parts, SceneOptions};
+use aniso_alpha::io::write_scene;
+use aniso_alpha::synth::SceneOptions;
 
 use crate::common::{self, parse_positive, CliError, Timings};
 
@@ -63,11 +64,13 @@ pub struct SynthArgs {
     /// Also write the facet id of each point as a 5th column (polyhedron)
     #[arg(long)]
     pub parts: bool,
+    #[command(flatten)]
+    pub common: crate::QuietArgs,
 }
 
 /// Runs `synth`.
 pub fn run(args: &SynthArgs, timings: &mut Timings) -> Result<(), CliError> {
-    common::check_output(&args.output)?;
+    common::check_io(&[], &[("--output", Some(&args.output))])?;
     let mut opts = match args.scene {
         Scene::Lines => SceneOptions::lines(),
         Scene::Planes => SceneOptions::planes(),
@@ -88,15 +91,7 @@ pub fn run(args: &SynthArgs, timings: &mut Timings) -> Result<(), CliError> {
     }
     let scene = timings.phase("synth", || opts.generate())?;
     let with_parts = args.parts || args.scene == Scene::Polyhedron;
-    common::write_output(&args.output, timings, |w| {
-        let mut w = std::io::BufWriter::new(w);
-        if with_parts {
-            write_xyz_labels_parts(&scene, &mut w)?;
-        } else {
-            write_xyz_labels(&scene, &mut w)?;
-        }
-        std::io::Write::flush(&mut w)
-    })?;
+    timings.phase("write", || write_scene(&args.output, &scene, with_parts))?;
     let p = opts.paper_params();
     let structure = if p.k == 1 { "lines" } else { "planes" };
     let lambda2 = if p.k == 2 {

@@ -55,6 +55,22 @@ impl<E: std::error::Error> From<E> for CliError {
 
 static QUIET: AtomicBool = AtomicBool::new(false);
 
+static FORMAT: std::sync::OnceLock<aio::Format> = std::sync::OnceLock::new();
+
+/// Sets `--format`: the input format, overriding file extensions.
+pub fn set_format(format: Option<aio::Format>) {
+    if let Some(f) = format {
+        let _ = FORMAT.set(f);
+    }
+}
+
+/// clap parser for `--format`.
+pub fn parse_format(s: &str) -> Result<aio::Format, String> {
+    aio::Format::from_name(s).ok_or_else(|| {
+        format!("unknown format '{s}' (expected xyz, txt, csv, pts, ply, las, laz or pcd)")
+    })
+}
+
 /// Sets `--quiet`: no progress bars, no informational messages.
 pub fn set_quiet(quiet: bool) {
     QUIET.store(quiet, Ordering::Relaxed);
@@ -70,6 +86,22 @@ pub fn info(message: impl fmt::Display) {
     if !quiet() {
         eprintln!("{message}");
     }
+}
+
+static SILENT: AtomicBool = AtomicBool::new(false);
+
+/// Sets `--quiet` as the user gave it (not implied by `--timings`): the
+/// summaries on stdout are silenced too.
+pub fn set_silent(silent: bool) {
+    SILENT.store(silent, Ordering::Relaxed);
+}
+
+/// Writes a summary (e.g. `detect`'s table) to stdout, unless `--quiet`.
+pub fn print_summary(text: &str) -> Result<(), CliError> {
+    if SILENT.load(Ordering::Relaxed) {
+        return Ok(());
+    }
+    print_stdout(text)
 }
 
 /// Writes `text` to stdout; a closed pipe (`| head`) is not an error.
@@ -199,22 +231,48 @@ fn round_json(s: f64) -> serde_json::Value {
 
 // ------------------------------------------------------------ input/output
 
-/// Reads a point file (format by extension) with a progress bar, as
-/// phase `read`. Errors name the file and, for text, the line.
+/// Reads a point file (format by extension, or `--format`; `-` is
+/// standard input) with a progress bar, as phase `read`. Errors name the
+/// file and, for text, the line; the reader's warnings are printed unless
+/// `--quiet`.
 pub fn read_input(
     path: &Path,
     options: &ReadOptions,
     timings: &mut Timings,
 ) -> Result<PointCloud, CliError> {
-    timings.phase("read", || {
+    let options = ReadOptions {
+        format: options.format.or(FORMAT.get().copied()),
+        ..*options
+    };
+    let cloud = timings.phase("read", || {
         let bar = progress_bytes(0, "reading");
-        let cloud = aio::read_points_with_progress(path, options, &mut |done, total| {
+        let cloud = aio::read_points_with_progress(path, &options, &mut |done, total| {
             bar.set_length(total);
             bar.set_position(done);
         });
         bar.finish_and_clear();
-        Ok(cloud?)
-    })
+        cloud
+    })?;
+    for w in &cloud.warnings {
+        warn(format_args!("{}: {w}", display_input(path)));
+    }
+    Ok(cloud)
+}
+
+/// How an input path is named in messages (`-` is standard input).
+pub fn display_input(path: &Path) -> String {
+    if aio::is_stdin(path) {
+        "<stdin>".to_string()
+    } else {
+        path.display().to_string()
+    }
+}
+
+/// Prints `warning: <message>` on stderr, unless `--quiet`.
+pub fn warn(message: impl fmt::Display) {
+    if !quiet() {
+        eprintln!("warning: {message}");
+    }
 }
 
 /// Reads a point file that must carry labels (ground truth): text column
@@ -222,9 +280,14 @@ pub fn read_input(
 pub fn read_truth(
     path: &Path,
     label_column: usize,
+    background_classes: aio::ClassSet,
     timings: &mut Timings,
 ) -> Result<(PointCloud, Vec<i64>), CliError> {
-    let mut cloud = read_input(path, &ReadOptions::with_labels(label_column), timings)?;
+    let options = ReadOptions {
+        background_classes,
+        ..ReadOptions::with_labels(label_column)
+    };
+    let mut cloud = read_input(path, &options, timings)?;
     match cloud.labels.take() {
         Some(labels) => Ok((cloud, labels)),
         None => Err(CliError::in_file(
@@ -235,19 +298,62 @@ pub fn read_truth(
 }
 
 /// Fails early, before any long computation, when `path` cannot be an
-/// output (missing folder, a directory).
+/// output (missing or read-only folder, a directory, a device node or a
+/// FIFO).
 pub fn check_output(path: &Path) -> Result<(), CliError> {
     Ok(aio::check_output_path(path)?)
 }
 
-/// [`check_output`] for each given optional output.
-pub fn check_outputs<'a>(
-    paths: impl IntoIterator<Item = Option<&'a Path>>,
-) -> Result<(), CliError> {
-    for p in paths.into_iter().flatten() {
-        check_output(p)?;
+/// Checks a command's files before any work: every output can be written
+/// ([`check_output`]), no output is also an input (the same file, through
+/// any link), and no two outputs write the same file. `outputs` pairs each
+/// output with the option that names it.
+pub fn check_io(inputs: &[&Path], outputs: &[(&str, Option<&Path>)]) -> Result<(), CliError> {
+    let given: Vec<(&str, &Path)> = outputs
+        .iter()
+        .filter_map(|(flag, p)| p.map(|p| (*flag, p)))
+        .collect();
+    let mut keys: Vec<(std::path::PathBuf, &str)> = Vec::new();
+    for &(flag, out) in &given {
+        for input in inputs {
+            if aio::same_file(input, out) {
+                return Err(CliError::msg(format!(
+                    "{flag} {}: is the input file {}; refusing to overwrite an input",
+                    out.display(),
+                    input.display()
+                )));
+            }
+        }
+        let key = aio::output_key(out);
+        if let Some((_, other)) = keys.iter().find(|(k, _)| *k == key) {
+            return Err(CliError::msg(format!(
+                "{other} and {flag} name the same file {}: give each output its own path",
+                out.display()
+            )));
+        }
+        keys.push((key, flag));
+    }
+    for &(_, out) in &given {
+        check_output(out)?;
     }
     Ok(())
+}
+
+/// Removes the temporary files of unfinished outputs on SIGINT, SIGTERM
+/// and SIGHUP, then exits with status 128 + the signal number.
+pub fn install_signal_cleanup() {
+    #[cfg(unix)]
+    {
+        use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+        if let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) {
+            std::thread::spawn(move || {
+                if let Some(sig) = signals.forever().next() {
+                    aio::remove_temp_files();
+                    std::process::exit(128 + sig);
+                }
+            });
+        }
+    }
 }
 
 /// Output formats for simplices.
@@ -273,12 +379,6 @@ pub fn mesh_format(path: &Path) -> Result<MeshFormat, CliError> {
             path.display()
         ))),
     }
-}
-
-/// [`check_output`] plus a known mesh extension; call it early.
-pub fn check_mesh_output(path: &Path) -> Result<(), CliError> {
-    mesh_format(path)?;
-    check_output(path)
 }
 
 /// Writes simplices as PLY (binary) or OBJ by extension, atomically, as
@@ -356,6 +456,22 @@ pub fn parse_positive_triple(s: &str) -> Result<[f64; 3], String> {
     Ok(t)
 }
 
+/// clap parser for `--background-classes`: `7,18`, or `none`.
+pub fn parse_classes(s: &str) -> Result<aio::ClassSet, String> {
+    if s.trim().eq_ignore_ascii_case("none") {
+        return Ok(aio::ClassSet::EMPTY);
+    }
+    let classes = s
+        .split(',')
+        .map(|t| {
+            t.trim()
+                .parse::<u8>()
+                .map_err(|_| format!("'{}' is not a LAS class (0-255)", t.trim()))
+        })
+        .collect::<Result<Vec<u8>, _>>()?;
+    Ok(aio::ClassSet::from_classes(&classes))
+}
+
 /// clap parser for a finite number > 0.
 pub fn parse_positive(s: &str) -> Result<f64, String> {
     match s.trim().parse::<f64>() {
@@ -381,6 +497,12 @@ mod tests {
         assert!(parse_triple("1,nan,2").is_err());
         assert!(parse_positive_triple("1,0,2").is_err());
         assert!(parse_positive("-1").is_err());
+        assert_eq!(parse_classes("none"), Ok(aio::ClassSet::EMPTY));
+        assert_eq!(
+            parse_classes("7, 18"),
+            Ok(aio::ClassSet::from_classes(&[7, 18]))
+        );
+        assert!(parse_classes("7,256").is_err());
     }
 
     #[test]
@@ -414,8 +536,8 @@ mod tests {
             .contains("f 1 2 3"));
         let e = write_mesh(&dir.join("m.stl"), &mesh, &mut t).unwrap_err();
         assert!(e.to_string().contains("m.stl: unknown output extension"));
-        assert!(check_mesh_output(&dir.join("m.txt")).is_err());
-        assert!(check_mesh_output(&dir.join("nope").join("m.ply")).is_err());
+        assert!(mesh_format(&dir.join("m.txt")).is_err());
+        assert!(check_output(&dir.join("nope").join("m.ply")).is_err());
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -233,6 +233,27 @@ fn bad_usage_exits_2() {
         let o = Command::new(BIN).args(args).output().unwrap();
         assert_eq!(o.status.code(), Some(2), "{args:?}");
     }
+    // `alpha --alpha A` alone asks for an output of the shape, nothing else.
+    let o = Command::new(BIN)
+        .args(["alpha", "in.xyz", "--alpha", "1"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    let missing = err.lines().nth(1).unwrap_or_default();
+    assert!(
+        missing.contains("--output") && missing.contains("--png"),
+        "{err}"
+    );
+    assert!(!missing.contains("--intervals"), "{err}");
+    // No --threads where it would do nothing.
+    for sub in ["synth", "eval", "view"] {
+        let o = Command::new(BIN)
+            .args([sub, "--threads", "2", "--help"])
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{sub} --threads");
+    }
     let o = Command::new(BIN)
         .args(["delaunay", "--help"])
         .output()
@@ -269,4 +290,183 @@ fn coordinates_beyond_exact_arithmetic() {
         b"1e-300 0 0\n0 1e-300 0\n0 0 1e-300\n1e-300 1e-300 1e-300\n",
     );
     expect_error(&d, &tiny, &out, &["tiny.xyz", "point 0", "rescale"]);
+}
+
+/// Issue 19 §4: text that used to be misread silently.
+#[test]
+fn misread_text_is_an_error() {
+    let d = TempDir::new("misread");
+    let out = d.0.join("out.tets");
+    let utf16: Vec<u8> = "\u{feff}0 0 0\n1 0 0\n0 1 0\n0 0 1\n"
+        .encode_utf16()
+        .flat_map(|u| u.to_le_bytes())
+        .collect();
+    let cases: Vec<(&str, Vec<u8>, &[&str])> = vec![
+        (
+            "euro.xyz",
+            b"0,0 0,0 0,0\n1,5 2,5 3,5\n".to_vec(),
+            &["euro.xyz:1:", "ambiguous comma", "decimal"],
+        ),
+        (
+            "thousands.csv",
+            b"x,y,z\n1,234.5,2,000.0,3.0\n".to_vec(),
+            &[
+                "thousands.csv:2:",
+                "5 comma-separated fields where line 1 has 3",
+            ],
+        ),
+        (
+            "minus.xyz",
+            "\u{2212}1 0 0\n1 0 0\n0 1 0\n0 0 1\n".as_bytes().to_vec(),
+            &["minus.xyz:1:", "Unicode minus"],
+        ),
+        ("utf16.xyz", utf16, &["utf16.xyz", "UTF-16"]),
+    ];
+    for (name, bytes, wants) in cases {
+        let input = d.file(name, &bytes);
+        expect_error(&d, &input, &out, wants);
+    }
+}
+
+#[test]
+fn header_guess_warns_unless_quiet() {
+    let d = TempDir::new("header");
+    let out = d.0.join("out.tets");
+    let input = d.file("h.xyz", b"X Y Z\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n");
+    let o = run(&[Path::new("delaunay"), &input, Path::new("--tets"), &out]);
+    assert_eq!(o.status.code(), Some(0));
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        stderr.contains("warning: ") && stderr.contains("h.xyz: line 1 taken as a header: 'X Y Z'"),
+        "{stderr}"
+    );
+    let o = run(&[
+        Path::new("delaunay"),
+        &input,
+        Path::new("--tets"),
+        &out,
+        Path::new("--quiet"),
+    ]);
+    assert_eq!(o.status.code(), Some(0));
+    assert!(
+        o.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
+#[test]
+fn stdin_and_format_override() {
+    use std::io::Write;
+    let d = TempDir::new("stdin");
+    let out = d.0.join("out.tets");
+    let mut child = Command::new(BIN)
+        .args(["delaunay", "-", "--tets"])
+        .arg(&out)
+        .stdin(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(b"0 0 0\n1 0 0\n0 1 0\n0 0 1\n")
+        .unwrap();
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert_eq!(std::fs::read_to_string(&out).unwrap().lines().count(), 1);
+    // An unknown extension read as text with --format.
+    let dat = d.file("points.dat", b"0 0 0\n1 0 0\n0 1 0\n0 0 1\n");
+    let o = run(&[Path::new("delaunay"), &dat, Path::new("--tets"), &out]);
+    assert_eq!(o.status.code(), Some(1));
+    let o = run(&[
+        Path::new("delaunay"),
+        &dat,
+        Path::new("--tets"),
+        &out,
+        Path::new("--format"),
+        Path::new("xyz"),
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let o = Command::new(BIN)
+        .args(["delaunay", "x", "--tets", "y", "--format", "e58"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+}
+
+/// Issue 19 §3: parameters whose size or range cannot work.
+#[test]
+fn huge_m2_is_a_clear_error() {
+    let d = TempDir::new("m2");
+    let input = d.file("p.xyz", b"0 0 0\n1 0 0\n0 1 0\n0 0 1\n");
+    let o = Command::new(BIN)
+        .arg("detect")
+        .arg(&input)
+        .args([
+            "--structure",
+            "planes",
+            "--alpha",
+            "1",
+            "--lambda3",
+            "8",
+            "--min-size",
+            "20",
+            "--m2",
+            "100000000",
+        ])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(
+        stderr.contains("--m2 100000000") && stderr.contains("orientations"),
+        "{stderr}"
+    );
+}
+
+/// Regression (issue 19): the triangulation's out-of-range error was
+/// swallowed and the run exited 0 with no structure.
+#[test]
+fn out_of_range_lambda3_names_the_parameter() {
+    let d = TempDir::new("lambda3");
+    let scene = d.0.join("s.xyz");
+    let o = Command::new(BIN)
+        .args(["synth", "lines", "--seed", "1", "--output"])
+        .arg(&scene)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0));
+    for l3 in ["1e300", "1e-60"] {
+        let o = Command::new(BIN)
+            .arg("detect")
+            .arg(&scene)
+            .args([
+                "--structure",
+                "lines",
+                "--alpha",
+                "1",
+                "--min-size",
+                "4",
+                "--lambda3",
+                l3,
+            ])
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "--lambda3 {l3}: {stderr}");
+        assert!(stderr.contains("lambda3"), "--lambda3 {l3}: {stderr}");
+    }
 }

@@ -1,4 +1,4 @@
-//! Anisotropy: the linear map Q = diag(e) · R of the paper (SPEC §2, §4).
+//! Anisotropy: the linear map Q = diag(e) · R of the paper (docs/method.md §2, §4).
 //!
 //! An [`Anisotropy`] is an orientation R (a proper rotation, rows = the axes of
 //! the ellipsoidal ball) and an elongation E = (e₁, e₂, e₃) with e_i > 0 and

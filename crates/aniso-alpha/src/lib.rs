@@ -50,6 +50,8 @@ pub mod detect;
 pub mod eval;
 pub mod geometry;
 pub mod io;
+#[cfg(feature = "json")]
+pub mod report;
 pub mod rng;
 pub mod synth;
 

@@ -1,4 +1,4 @@
-//! Property tests of the anisotropic complex (SPEC §2).
+//! Property tests of the anisotropic complex (docs/method.md §2).
 //!
 //! * E = (1, 1, 1) with the identity rotation is the Euclidean complex,
 //!   bit for bit (the transform `(1·x + 0·y) + 0·z` is exact).

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use aniso_alpha::io::{
     read_labels, read_pcd_bytes, read_ply_bytes, read_points, read_points_bytes, write_labels,
-    write_obj, write_ply, IoError, Mesh, PlyEncoding, ReadOptions,
+    write_obj, write_ply, ClassSet, IoError, Mesh, PlyEncoding, ReadOptions,
 };
 
 fn tmp_dir(name: &str) -> PathBuf {
@@ -32,6 +32,8 @@ fn bits(p: &[[f64; 3]]) -> Vec<[u64; 3]> {
 const NO_LABELS: ReadOptions = ReadOptions {
     label_column: None,
     read_labels: false,
+    format: None,
+    background_classes: ClassSet::LAS_BACKGROUND,
 };
 
 #[test]
@@ -42,10 +44,10 @@ fn ply_round_trip_ascii_and_binary_exact_bits() {
     let edges = [[0u32, 1], [4, 5]];
     let faces = [[0u32, 1, 2], [3, 4, 5]];
     let mesh = Mesh {
-        points: &pts,
         labels: Some(&labels),
         edges: &edges,
         faces: &faces,
+        ..Mesh::new(&pts)
     };
     for (enc, name) in [
         (PlyEncoding::Ascii, "a.ply"),
@@ -354,6 +356,28 @@ fn pcd_ascii_binary_compressed() {
         ),
         ("FIELDS x y z\nDATA ascii\n1 2 3\n".to_string(), "no POINTS"),
         ("FIELDS x y z\nPOINTS 1\n".to_string(), "no DATA"),
+        // Issue 19 §1: a field of COUNT 0 (ascii: index out of bounds;
+        // binary: zero stride, 10M points from 12 bytes, or 96 GB reserved).
+        (
+            "FIELDS x y z i\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 0\nPOINTS 1\nDATA ascii\n1 2 3\n"
+                .to_string(),
+            "field 'i' has SIZE 4 and COUNT 0",
+        ),
+        (
+            "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 0 0 0\nPOINTS 10000000\nDATA binary\n\0\0\0\0\0\0\0\0\0\0\0\0"
+                .to_string(),
+            "COUNT 0",
+        ),
+        (
+            "FIELDS x y z\nSIZE 4 4 0\nTYPE F F F\nPOINTS 4000000000\nDATA binary_compressed\n"
+                .to_string(),
+            "SIZE 0",
+        ),
+        (
+            "FIELDS x y z\nWIDTH 2\nHEIGHT 2\nPOINTS 3\nDATA ascii\n1 2 3\n1 2 3\n1 2 3\n"
+                .to_string(),
+            "POINTS 3 differs from WIDTH × HEIGHT = 2 × 2 = 4",
+        ),
     ];
     for (text, want) in errors {
         let e = read_pcd_bytes(Path::new("c.pcd"), text.as_bytes(), &labels).unwrap_err();
@@ -467,7 +491,14 @@ fn las_and_laz_round_trip() {
         let c = read_points(&path, &ReadOptions::with_labels(0)).unwrap();
         assert_eq!(c.points.len(), 5);
         assert_eq!(c.points[2], [1000.25, -3.0, 4.0]);
-        assert_eq!(c.labels, Some(vec![1, 2, 3, 4, 5]));
+        // Class 1 (unclassified) is background by default.
+        assert_eq!(c.labels, Some(vec![-1, 2, 3, 4, 5]));
+        let custom = ReadOptions {
+            background_classes: ClassSet::from_classes(&[3, 5]),
+            ..ReadOptions::with_labels(0)
+        };
+        let c = read_points(&path, &custom).unwrap();
+        assert_eq!(c.labels, Some(vec![1, 2, -1, 4, -1]));
         let bytes = std::fs::read(&path).unwrap();
         for cut in (0..bytes.len()).step_by(7) {
             let r = aniso_alpha::io::read_las_bytes(&path, &bytes[..cut], &NO_LABELS);
@@ -475,4 +506,210 @@ fn las_and_laz_round_trip() {
         }
     }
     std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// A LAS (or LAZ) file of `n` points in point format `format` with
+/// `extra` extra bytes, written by the `las` crate.
+#[cfg(feature = "las")]
+fn las_file(format: u8, extra: u16, compressed: bool, n: usize) -> Option<Vec<u8>> {
+    let mut builder = las::Builder::from((1, 4));
+    builder.point_format = las::point::Format::new(format).ok()?;
+    builder.point_format.extra_bytes = extra;
+    builder.point_format.is_compressed = compressed;
+    builder.transforms = las::Vector {
+        x: las::Transform {
+            scale: 0.01,
+            offset: 100.0,
+        },
+        y: las::Transform {
+            scale: 0.01,
+            offset: 0.0,
+        },
+        z: las::Transform {
+            scale: 0.001,
+            offset: 0.0,
+        },
+    };
+    let header = builder.into_header().ok()?;
+    let mut w = las::Writer::new(std::io::Cursor::new(Vec::new()), header).ok()?;
+    let f = las::point::Format::new(format).ok()?;
+    for i in 0..n {
+        let p = las::Point {
+            x: 100.0 + (i % 17) as f64 * 0.25,
+            y: (i / 17) as f64 * 0.5,
+            z: (i % 5) as f64 * 0.125,
+            intensity: (i * 37 % 65536) as u16,
+            return_number: 1,
+            number_of_returns: 1,
+            classification: las::point::Classification::new((i % 7) as u8).ok()?,
+            gps_time: f.has_gps_time.then_some(i as f64 * 0.001),
+            color: f
+                .has_color
+                .then_some(las::Color::new(i as u16, 2 * i as u16, 3)),
+            nir: f.has_nir.then_some(i as u16),
+            waveform: f.has_waveform.then(las::raw::point::Waveform::default),
+            extra_bytes: (0..extra).map(|k| (i + k as usize) as u8).collect(),
+            ..Default::default()
+        };
+        w.write_point(p).ok()?;
+    }
+    w.close().ok()?;
+    Some(w.into_inner().ok()?.into_inner())
+}
+
+/// Byte offset of the laszip VLR's payload in a LAZ file.
+#[cfg(feature = "las")]
+fn laszip_vlr_at(b: &[u8]) -> usize {
+    let header_size = u16::from_le_bytes([b[94], b[95]]) as usize;
+    let n = u32::from_le_bytes(b[100..104].try_into().unwrap());
+    let mut pos = header_size;
+    for _ in 0..n {
+        let len = u16::from_le_bytes([b[pos + 20], b[pos + 21]]) as usize;
+        if &b[pos + 2..pos + 16] == b"laszip encoded" {
+            return pos + 54;
+        }
+        pos += 54 + len;
+    }
+    panic!("no laszip VLR");
+}
+
+#[cfg(feature = "las")]
+#[test]
+fn laz_of_every_point_format_reads_like_las() {
+    for format in 0..=10u8 {
+        for extra in [0u16, 3] {
+            let (Some(las), Some(laz)) = (
+                las_file(format, extra, false, 300),
+                las_file(format, extra, true, 300),
+            ) else {
+                panic!("format {format}: the las crate could not write it");
+            };
+            let a =
+                read_points_bytes(Path::new("a.las"), &las, &ReadOptions::with_labels(0)).unwrap();
+            let b = read_points_bytes(Path::new("a.laz"), &laz, &ReadOptions::with_labels(0))
+                .unwrap_or_else(|e| panic!("format {format} extra {extra}: {e}"));
+            assert_eq!(a, b, "format {format} extra {extra}");
+            assert_eq!(a.points.len(), 300);
+            assert_eq!(a.points[18], [100.25, 0.5, 0.375]);
+            assert_eq!(a.labels.as_ref().unwrap()[9], 2);
+        }
+    }
+}
+
+/// Hostile LAZ files (issue 19 §1): each is an error naming the file, with
+/// no panic and no allocation beyond the file's size.
+#[cfg(feature = "las")]
+#[test]
+fn laz_lies_are_errors() {
+    for format in [1u8, 3, 6, 7] {
+        let good = las_file(format, 2, true, 2000).unwrap();
+        let vlr = laszip_vlr_at(&good);
+        let data_start = u32::from_le_bytes(good[96..100].try_into().unwrap()) as usize;
+        let table = u64::from_le_bytes(good[data_start..data_start + 8].try_into().unwrap());
+        let table = table as usize;
+        let mut cases: Vec<(&str, Vec<u8>, &str)> = Vec::new();
+        // num_items = 0 (the laz crate panicked in details.rs).
+        let mut b = good.clone();
+        b[vlr + 32..vlr + 34].copy_from_slice(&0u16.to_le_bytes());
+        cases.push(("no items", b, "no items"));
+        // An item of the wrong type for the point format.
+        let mut b = good.clone();
+        b[vlr + 34..vlr + 36].copy_from_slice(&7u16.to_le_bytes());
+        cases.push(("wrong item", b, "do not describe point format"));
+        // A chunk count patched to 0xFFFFFFFF (35–69 GB allocated, abort).
+        let mut b = good.clone();
+        b[table + 4..table + 8].copy_from_slice(&u32::MAX.to_le_bytes());
+        cases.push(("chunk count", b, "chunks"));
+        // A chunk table offset past the end of the file.
+        let mut b = good.clone();
+        b[data_start..data_start + 8].copy_from_slice(&(1u64 << 40).to_le_bytes());
+        cases.push(("table offset", b, "chunk table"));
+        // A point count far beyond what the data can hold.
+        let mut b = good.clone();
+        if format >= 6 {
+            b[247..255].copy_from_slice(&(1u64 << 40).to_le_bytes());
+        } else {
+            b[107..111].copy_from_slice(&u32::MAX.to_le_bytes());
+        }
+        cases.push(("point count", b, "points"));
+        if format >= 6 {
+            // A layer size of 4 GB in the first chunk (resized, zero-filled).
+            let mut b = good.clone();
+            let at = data_start + 8 + b[105] as usize + 4;
+            b[at..at + 4].copy_from_slice(&u32::MAX.to_le_bytes());
+            cases.push(("layer size", b, "layers"));
+        }
+        for (what, bytes, want) in cases {
+            let e = read_points_bytes(Path::new("bad.laz"), &bytes, &NO_LABELS)
+                .expect_err(what)
+                .to_string();
+            assert!(e.starts_with("bad.laz: "), "{what}: {e}");
+            assert!(e.contains(want), "format {format}, {what}: {e}");
+        }
+        // Every one-byte corruption of the compressed data: points or an
+        // error, never a panic or an abort.
+        for at in (data_start + 8..table).step_by(13) {
+            let mut b = good.clone();
+            b[at] ^= 0x5A;
+            let _ = read_points_bytes(Path::new("bad.laz"), &b, &NO_LABELS);
+        }
+    }
+}
+
+/// Writes the LAS fuzz target's seeds: LAS and LAZ files of every point
+/// format. Run with `--ignored` after a change of the format support.
+#[cfg(feature = "las")]
+#[test]
+#[ignore = "writes fuzz/corpus_seeds/las"]
+fn write_fuzz_seeds() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz/corpus_seeds/las");
+    std::fs::create_dir_all(&dir).unwrap();
+    for format in 0..=10u8 {
+        for (compressed, ext) in [(false, "las"), (true, "laz")] {
+            let b = las_file(format, if format % 3 == 0 { 2 } else { 0 }, compressed, 40).unwrap();
+            std::fs::write(dir.join(format!("format{format}.{ext}")), b).unwrap();
+        }
+    }
+}
+
+/// Issue 19 §4: PLY values outside their declared type are errors.
+#[test]
+fn ply_values_must_fit_their_type() {
+    let head = |ty: &str, label: &str| {
+        format!(
+            "ply\nformat ascii 1.0\nelement vertex 1\nproperty {ty} x\nproperty float y\n\
+             property float z\nproperty {label} label\nend_header\n"
+        )
+    };
+    let labels = ReadOptions::with_labels(3);
+    for (ty, value, want) in [
+        ("uchar", "300", "out of range for a uchar"),
+        ("uchar", "-5", "out of range for a uchar"),
+        ("uchar", "1.5", "not an integer"),
+        ("int", "1e20", "not an integer"),
+        ("short", "40000", "out of range for a short"),
+    ] {
+        let text = head(ty, "int") + &format!("{value} 0 0 1\n");
+        let e = read_ply_bytes(Path::new("t.ply"), text.as_bytes(), &labels).unwrap_err();
+        let e = e.to_string();
+        assert!(e.starts_with("t.ply:9: invalid value"), "{ty} {value}: {e}");
+        assert!(e.contains(want), "{ty} {value}: {e}");
+    }
+    let ok = head("uchar", "int") + "255 0 0 -7\n";
+    let c = read_ply_bytes(Path::new("t.ply"), ok.as_bytes(), &labels).unwrap();
+    assert_eq!((c.points[0][0], c.labels.unwrap()[0]), (255.0, -7));
+    // A NaN or fractional float label is an error, not 0 (ascii and binary).
+    for v in ["nan", "1.5"] {
+        let text = head("float", "float") + &format!("1 0 0 {v}\n");
+        let e = read_ply_bytes(Path::new("t.ply"), text.as_bytes(), &labels).unwrap_err();
+        assert!(e.to_string().contains("is not an integer"), "{v}: {e}");
+    }
+    let mut b = b"ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\n\
+property float y\nproperty float z\nproperty float label\nend_header\n"
+        .to_vec();
+    for v in [1.0f32, 2.0, 3.0, f32::NAN] {
+        b.extend_from_slice(&v.to_le_bytes());
+    }
+    let e = read_ply_bytes(Path::new("b.ply"), &b, &labels).unwrap_err();
+    assert!(e.to_string().contains("label NaN is not an integer"), "{e}");
 }

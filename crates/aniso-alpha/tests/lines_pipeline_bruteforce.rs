@@ -2,7 +2,7 @@
 //! (Fig. 12), without the Delaunay engine: F_{1,α,Q}(P) is computed by brute
 //! force (an edge is exposed when some ball of radius α through its two
 //! transformed endpoints is empty of the other transformed points), then
-//! the SPEC §4 loop runs with the real sampler, path filter, union,
+//! the docs/method.md §4 loop runs with the real sampler, path filter, union,
 //! component clean-up, labelling and scores.
 //!
 //! This validates the scale choices of `synth` (step d = 7, background

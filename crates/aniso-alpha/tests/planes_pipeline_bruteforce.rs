@@ -3,7 +3,7 @@
 //! F_{2,α,Q}(P) is computed by brute force (a triangle of circumradius
 //! R ≤ α is exposed when one of the two balls of radius α through its
 //! transformed vertices, centred at circumcentre ± √(α² − R²)·normal, is
-//! empty of the other transformed points). Then the SPEC §4 loop runs with
+//! empty of the other transformed points). Then the docs/method.md §4 loop runs with
 //! the box sampler (1,944 orientations), the path filter per orientation,
 //! the union, the component clean-up, labelling and scores.
 

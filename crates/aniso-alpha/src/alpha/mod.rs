@@ -1,5 +1,5 @@
 //! Alpha-shape intervals, Euclidean and anisotropic alpha-shapes
-//! (SPEC §1–§2).
+//! (docs/method.md §1–§2).
 //!
 //! [`AlphaComplex`] takes a Delaunay [`Triangulation`] and computes, for
 //! every finite edge and triangle σ, the interval `[α_min(σ), α_max(σ)]` of
@@ -222,7 +222,7 @@ impl AlphaComplex {
         Ok(Self::new(Triangulation::new(points)?))
     }
 
-    /// The anisotropic complex of SPEC §2: transforms every point by the
+    /// The anisotropic complex of docs/method.md §2: transforms every point by the
     /// matrix `Q` given by its rows `q_rows` (`Q = diag(e)·R`, see
     /// [`q_matrix`]), triangulates `Q·P` and computes its intervals. Since
     /// `d_Q(p, q) = |Qp − Qq|`, the result's `F_α` is the anisotropic

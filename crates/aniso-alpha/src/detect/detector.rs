@@ -1,28 +1,26 @@
-//! The structure detector of paper §4.3 (SPEC §4): scan orientations, take
-//! the union of the filtered anisotropic α-shapes, clean it, and extract
-//! structures with fitted primitives and per-point labels.
+//! The structure detector (paper §4.3, method doc §4): its parameters, and
+//! the run that chains the steps: the orientation scan ([`super::scan`]),
+//! the union and its clean-up, and the assembly of structures and parts
+//! ([`super::assemble`]).
 //!
-//! For every orientation R of the sampler: Q = diag(E)·R, transform the
-//! points, drop the points that are isolated at distance 2α (exact, see
-//! [`super::prune`]), triangulate, select `F_{k,α,Q}` ([`super::faces`]: the same membership as
-//! [`crate::alpha::AlphaComplex`], computed for one α), and apply the path filter with `nb_c`. The orientations are
-//! independent and run in parallel (feature `parallel`, on by default); the
-//! result does not depend on the thread count because each orientation's
-//! output is collected in orientation order before the union is sorted.
+//! Parameters come from the user ([`Detector::lines`],
+//! [`Detector::planes`]) or from the data ([`Detector::auto`], method doc
+//! §8: the scales, and an orientation set made of the modes of the local
+//! normals or directions, each with the points it concerns).
 //!
-//! Then, on the union (set semantics):
-//! 1. whole connected components with fewer than `nb_c` simplices are
-//!    dropped (the path filter is *not* re-applied: for k = 2 the union
-//!    holds triangles of different triangulations of one plane, which the
-//!    path filter would shred);
-//! 2. each component is split into straight or flat *parts*
-//!    ([`super::parts`]); adjacent parts are the facets of one structure
-//!    (a polyhedral surface, or a bent line) when they meet along their
-//!    boundary, and separate structures when one passes through the other
-//!    (crossing lines, planes cutting each other, a T-junction);
-//! 3. each structure and part gets a least-squares line or plane;
-//! 4. every input point is labelled with the largest structure containing
-//!    it, or −1.
+//! The orientations are independent and run in parallel (feature
+//! `parallel`, on by default, on [`Detector::threads`] threads or rayon's
+//! current pool); the result does not depend on the thread count because
+//! each orientation's output is collected in orientation order before the
+//! union is sorted.
+//!
+//! After the scan, on the union (set semantics): whole connected components
+//! with fewer than `nb_c` simplices are dropped (the path filter is *not*
+//! re-applied: for k = 2 the union holds triangles of different
+//! triangulations of one plane, which the path filter would shred); then
+//! the assembly splits components into disjoint straight or flat parts with
+//! fitted lines and planes, outlines and segments, tests their
+//! significance, groups them into structures, and labels every point.
 //!
 //! ```
 //! use aniso_alpha::detect::detector::Detector;
@@ -35,19 +33,33 @@
 //! # Ok::<(), aniso_alpha::detect::detector::DetectError>(())
 //! ```
 
-use super::filter::{component_size_mask, components, filter, FilterError, Simplex};
-use super::fit::{fit_line_indices, fit_plane_indices, LineFit, PlaneFit};
+pub use super::detection::{Detection, Part, Primitive, RunStats, Structure};
+pub use super::estimate::{Estimate, Given, ModeScan, Param};
+
+use super::assemble::{assemble, Scale, Settings};
+use super::estimate::{estimate, mode_rotations};
+use super::filter::{component_size_mask, FilterError};
 use super::orientations::{orientations, OrientationError, Sampler};
-use super::parts::{linear_parts, planar_parts, PartsError};
-use super::prune::{non_isolated, CandidatePairs};
+use super::prune::CandidatePairs;
+use super::scan::{run_job, union, Face, Job, JobResult, Pruning, ScanError, RADIUS_SLACK};
 use super::StructureKind;
 use crate::aniso::{Anisotropy, AnisotropyError};
-use crate::delaunay::Triangulation;
 use std::fmt;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 /// A 3×3 matrix as rows.
-pub type Mat3 = [[f64; 3]; 3];
+pub type Mat3 = crate::aniso::Mat3;
+
+pub use super::orientations::MAX_ORIENTATIONS;
+
+/// Range of λ accepted: beyond it the transformed coordinates leave the
+/// range where the arithmetic is exact for the inputs allowed.
+pub const LAMBDA_RANGE: (f64, f64) = (1e-3, 1e4);
+
+/// Candidate pairs for the pruning are found once for all orientations
+/// unless there would be more than this many per point (plus a constant):
+/// then each orientation grids its own transformed points.
+const PAIRS_PER_POINT: usize = 32;
 
 /// Error of a detection run.
 #[derive(Debug, Clone, PartialEq)]
@@ -74,6 +86,8 @@ pub enum DetectError {
     Anisotropy(AnisotropyError),
     /// The run was cancelled by the progress callback.
     Cancelled,
+    /// An internal invariant broke (a bug: please report it).
+    Internal(String),
 }
 
 impl fmt::Display for DetectError {
@@ -92,6 +106,7 @@ impl fmt::Display for DetectError {
             DetectError::Orientations(e) => write!(f, "orientations: {e}"),
             DetectError::Anisotropy(e) => write!(f, "anisotropy: {e}"),
             DetectError::Cancelled => write!(f, "cancelled"),
+            DetectError::Internal(m) => write!(f, "internal error (a bug, please report): {m}"),
         }
     }
 }
@@ -108,9 +123,36 @@ impl From<AnisotropyError> for DetectError {
         DetectError::Anisotropy(e)
     }
 }
+impl From<FilterError> for DetectError {
+    fn from(e: FilterError) -> Self {
+        DetectError::Internal(format!("filter: {e}"))
+    }
+}
+impl From<ScanError> for DetectError {
+    fn from(e: ScanError) -> Self {
+        match e {
+            ScanError::Triangulation(t) => DetectError::Internal(format!(
+                "triangulation of the transformed points failed: {t}"
+            )),
+            ScanError::Filter(f) => f.into(),
+        }
+    }
+}
 
-/// Parameters of a detection run; build them with [`Detector::lines`] or
-/// [`Detector::planes`] and the builder methods.
+/// The orientation set of a run.
+#[derive(Debug, Clone, PartialEq)]
+pub enum OrientationSet {
+    /// A sampler, over every point.
+    Sampler(Sampler),
+    /// Explicit rotations (rows of R), over every point.
+    Rotations(Vec<Mat3>),
+    /// The data orientation set: per mode, its rotations, its points and
+    /// its scale ([`Detector::auto`]).
+    Data(Vec<ModeScan>),
+}
+
+/// Parameters of a detection run; build them with [`Detector::lines`],
+/// [`Detector::planes`] or [`Detector::auto`] and the builder methods.
 #[derive(Clone)]
 pub struct Detector<'a> {
     kind: StructureKind,
@@ -118,10 +160,13 @@ pub struct Detector<'a> {
     lambda2: f64,
     lambda3: f64,
     nb_c: u32,
-    sampler: Sampler,
-    rotations: Option<Vec<Mat3>>,
+    set: OrientationSet,
     prune: bool,
     part_angle_deg: f64,
+    epsilon: Option<f64>,
+    threads: Option<usize>,
+    tile: Option<f64>,
+    estimate: Option<Box<Estimate>>,
     progress: Option<&'a (dyn Fn(usize, usize) -> bool + Sync)>,
 }
 
@@ -133,8 +178,10 @@ impl fmt::Debug for Detector<'_> {
             .field("lambda2", &self.lambda2)
             .field("lambda3", &self.lambda3)
             .field("nb_c", &self.nb_c)
-            .field("sampler", &self.sampler)
             .field("prune", &self.prune)
+            .field("epsilon", &self.epsilon)
+            .field("threads", &self.threads)
+            .field("tile", &self.tile)
             .finish()
     }
 }
@@ -150,10 +197,13 @@ impl<'a> Detector<'a> {
             lambda2: 1.0,
             lambda3,
             nb_c,
-            sampler: Sampler::default(),
-            rotations: None,
+            set: OrientationSet::Sampler(Sampler::default()),
             prune: true,
             part_angle_deg: 10.0,
+            epsilon: Some(1.0),
+            threads: None,
+            tile: None,
+            estimate: None,
             progress: None,
         }
     }
@@ -169,17 +219,91 @@ impl<'a> Detector<'a> {
         }
     }
 
+    /// Parameters and orientations from the data (method doc §8, see
+    /// [`super::estimate`]); the values in `given` are kept. Planes use
+    /// m2 = 12 turns about the normal when λ₂ ≠ λ₃ (the paper's).
+    ///
+    /// # Errors
+    /// Empty input, non-finite or out-of-range coordinates, given values
+    /// out of range.
+    pub fn auto(
+        kind: StructureKind,
+        points: &[[f64; 3]],
+        given: &Given,
+    ) -> Result<Self, DetectError> {
+        Self::auto_with(kind, points, given, 12)
+    }
+
+    /// [`Self::auto`] with `m2` turns about a plane's normal when λ₂ ≠ λ₃.
+    ///
+    /// # Errors
+    /// As [`Self::auto`].
+    pub fn auto_with(
+        kind: StructureKind,
+        points: &[[f64; 3]],
+        given: &Given,
+        m2: u32,
+    ) -> Result<Self, DetectError> {
+        check_points(points)?;
+        let probe = Detector {
+            alpha: given.alpha.unwrap_or(1.0),
+            lambda2: given.lambda2.unwrap_or(1.0),
+            lambda3: given.lambda3.unwrap_or(1.0),
+            nb_c: given.min_size.unwrap_or(1),
+            ..Self::lines(1.0, 1.0, 1)
+        };
+        probe.check_values()?;
+        let e = estimate(kind, points, given, m2);
+        let mut d = match kind {
+            StructureKind::Lines => {
+                Self::lines(e.alpha.value, e.lambda3.value, e.min_size.value as u32)
+            }
+            StructureKind::Planes => Self::planes(
+                e.alpha.value,
+                e.lambda2.value,
+                e.lambda3.value,
+                e.min_size.value as u32,
+            ),
+        };
+        d.set = OrientationSet::Data(e.modes.clone());
+        d.estimate = Some(Box::new(e));
+        Ok(d)
+    }
+
     /// The orientation sampler (default: the paper's box sampler,
-    /// m1 = 0.3, m2 = 12).
+    /// m1 = 0.3, m2 = 12), over every point.
     pub fn sampler(mut self, sampler: Sampler) -> Self {
-        self.sampler = sampler;
+        self.set = OrientationSet::Sampler(sampler);
         self
     }
 
     /// Explicit rotations instead of a sampler (e.g. the identity alone,
     /// with λ = 1, for the Euclidean α-shape baseline).
     pub fn rotations(mut self, rotations: Vec<Mat3>) -> Self {
-        self.rotations = Some(rotations);
+        self.set = OrientationSet::Rotations(rotations);
+        self
+    }
+
+    /// The data orientation set of `points` (the modes of their local
+    /// normals or directions), with this detector's α and λ for every mode
+    /// (see [`Self::auto`] for estimated scales as well).
+    pub fn data_orientations(mut self, points: &[[f64; 3]], m2: u32) -> Self {
+        let given = Given {
+            alpha: Some(self.alpha),
+            lambda2: Some(self.lambda2),
+            lambda3: Some(self.lambda3),
+            min_size: Some(self.nb_c),
+        };
+        let e = estimate(self.kind, points, &given, m2);
+        let modes = e
+            .modes
+            .into_iter()
+            .map(|mut m| {
+                m.rotations = mode_rotations(self.kind, m.axis, self.lambda2, self.lambda3, m2);
+                m
+            })
+            .collect();
+        self.set = OrientationSet::Data(modes);
         self
     }
 
@@ -196,6 +320,29 @@ impl<'a> Detector<'a> {
         self
     }
 
+    /// The significance test's ε (default 1: keep parts with at most one
+    /// expected false alarm), or `None` to keep every part (the paper's
+    /// behaviour, nb_c alone).
+    pub fn significance(mut self, epsilon: Option<f64>) -> Self {
+        self.epsilon = epsilon;
+        self
+    }
+
+    /// Runs on this many threads (a pool of its own); default: rayon's
+    /// current pool (all cores).
+    pub fn threads(mut self, n: usize) -> Self {
+        self.threads = Some(n);
+        self
+    }
+
+    /// Cuts each orientation's points into tiles of this side (input
+    /// units) with halos (see [`super::scan`]): bounded memory, the same
+    /// result.
+    pub fn tile(mut self, side: Option<f64>) -> Self {
+        self.tile = side;
+        self
+    }
+
     /// A callback called after each orientation with (done, total); return
     /// `false` to cancel the run ([`DetectError::Cancelled`]). It is called
     /// from worker threads.
@@ -204,27 +351,75 @@ impl<'a> Detector<'a> {
         self
     }
 
+    /// Lines or planes.
+    pub fn kind(&self) -> StructureKind {
+        self.kind
+    }
+
+    /// α (the whole cloud's; with a data orientation set, modes have their
+    /// own, see [`Self::orientations`]).
+    pub fn alpha(&self) -> f64 {
+        self.alpha
+    }
+
+    /// (λ₂, λ₃).
+    pub fn lambdas(&self) -> (f64, f64) {
+        (self.lambda2, self.lambda3)
+    }
+
+    /// nb_c.
+    pub fn min_size(&self) -> u32 {
+        self.nb_c
+    }
+
+    /// The significance test's ε, if any.
+    pub fn epsilon(&self) -> Option<f64> {
+        self.epsilon
+    }
+
+    /// The orientation set.
+    pub fn orientations(&self) -> &OrientationSet {
+        &self.set
+    }
+
+    /// What [`Self::auto`] estimated, if it made this detector.
+    pub fn estimate(&self) -> Option<&Estimate> {
+        self.estimate.as_deref()
+    }
+
     /// The elongation E of the ellipsoids.
     pub fn elongation(&self) -> [f64; 3] {
-        match self.kind {
-            StructureKind::Lines => [1.0, 1.0, 1.0 / self.lambda3],
-            StructureKind::Planes => [1.0, 1.0 / self.lambda2, 1.0 / self.lambda3],
-        }
+        elongation(self.kind, self.lambda2, self.lambda3)
     }
 
-    /// The orientation set that [`Self::run`] scans.
+    /// The number of orientations [`Self::run`] scans.
+    ///
+    /// # Errors
+    /// Bad sampler parameters.
+    pub fn orientation_count(&self) -> Result<usize, DetectError> {
+        Ok(match &self.set {
+            OrientationSet::Data(m) => m.iter().map(|m| m.rotations.len()).sum(),
+            _ => self.orientation_set()?.len(),
+        })
+    }
+
+    /// The rotations [`Self::run`] scans (over every point, or per mode).
+    ///
+    /// # Errors
+    /// Bad sampler parameters.
     pub fn orientation_set(&self) -> Result<Vec<Mat3>, DetectError> {
-        match &self.rotations {
-            Some(r) => Ok(r.clone()),
-            None => Ok(orientations(
-                self.kind,
-                &self.sampler,
-                self.lambda2 == self.lambda3,
-            )?),
+        match &self.set {
+            OrientationSet::Rotations(r) => Ok(r.clone()),
+            OrientationSet::Sampler(s) => {
+                Ok(orientations(self.kind, s, self.lambda2 == self.lambda3)?)
+            }
+            OrientationSet::Data(m) => {
+                Ok(m.iter().flat_map(|m| m.rotations.iter().copied()).collect())
+            }
         }
     }
 
-    fn check(&self, points: &[[f64; 3]]) -> Result<(), DetectError> {
+    fn check_values(&self) -> Result<(), DetectError> {
         let bad = |m: String| Err(DetectError::BadParameter(m));
         if !(self.alpha.is_finite() && self.alpha > 0.0) {
             return bad(format!(
@@ -233,8 +428,11 @@ impl<'a> Detector<'a> {
             ));
         }
         for (name, l) in [("lambda2", self.lambda2), ("lambda3", self.lambda3)] {
-            if !(l.is_finite() && l > 0.0) {
-                return bad(format!("{name} must be positive and finite, got {l}"));
+            if !(l.is_finite() && (LAMBDA_RANGE.0..=LAMBDA_RANGE.1).contains(&l)) {
+                return bad(format!(
+                    "{name} must be between {} and {}, got {l}",
+                    LAMBDA_RANGE.0, LAMBDA_RANGE.1
+                ));
             }
         }
         if self.nb_c == 0 {
@@ -246,20 +444,18 @@ impl<'a> Detector<'a> {
                 self.part_angle_deg
             ));
         }
-        if points.is_empty() {
-            return Err(DetectError::Empty);
+        if let Some(e) = self.epsilon {
+            if !(e.is_finite() && e > 0.0) {
+                return bad(format!("epsilon must be positive and finite, got {e}"));
+            }
         }
-        if let Some(index) = points.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
-            return Err(DetectError::NonFinite { index });
+        if self.threads == Some(0) {
+            return bad("threads must be at least 1".into());
         }
-        // Tighter than the triangulation's range, so that every transformed
-        // point Q·p stays inside it (|Q·p| ≤ √3·max|p|; cancellation leaves
-        // either 0 or at least an ulp of the inputs).
-        if let Some(index) = points.iter().position(|p| {
-            p.iter()
-                .any(|c| c.abs() > 1e50 || (*c != 0.0 && c.abs() < 1e-30))
-        }) {
-            return Err(DetectError::OutOfRange { index });
+        if let Some(t) = self.tile {
+            if !(t.is_finite() && t > 0.0) {
+                return bad(format!("tile must be positive and finite, got {t}"));
+            }
         }
         Ok(())
     }
@@ -270,47 +466,114 @@ impl<'a> Detector<'a> {
     /// Bad parameters, empty input, non-finite coordinates, or a
     /// cancellation by the progress callback.
     pub fn run(&self, points: &[[f64; 3]]) -> Result<Detection, DetectError> {
-        self.check(points)?;
-        let rotations = self.orientation_set()?;
-        match self.kind {
-            StructureKind::Lines => self.run_k::<[u32; 2]>(points, &rotations),
-            StructureKind::Planes => self.run_k::<[u32; 3]>(points, &rotations),
+        self.check_values()?;
+        check_points(points)?;
+        let go = || match self.kind {
+            StructureKind::Lines => self.run_k::<[u32; 2]>(points),
+            StructureKind::Planes => self.run_k::<[u32; 3]>(points),
+        };
+        #[cfg(feature = "parallel")]
+        if let Some(n) = self.threads {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .map_err(|e| DetectError::Internal(format!("thread pool: {e}")))?;
+            return pool.install(go);
         }
+        go()
     }
 
-    fn run_k<S: Face>(
+    /// The jobs of the run and the scale of each group.
+    fn jobs<'p>(
         &self,
-        points: &[[f64; 3]],
+        modes: &'p [ModeScan],
         rotations: &[Mat3],
-    ) -> Result<Detection, DetectError> {
+    ) -> Result<(Vec<Job<'p>>, Vec<Scale>), DetectError> {
+        let scale = |kind: StructureKind, alpha: f64, l2: f64, l3: f64| Scale {
+            tau: alpha,
+            cell: alpha
+                * match kind {
+                    StructureKind::Lines => l3,
+                    StructureKind::Planes => l2.max(l3),
+                },
+        };
+        if !modes.is_empty() {
+            let mut jobs = Vec::new();
+            let mut scales = Vec::new();
+            for (g, m) in modes.iter().enumerate() {
+                let e = elongation(self.kind, m.lambda2, m.lambda3);
+                for r in &m.rotations {
+                    jobs.push(Job {
+                        anisotropy: Anisotropy::from_matrix_rows(*r, e)?,
+                        alpha: m.alpha,
+                        ids: Some(&m.points),
+                        group: g as u32,
+                    });
+                }
+                scales.push(scale(self.kind, m.alpha, m.lambda2, m.lambda3));
+            }
+            return Ok((jobs, scales));
+        }
         let e = self.elongation();
-        let anisotropies = rotations
+        let jobs = rotations
             .iter()
-            .map(|r| Anisotropy::from_matrix_rows(*r, e))
-            .collect::<Result<Vec<_>, _>>()?;
-        // Candidate pairs for the pruning, once for all orientations (unless
-        // there are too many: then each orientation grids its own points).
-        // The radii are inflated by 1e-9 so that rounding in the two ways of
-        // computing a distance never drops a point at exactly 2α.
-        let lmax = e.iter().map(|&x| 1.0 / x).fold(1.0, f64::max);
-        let radius = 2.0 * self.alpha * (1.0 + 1e-9);
-        let cands = if self.prune {
+            .map(|r| {
+                Ok(Job {
+                    anisotropy: Anisotropy::from_matrix_rows(*r, e)?,
+                    alpha: self.alpha,
+                    ids: None,
+                    group: 0,
+                })
+            })
+            .collect::<Result<Vec<_>, DetectError>>()?;
+        Ok((
+            jobs,
+            vec![scale(self.kind, self.alpha, self.lambda2, self.lambda3)],
+        ))
+    }
+
+    fn run_k<S: Face>(&self, points: &[[f64; 3]]) -> Result<Detection, DetectError> {
+        let (modes, rotations): (&[ModeScan], Vec<Mat3>) = match &self.set {
+            OrientationSet::Data(m) => (m.as_slice(), Vec::new()),
+            _ => (&[], self.orientation_set()?),
+        };
+        let (jobs, scales) = self.jobs(modes, &rotations)?;
+        if jobs.len() > MAX_ORIENTATIONS {
+            return Err(DetectError::BadParameter(format!(
+                "{} orientations: at most {MAX_ORIENTATIONS} (coarser --m1, fewer --m2, or a larger --step)",
+                jobs.len()
+            )));
+        }
+        // Candidate pairs for the pruning, once for all orientations over
+        // every point (unless there are too many).
+        let lmax = self
+            .elongation()
+            .iter()
+            .map(|&x| 1.0 / x)
+            .fold(1.0, f64::max);
+        let cands = if self.prune && modes.is_empty() {
+            let radius = 2.0 * self.alpha * (1.0 + RADIUS_SLACK);
             CandidatePairs::new(
                 points,
-                radius * lmax * (1.0 + 1e-9),
-                32 * points.len() + 1024,
+                radius * lmax * (1.0 + RADIUS_SLACK),
+                PAIRS_PER_POINT * points.len() + 1024,
             )
         } else {
             None
         };
+        let pruning = match (&cands, self.prune) {
+            (Some(c), _) => Pruning::Pairs(c),
+            (None, true) => Pruning::Grid,
+            (None, false) => Pruning::Off,
+        };
         let done = AtomicUsize::new(0);
         let cancelled = AtomicBool::new(false);
-        let total = anisotropies.len();
-        let one = |a: &Anisotropy| -> Result<OrientationResult<S>, DetectError> {
+        let total = jobs.len();
+        let one = |job: &Job<'_>| -> Result<JobResult<S>, DetectError> {
             if cancelled.load(Ordering::Relaxed) {
                 return Err(DetectError::Cancelled);
             }
-            let r = self.one_orientation::<S>(points, a, cands.as_ref(), radius);
+            let r = run_job::<S>(points, job, &pruning, self.tile, self.nb_c)?;
             let d = done.fetch_add(1, Ordering::Relaxed) + 1;
             if let Some(cb) = self.progress {
                 if !cb(d, total) {
@@ -320,13 +583,12 @@ impl<'a> Detector<'a> {
             Ok(r)
         };
         #[cfg(feature = "parallel")]
-        let per: Vec<Result<OrientationResult<S>, DetectError>> = {
+        let per: Vec<Result<JobResult<S>, DetectError>> = {
             use rayon::prelude::*;
-            anisotropies.par_iter().map(one).collect()
+            jobs.par_iter().map(one).collect()
         };
         #[cfg(not(feature = "parallel"))]
-        let per: Vec<Result<OrientationResult<S>, DetectError>> =
-            anisotropies.iter().map(one).collect();
+        let per: Vec<Result<JobResult<S>, DetectError>> = jobs.iter().map(one).collect();
         if cancelled.load(Ordering::Relaxed) {
             return Err(DetectError::Cancelled);
         }
@@ -334,127 +596,45 @@ impl<'a> Detector<'a> {
             orientations: total,
             ..RunStats::default()
         };
-        let mut union: Vec<S> = Vec::new();
-        for r in per {
+        let mut found: Vec<(u32, Vec<S>)> = Vec::with_capacity(per.len());
+        for (r, job) in per.into_iter().zip(&jobs) {
             let r = r?;
             stats.triangulated_points += r.triangulated as u64;
             stats.raw_simplices += r.raw as u64;
             stats.filtered_simplices += r.faces.len() as u64;
-            union.extend(r.faces);
+            found.push((job.group, r.faces));
         }
-        union.sort_unstable();
-        union.dedup();
-        stats.union_simplices = union.len();
-        let keep = component_size_mask(&union, self.nb_c).map_err(filter_bug)?;
-        let kept: Vec<S> = union
-            .iter()
-            .zip(&keep)
-            .filter_map(|(s, &k)| k.then_some(*s))
-            .collect();
+        let (all, groups) = union(found);
+        stats.union_simplices = all.len();
+        let keep = component_size_mask(&all, self.nb_c)?;
+        let mut kept = Vec::with_capacity(all.len());
+        let mut kept_groups = Vec::with_capacity(all.len());
+        for ((s, g), k) in all.into_iter().zip(groups).zip(keep) {
+            if k {
+                kept.push(s);
+                kept_groups.push(g);
+            }
+        }
         stats.kept_simplices = kept.len();
-        Ok(self.structures(points, kept, stats))
-    }
-
-    /// F_{k,α,Q} of one orientation, filtered, as sorted input-index
-    /// simplices.
-    /// F_{k,α,Q} of one orientation (unfiltered), as sorted input-index
-    /// simplices, and the number of points triangulated.
-    fn raw_faces<S: Face>(
-        &self,
-        points: &[[f64; 3]],
-        a: &Anisotropy,
-        cands: Option<&CandidatePairs>,
-        radius: f64,
-    ) -> (Vec<S>, usize) {
-        let alpha = self.alpha;
-        let (map, mut reduced): (Vec<u32>, Vec<[f64; 3]>) = match cands {
-            Some(c) => {
-                // The 1-core (non-isolated points). The 2-core is exact for
-                // k = 2 too and drops more background, but measured 4x
-                // slower on the Fig. 10 scene: what is left is then often a
-                // grid-sampled plane alone, a nearly flat set whose
-                // triangulation is all slivers and exact arithmetic.
-                let keep = c.non_isolated_under(points, &a.q(), radius);
-                let map: Vec<u32> = (0..points.len() as u32)
-                    .filter(|&i| keep[i as usize])
-                    .collect();
-                let kept: Vec<[f64; 3]> = map.iter().map(|&i| points[i as usize]).collect();
-                (map, a.transform(&kept))
-            }
-            None => {
-                let q = a.transform(points);
-                let keep = if self.prune {
-                    non_isolated(&q, radius)
-                } else {
-                    vec![true; q.len()]
-                };
-                let map: Vec<u32> = (0..q.len() as u32).filter(|&i| keep[i as usize]).collect();
-                let reduced = map.iter().map(|&i| q[i as usize]).collect();
-                (map, reduced)
-            }
+        let min_vertices = match self.kind {
+            StructureKind::Lines => self.nb_c as usize + 1,
+            StructureKind::Planes => (self.nb_c as usize / 2).max(4),
         };
-        let triangulated = reduced.len();
-        if reduced.len() < 2 {
-            return (Vec::new(), triangulated);
-        }
-        let n_real = map.len() as u32;
-        let mut tri = Triangulation::new(&reduced).ok();
-        if tri.as_ref().is_none_or(|t| t.dimension() < 3) {
-            // What is left is one clean plane or line (or a few points):
-            // four far sentinels around it make the set 3-dimensional. They
-            // are isolated (farther than 2α from everything), so F_α is
-            // unchanged.
-            let (lo, hi) = crate::geometry::bounding_box(&reduced);
-            let ext = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max) + 4.0 * alpha + 1.0;
-            let c = [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]));
-            // Distance from any point of the box to a sentinel: at least
-            // (√3/2)·ext > 2α. Not farther: far sentinels make slivers, which
-            // the exact arithmetic then pays for.
-            let d = ext;
-            for s in [
-                [1.0, 1.0, 1.0],
-                [1.0, -1.0, -1.0],
-                [-1.0, 1.0, -1.0],
-                [-1.0, -1.0, 1.0],
-            ] {
-                reduced.push([c[0] + d * s[0], c[1] + d * s[1], c[2] + d * s[2]]);
-            }
-            tri = Triangulation::new(&reduced).ok();
-        }
-        // (Triangulation errors are unreachable: the points are finite.)
-        let faces: Vec<S> = match tri {
-            Some(tri) => S::at(&tri, alpha)
-                .into_iter()
-                .filter(|f| f.as_ref().iter().all(|&v| v < n_real))
-                .map(|f| S::sorted(f.as_ref().iter().map(|&v| map[v as usize])))
-                .collect(),
-            None => Vec::new(),
+        let settings = Settings {
+            kind: self.kind,
+            part_angle_deg: self.part_angle_deg,
+            min_vertices,
+            scales,
+            log10_epsilon: self.epsilon.map(f64::log10),
+            orientations: total,
         };
-        (faces, triangulated)
-    }
-
-    /// F_{k,α,Q} of one orientation, path-filtered, with counters.
-    fn one_orientation<S: Face>(
-        &self,
-        points: &[[f64; 3]],
-        a: &Anisotropy,
-        cands: Option<&CandidatePairs>,
-        radius: f64,
-    ) -> OrientationResult<S> {
-        let (faces, triangulated) = self.raw_faces::<S>(points, a, cands, radius);
-        let raw = faces.len();
-        let faces = filter(&faces, self.nb_c).unwrap_or_default();
-        OrientationResult {
-            faces,
-            triangulated,
-            raw,
-        }
+        Ok(assemble::<S>(points, kept, kept_groups, &settings, stats)?.detection)
     }
 
     /// The anisotropic α-shape `F_{k,α,Q}(P)` of one orientation (rows of
     /// R), before the path filter: sorted simplices of input indices,
     /// ascending within each. This is what [`Self::run`] computes for each
-    /// orientation of its set, and a way to look at one of them.
+    /// orientation of a sampler, and a way to look at one of them.
     ///
     /// # Errors
     /// As [`Self::run`].
@@ -463,595 +643,65 @@ impl<'a> Detector<'a> {
         points: &[[f64; 3]],
         rotation: &Mat3,
     ) -> Result<Vec<Vec<u32>>, DetectError> {
-        self.check(points)?;
-        let a = Anisotropy::from_matrix_rows(*rotation, self.elongation())?;
-        let radius = 2.0 * self.alpha * (1.0 + 1e-9);
+        self.check_values()?;
+        check_points(points)?;
+        let job = Job {
+            anisotropy: Anisotropy::from_matrix_rows(*rotation, self.elongation())?,
+            alpha: self.alpha,
+            ids: None,
+            group: 0,
+        };
+        let pruning = if self.prune {
+            Pruning::Grid
+        } else {
+            Pruning::Off
+        };
         let mut out: Vec<Vec<u32>> = match self.kind {
-            StructureKind::Lines => self
-                .raw_faces::<[u32; 2]>(points, &a, None, radius)
-                .0
-                .iter()
-                .map(|f| f.to_vec())
-                .collect(),
-            StructureKind::Planes => self
-                .raw_faces::<[u32; 3]>(points, &a, None, radius)
-                .0
-                .iter()
-                .map(|f| f.to_vec())
-                .collect(),
+            StructureKind::Lines => {
+                super::scan::raw_faces::<[u32; 2]>(points, &job, &pruning, self.tile)?
+                    .0
+                    .iter()
+                    .map(|f| f.to_vec())
+                    .collect()
+            }
+            StructureKind::Planes => {
+                super::scan::raw_faces::<[u32; 3]>(points, &job, &pruning, self.tile)?
+                    .0
+                    .iter()
+                    .map(|f| f.to_vec())
+                    .collect()
+            }
         };
         out.sort_unstable();
         Ok(out)
     }
+}
 
-    fn structures<S: Face>(&self, points: &[[f64; 3]], kept: Vec<S>, stats: RunStats) -> Detection {
-        let n = points.len();
-        let comp = if kept.is_empty() {
-            Vec::new()
-        } else {
-            components(&kept).map_err(filter_bug).unwrap_or_default()
-        };
-        let n_comp = comp.iter().map(|&c| c as usize + 1).max().unwrap_or(0);
-        let mut comp_simplices: Vec<Vec<u32>> = vec![Vec::new(); n_comp];
-        for (s, &c) in comp.iter().enumerate() {
-            comp_simplices[c as usize].push(s as u32);
-        }
-        // Primitives, component by component.
-        let mut prims: Vec<Prim> = Vec::new();
-        for ss in &comp_simplices {
-            let local: Vec<S> = ss.iter().map(|&s| kept[s as usize]).collect();
-            self.extract::<S>(points, &local, &mut prims);
-        }
-        let groups = group_primitives(&prims, points);
-        // Structures: groups ordered by number of points (desc), then by
-        // smallest point, for deterministic ids.
-        let n_groups = groups.iter().map(|&g| g as usize + 1).max().unwrap_or(0);
-        let mut members: Vec<Vec<u32>> = vec![Vec::new(); n_groups];
-        for (p, &g) in groups.iter().enumerate() {
-            members[g as usize].push(p as u32);
-        }
-        let mut order: Vec<(usize, u32, usize)> = members
-            .iter()
-            .enumerate()
-            .map(|(g, ps)| {
-                let mut v: Vec<u32> = ps
-                    .iter()
-                    .flat_map(|&p| prims[p as usize].vertices.iter().copied())
-                    .collect();
-                v.sort_unstable();
-                v.dedup();
-                (v.len(), v.first().copied().unwrap_or(u32::MAX), g)
-            })
-            .collect();
-        order.sort_unstable_by(|a, b| b.0.cmp(&a.0).then(a.1.cmp(&b.1)));
-        // Vertex -> structure (the largest, i.e. the smallest id).
-        let mut vstruct = vec![u32::MAX; n];
-        let mut structures: Vec<Structure> = Vec::with_capacity(order.len());
-        for (id, &(_, _, g)) in order.iter().enumerate() {
-            let mut parts: Vec<Part> = members[g]
-                .iter()
-                .map(|&p| Part {
-                    simplices: Vec::new(),
-                    vertices: prims[p as usize].vertices.clone(),
-                    primitive: prims[p as usize].fit.clone(),
-                })
-                .collect();
-            parts.sort_by(|a, b| {
-                b.vertices
-                    .len()
-                    .cmp(&a.vertices.len())
-                    .then(a.vertices.first().cmp(&b.vertices.first()))
-            });
-            let mut v: Vec<u32> = parts
-                .iter()
-                .flat_map(|p| p.vertices.iter().copied())
-                .collect();
-            v.sort_unstable();
-            v.dedup();
-            for &x in &v {
-                if vstruct[x as usize] == u32::MAX {
-                    vstruct[x as usize] = id as u32;
-                }
-            }
-            structures.push(Structure {
-                id: id as u32,
-                simplices: Vec::new(),
-                primitive: S::fit(points, &v),
-                vertices: v,
-                parts,
-            });
-        }
-        // Simplices: kept when all their vertices lie on one structure
-        // (bridging simplices between two separate structures are dropped);
-        // within it, the part holding all its vertices if there is one.
-        let mut simplices: Vec<Vec<u32>> = Vec::new();
-        let mut simplex_structure: Vec<u32> = Vec::new();
-        for s in &kept {
-            let vs = s.as_ref();
-            let cand = vs
-                .iter()
-                .map(|&v| vstruct[v as usize])
-                .min()
-                .unwrap_or(u32::MAX);
-            if cand == u32::MAX {
-                continue;
-            }
-            let st = &mut structures[cand as usize];
-            if !vs.iter().all(|v| st.vertices.binary_search(v).is_ok()) {
-                continue;
-            }
-            let idx = simplices.len() as u32;
-            if let Some(p) = st
-                .parts
-                .iter_mut()
-                .find(|p| vs.iter().all(|v| p.vertices.binary_search(v).is_ok()))
-            {
-                p.simplices.push(idx);
-            }
-            st.simplices.push(idx);
-            simplices.push(vs.to_vec());
-            simplex_structure.push(cand);
-        }
-        // Simplices refer to first occurrences only: duplicates take their
-        // first occurrence's label.
-        let first_occurrence = first_occurrences(points);
-        let labels: Vec<i64> = first_occurrence
-            .iter()
-            .map(|&f| match vstruct[f as usize] {
-                u32::MAX => -1,
-                s => s as i64,
-            })
-            .collect();
-        let mut stats = stats;
-        stats.structure_simplices = simplices.len();
-        Detection {
-            kind: self.kind,
-            simplices,
-            simplex_structure,
-            structures,
-            labels,
-            first_occurrence,
-            stats,
-        }
-    }
-
-    /// Greedy extraction of straight/flat primitives from one connected
-    /// component of the union. Candidates are the least-squares fits of its
-    /// parts (regions of like-oriented simplices, [`super::parts`]); the
-    /// candidate covering the most not-yet-covered vertices within
-    /// distance α (the short semi-axis of the ellipsoid, so the points of a
-    /// detected structure lie within it) is refitted on its inliers and
-    /// taken, until no candidate covers enough new vertices. A vertex may
-    /// belong to several primitives (where planes meet or lines cross).
-    fn extract<S: Face>(&self, points: &[[f64; 3]], local: &[S], out: &mut Vec<Prim>) {
-        let mut verts: Vec<u32> = local.iter().flat_map(|s| s.as_ref().to_vec()).collect();
-        verts.sort_unstable();
-        verts.dedup();
-        let min_vertices = match self.kind {
-            StructureKind::Lines => self.nb_c as usize + 1,
-            StructureKind::Planes => (self.nb_c as usize / 2).max(4),
-        };
-        if verts.len() < min_vertices {
-            return;
-        }
-        let tol = self.alpha;
-        let part =
-            S::parts(points, local, self.part_angle_deg).unwrap_or_else(|_| vec![0; local.len()]);
-        let n_parts = part.iter().map(|&p| p as usize + 1).max().unwrap_or(0);
-        let mut pv: Vec<Vec<u32>> = vec![Vec::new(); n_parts];
-        for (s, &p) in local.iter().zip(&part) {
-            pv[p as usize].extend_from_slice(s.as_ref());
-        }
-        // Candidates: parts with at least two simplices' worth of points,
-        // largest first, at most 64 of them; plus the whole component.
-        let mut cands: Vec<Primitive> = Vec::new();
-        let mut by_size: Vec<(usize, usize)> = pv
-            .iter_mut()
-            .enumerate()
-            .map(|(i, v)| {
-                v.sort_unstable();
-                v.dedup();
-                (v.len(), i)
-            })
-            .collect();
-        by_size.sort_unstable_by(|a, b| b.0.cmp(&a.0).then(a.1.cmp(&b.1)));
-        for &(sz, i) in by_size.iter().take(64) {
-            if sz >= S::K + 2 {
-                cands.push(S::fit(points, &pv[i]));
-            }
-        }
-        cands.push(S::fit(points, &verts));
-        let mut covered = vec![false; verts.len()];
-        loop {
-            let mut best: Option<(usize, usize)> = None; // (new inliers, candidate)
-            for (ci, c) in cands.iter().enumerate() {
-                let new = verts
-                    .iter()
-                    .zip(&covered)
-                    .filter(|(&v, &cov)| !cov && distance(c, &points[v as usize]) <= tol)
-                    .count();
-                if best.is_none_or(|b| new > b.0) {
-                    best = Some((new, ci));
-                }
-            }
-            let Some((new, ci)) = best else { break };
-            if new < min_vertices {
-                break;
-            }
-            // Refit on all inliers of the component, twice.
-            let mut fit = cands.swap_remove(ci);
-            let inliers = |fit: &Primitive| -> Vec<u32> {
-                verts
-                    .iter()
-                    .copied()
-                    .filter(|&v| distance(fit, &points[v as usize]) <= tol)
-                    .collect()
-            };
-            for _ in 0..2 {
-                let refit = S::fit(points, &inliers(&fit));
-                if matches!(refit, Primitive::None) {
-                    break;
-                }
-                fit = refit;
-            }
-            let inl = inliers(&fit);
-            let mut gained = 0;
-            for (k, &v) in verts.iter().enumerate() {
-                if !covered[k] && inl.binary_search(&v).is_ok() {
-                    covered[k] = true;
-                    gained += 1;
-                }
-            }
-            if gained < min_vertices || inl.len() < min_vertices {
-                break;
-            }
-            out.push(Prim { vertices: inl, fit });
-        }
+/// The elongation E for λ₂, λ₃.
+fn elongation(kind: StructureKind, lambda2: f64, lambda3: f64) -> [f64; 3] {
+    match kind {
+        StructureKind::Lines => [1.0, 1.0, 1.0 / lambda3],
+        StructureKind::Planes => [1.0, 1.0 / lambda2, 1.0 / lambda3],
     }
 }
 
-/// An extracted primitive: its inlier points and its fit.
-struct Prim {
-    vertices: Vec<u32>,
-    fit: Primitive,
-}
-
-/// Distance from a point to a fitted line or plane (∞ for no fit).
-fn distance(fit: &Primitive, p: &[f64; 3]) -> f64 {
-    match fit {
-        Primitive::Plane(f) => dot(sub(*p, f.centroid), f.normal).abs(),
-        Primitive::Line(f) => {
-            let w = sub(*p, f.centroid);
-            let t = dot(w, f.direction);
-            let r = [
-                w[0] - t * f.direction[0],
-                w[1] - t * f.direction[1],
-                w[2] - t * f.direction[2],
-            ];
-            dot(r, r).sqrt()
-        }
-        Primitive::None => f64::INFINITY,
+/// Input checks: not empty, finite, in the range of exact arithmetic.
+fn check_points(points: &[[f64; 3]]) -> Result<(), DetectError> {
+    if points.is_empty() {
+        return Err(DetectError::Empty);
     }
-}
-
-/// Groups primitives into structures: two primitives sharing points are
-/// facets of one structure (a polyhedral surface, a bent line) unless one
-/// passes through the other's interior (crossing lines, planes cutting
-/// each other, a T-junction). Returns a group id per primitive.
-fn group_primitives(prims: &[Prim], points: &[[f64; 3]]) -> Vec<u32> {
-    let n = prims.len();
-    let mut uf: Vec<u32> = (0..n as u32).collect();
-    fn find(uf: &mut [u32], mut x: u32) -> u32 {
-        while uf[x as usize] != x {
-            uf[x as usize] = uf[uf[x as usize] as usize];
-            x = uf[x as usize];
-        }
-        x
+    if let Some(index) = points.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+        return Err(DetectError::NonFinite { index });
     }
-    let mut vp: Vec<(u32, u32)> = Vec::new();
-    for (p, pr) in prims.iter().enumerate() {
-        vp.extend(pr.vertices.iter().map(|&v| (v, p as u32)));
+    // Tighter than the triangulation's range, so that every transformed
+    // point Q·p stays inside it (|Q·p| ≤ √3·max|p|·max e, with λ within
+    // LAMBDA_RANGE; cancellation leaves either 0 or at least an ulp of the
+    // inputs).
+    if let Some(index) = points.iter().position(|p| {
+        p.iter()
+            .any(|c| c.abs() > 1e50 || (*c != 0.0 && c.abs() < 1e-30))
+    }) {
+        return Err(DetectError::OutOfRange { index });
     }
-    vp.sort_unstable();
-    let mut pairs: Vec<(u32, u32)> = Vec::new();
-    let mut i = 0;
-    while i < vp.len() {
-        let mut j = i + 1;
-        while j < vp.len() && vp[j].0 == vp[i].0 {
-            j += 1;
-        }
-        for a in i..j {
-            for b in a + 1..j {
-                pairs.push((vp[a].1, vp[b].1));
-            }
-        }
-        i = j;
-    }
-    pairs.sort_unstable();
-    pairs.dedup();
-    for &(a, b) in &pairs {
-        let (pa, pb) = (&prims[a as usize], &prims[b as usize]);
-        if !crosses(&pa.fit, &pb.vertices, points) && !crosses(&pb.fit, &pa.vertices, points) {
-            let (ra, rb) = (find(&mut uf, a), find(&mut uf, b));
-            if ra != rb {
-                uf[ra.max(rb) as usize] = ra.min(rb);
-            }
-        }
-    }
-    let roots: Vec<u32> = (0..n as u32).map(|p| find(&mut uf, p)).collect();
-    let mut dense = vec![u32::MAX; n];
-    let mut next = 0;
-    roots
-        .iter()
-        .map(|&r| {
-            if dense[r as usize] == u32::MAX {
-                dense[r as usize] = next;
-                next += 1;
-            }
-            dense[r as usize]
-        })
-        .collect()
-}
-
-fn filter_bug(e: FilterError) -> DetectError {
-    DetectError::BadParameter(format!("internal filter error: {e}"))
-}
-
-/// Whether the primitive `fit` (of part A) passes through the interior of
-/// part B (given by its vertices): B has a substantial share of its
-/// vertices strictly on each side. For a plane, the sides of the plane;
-/// for a line, the two sides of the point of B's line closest to it, along
-/// B's direction (a line through B's middle).
-fn crosses(fit: &Primitive, b: &[u32], points: &[[f64; 3]]) -> bool {
-    if b.len() < 4 {
-        return false;
-    }
-    let side = |d: f64, tol: f64| {
-        if d > tol {
-            1
-        } else if d < -tol {
-            -1
-        } else {
-            0
-        }
-    };
-    let (pos, neg) = match fit {
-        Primitive::Plane(pf) => {
-            let tol = 3.0 * pf.rms_residual + 1e-9 * (pf.extent[0] + pf.extent[1]);
-            let mut c = (0, 0);
-            for &v in b {
-                let p = points[v as usize];
-                let d = (0..3)
-                    .map(|k| (p[k] - pf.centroid[k]) * pf.normal[k])
-                    .sum::<f64>();
-                match side(d, tol) {
-                    1 => c.0 += 1,
-                    -1 => c.1 += 1,
-                    _ => {}
-                }
-            }
-            c
-        }
-        Primitive::Line(la) => {
-            // B's own line: its centroid and direction from B's vertices.
-            let bv: Vec<[f64; 3]> = b.iter().map(|&v| points[v as usize]).collect();
-            let Ok(lb) = super::fit::fit_line(&bv) else {
-                return false;
-            };
-            // Point of line B closest to line A.
-            let w = sub(lb.centroid, la.centroid);
-            let (u, v) = (la.direction, lb.direction);
-            let (a_, b_, c_) = (dot(u, u), dot(u, v), dot(v, v));
-            let (d_, e_) = (dot(u, w), dot(v, w));
-            let den = a_ * c_ - b_ * b_;
-            if den.abs() < 1e-12 {
-                return false; // parallel: no crossing
-            }
-            let t = (b_ * d_ - a_ * e_) / den; // parameter along B
-            let tol = 0.05 * lb.extent.max(1e-12);
-            let mut c = (0, 0);
-            for p in &bv {
-                match side(dot(sub(*p, lb.centroid), v) - t, tol) {
-                    1 => c.0 += 1,
-                    -1 => c.1 += 1,
-                    _ => {}
-                }
-            }
-            c
-        }
-        Primitive::None => return false,
-    };
-    let m = b.len();
-    pos.min(neg) * 5 >= m // at least 20% on each side
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-/// Per point, the index of the first point with the same coordinates
-/// (itself when no earlier point has them).
-fn first_occurrences(points: &[[f64; 3]]) -> Vec<u32> {
-    let mut first: Vec<u32> = (0..points.len() as u32).collect();
-    let mut idx = first.clone();
-    // A stable sort: each run of equal points starts with its first index.
-    idx.sort_by(|&a, &b| {
-        points[a as usize]
-            .partial_cmp(&points[b as usize])
-            .unwrap_or(std::cmp::Ordering::Equal)
-    });
-    for w in idx.windows(2) {
-        if points[w[1] as usize] == points[w[0] as usize] {
-            first[w[1] as usize] = first[w[0] as usize];
-        }
-    }
-    first
-}
-
-struct OrientationResult<S> {
-    faces: Vec<S>,
-    triangulated: usize,
-    raw: usize,
-}
-
-/// A simplex kind the detector works with: edges (k = 1) or triangles
-/// (k = 2).
-trait Face: Simplex + AsRef<[u32]> + Send + Sync + 'static {
-    /// The simplex dimension.
-    const K: usize;
-    fn at(tri: &Triangulation, alpha: f64) -> Vec<Self>;
-    fn sorted(v: impl Iterator<Item = u32>) -> Self;
-    fn parts(points: &[[f64; 3]], s: &[Self], angle: f64) -> Result<Vec<u32>, PartsError>;
-    fn fit(points: &[[f64; 3]], vertices: &[u32]) -> Primitive;
-}
-
-impl Face for [u32; 2] {
-    const K: usize = 1;
-    fn at(tri: &Triangulation, alpha: f64) -> Vec<Self> {
-        super::faces::edges_at(tri, alpha)
-    }
-    fn sorted(mut v: impl Iterator<Item = u32>) -> Self {
-        let mut s = [v.next().unwrap_or(0), v.next().unwrap_or(0)];
-        s.sort_unstable();
-        s
-    }
-    fn parts(points: &[[f64; 3]], s: &[Self], angle: f64) -> Result<Vec<u32>, PartsError> {
-        linear_parts(points, s, angle)
-    }
-    fn fit(points: &[[f64; 3]], vertices: &[u32]) -> Primitive {
-        fit_line_indices(points, vertices).map_or(Primitive::None, Primitive::Line)
-    }
-}
-
-impl Face for [u32; 3] {
-    const K: usize = 2;
-    fn at(tri: &Triangulation, alpha: f64) -> Vec<Self> {
-        super::faces::triangles_at(tri, alpha)
-    }
-    fn sorted(mut v: impl Iterator<Item = u32>) -> Self {
-        let mut s = [
-            v.next().unwrap_or(0),
-            v.next().unwrap_or(0),
-            v.next().unwrap_or(0),
-        ];
-        s.sort_unstable();
-        s
-    }
-    fn parts(points: &[[f64; 3]], s: &[Self], angle: f64) -> Result<Vec<u32>, PartsError> {
-        planar_parts(points, s, angle)
-    }
-    fn fit(points: &[[f64; 3]], vertices: &[u32]) -> Primitive {
-        fit_plane_indices(points, vertices).map_or(Primitive::None, Primitive::Plane)
-    }
-}
-
-/// A fitted primitive.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Primitive {
-    /// A least-squares line (k = 1).
-    Line(LineFit),
-    /// A least-squares plane (k = 2).
-    Plane(PlaneFit),
-    /// Too few or degenerate points to fit.
-    None,
-}
-
-/// A straight or flat piece of a structure.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Part {
-    /// Indices into [`Detection::simplices`].
-    pub simplices: Vec<u32>,
-    /// Input indices of its points, ascending.
-    pub vertices: Vec<u32>,
-    /// Its least-squares line or plane.
-    pub primitive: Primitive,
-}
-
-/// A detected structure: a line, a plane, or a polyhedral surface (several
-/// flat parts meeting along their boundaries).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Structure {
-    /// Its id (0 = largest), as used in [`Detection::labels`].
-    pub id: u32,
-    /// Indices into [`Detection::simplices`].
-    pub simplices: Vec<u32>,
-    /// Input indices of its points, ascending.
-    pub vertices: Vec<u32>,
-    /// Least-squares line (k = 1) or plane (k = 2) of all its points.
-    pub primitive: Primitive,
-    /// Its straight or flat parts, largest first (one for a plain line or
-    /// plane; the facets of a polyhedral surface).
-    pub parts: Vec<Part>,
-}
-
-/// Counters of a run.
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
-pub struct RunStats {
-    /// Orientations scanned.
-    pub orientations: usize,
-    /// Points triangulated, summed over orientations (after pruning).
-    pub triangulated_points: u64,
-    /// Simplices of `F_{k,α,Q}` before the path filter, summed.
-    pub raw_simplices: u64,
-    /// Simplices after the path filter, summed over orientations.
-    pub filtered_simplices: u64,
-    /// Distinct simplices in the union.
-    pub union_simplices: usize,
-    /// Simplices left after the component clean-up.
-    pub kept_simplices: usize,
-    /// Simplices of the reported structures (bridging simplices between
-    /// separate structures and simplices off every primitive dropped).
-    pub structure_simplices: usize,
-}
-
-/// The result of [`Detector::run`].
-#[derive(Debug, Clone, PartialEq)]
-pub struct Detection {
-    /// Lines (k = 1) or planes (k = 2).
-    pub kind: StructureKind,
-    /// The simplices of the structures: vertex index pairs (k = 1) or
-    /// triples (k = 2), ascending within each, sorted.
-    pub simplices: Vec<Vec<u32>>,
-    /// The structure of each simplex.
-    pub simplex_structure: Vec<u32>,
-    /// The structures, largest first.
-    pub structures: Vec<Structure>,
-    /// Per input point: the id of the largest structure containing it, or
-    /// −1 (background). An exact duplicate has its first occurrence's.
-    pub labels: Vec<i64>,
-    /// Per input point: the index of the first input point with the same
-    /// coordinates (itself when no earlier point has them). Simplices,
-    /// structures and parts list first occurrences only (SPEC §7).
-    pub first_occurrence: Vec<u32>,
-    /// Counters.
-    pub stats: RunStats,
-}
-
-impl Detection {
-    /// Per input point: the global id of the largest part containing it
-    /// (parts numbered structure by structure, largest first), or −1. An
-    /// exact duplicate has its first occurrence's.
-    pub fn part_labels(&self) -> Vec<i64> {
-        let mut labels = vec![-1i64; self.labels.len()];
-        let mut best = vec![0usize; self.labels.len()];
-        let mut id = 0i64;
-        for st in &self.structures {
-            for p in &st.parts {
-                for &v in &p.vertices {
-                    if p.simplices.len() > best[v as usize] {
-                        best[v as usize] = p.simplices.len();
-                        labels[v as usize] = id;
-                    }
-                }
-                id += 1;
-            }
-        }
-        for (i, &f) in self.first_occurrence.iter().enumerate() {
-            labels[i] = labels[f as usize];
-        }
-        labels
-    }
+    Ok(())
 }

@@ -9,17 +9,32 @@
 //!   labelling;
 //! * [`faces`]: `F_{k,α}` at one α straight from a triangulation;
 //! * [`prune`]: exact removal of points isolated at distance 2α;
-//! * [`detector`]: the whole §4 pipeline over many orientations.
+//! * [`local`], [`modes`], [`estimate`]: the local shape of the cloud, the
+//!   modes of its normals or directions, and the parameters and data
+//!   orientation set estimated from them (method doc §8);
+//! * `scan`: the orientation scan (per orientation `F_{k,α,Q}`, tiles with
+//!   halos, path filter, union);
+//! * `assemble`: structures and disjoint parts from the union, with
+//!   [`outline`] (outlines and meshes of planar parts) and [`significance`]
+//!   (the a-contrario test);
+//! * [`detection`]: the result types;
+//! * [`detector`]: the parameters and the run that chains the steps.
 
+mod assemble;
+pub mod detection;
 pub mod detector;
+pub mod estimate;
 pub mod faces;
 pub mod filter;
 pub mod fit;
 pub mod local;
 pub mod modes;
 pub mod orientations;
+pub mod outline;
 pub mod parts;
 pub mod prune;
+mod scan;
+pub mod significance;
 
 /// Which structures are sought: k = 1 (lines, edges) or k = 2 (planes,
 /// triangles).

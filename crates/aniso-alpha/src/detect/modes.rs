@@ -37,7 +37,11 @@
 use crate::geometry::kdtree::KdTree;
 
 /// Samples used for the mode search at most.
-pub const MAX_SAMPLES: usize = 20_000;
+///
+/// 4,000 samples resolve a mode of 0.25% of the axes with 10 samples, and
+/// keep the search (quadratic in the samples within a kernel) far below
+/// the cost of one triangulation.
+pub const MAX_SAMPLES: usize = 4_000;
 
 /// A mode of a distribution of axes.
 #[derive(Debug, Clone, Copy, PartialEq)]

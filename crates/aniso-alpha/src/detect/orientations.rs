@@ -70,6 +70,10 @@ use std::fmt;
 
 /// Smallest accepted box spacing m1 (keeps the sample count below ~10⁵).
 pub const MIN_M1: f64 = 0.01;
+/// Largest accepted orientation set (72 MB of rotations; a detection runs
+/// one triangulation per orientation). Checked before anything is
+/// allocated: `--m2 100000000` once asked for 1.17 TB.
+pub const MAX_ORIENTATIONS: usize = 1_000_000;
 /// Smallest accepted Fibonacci step in degrees.
 pub const MIN_STEP_DEGREES: f64 = 0.5;
 /// Two unit vectors closer than this (max coordinate difference) are one
@@ -110,6 +114,13 @@ pub enum OrientationError {
     BadM2(u32),
     /// The step is NaN, infinite, below [`MIN_STEP_DEGREES`] or above 180°.
     BadStep(f64),
+    /// The set would hold more than [`MAX_ORIENTATIONS`] orientations.
+    TooMany {
+        /// Axes sampled.
+        axes: usize,
+        /// Rotations about each axis (m2, or the Fibonacci m_θ).
+        per_axis: usize,
+    },
 }
 
 impl fmt::Display for OrientationError {
@@ -120,6 +131,12 @@ impl fmt::Display for OrientationError {
             Self::BadStep(s) => write!(
                 f,
                 "angular step = {s}° must be finite, ≥ {MIN_STEP_DEGREES}° and ≤ 180°"
+            ),
+            Self::TooMany { axes, per_axis } => write!(
+                f,
+                "{axes} axes × {per_axis} rotations = {} orientations, more than the limit of \
+                 {MAX_ORIENTATIONS}",
+                (*axes as u128) * (*per_axis as u128)
             ),
         }
     }
@@ -263,6 +280,7 @@ pub fn orientations(
                     if m2 == 0 {
                         return Err(OrientationError::BadM2(m2));
                     }
+                    too_many(angles.len(), m2 as usize)?;
                     let mut out = Vec::with_capacity(angles.len() * m2 as usize);
                     for &(psi, phi) in &angles {
                         for j in 1..=m2 {
@@ -284,6 +302,7 @@ pub fn orientations(
                     } else {
                         (180.0 / step_degrees).ceil().max(1.0) as usize
                     };
+                    too_many(dirs.len(), m_theta)?;
                     let mut out = Vec::with_capacity(dirs.len() * m_theta);
                     for &n in &dirs {
                         let [n, a, b] = completion_first_row(n); // n × a = b
@@ -306,6 +325,19 @@ pub fn orientations(
                 }
             }
         }
+    }
+}
+
+/// [`OrientationError::TooMany`] when `axes × per_axis` exceeds
+/// [`MAX_ORIENTATIONS`].
+fn too_many(axes: usize, per_axis: usize) -> Result<(), OrientationError> {
+    if axes
+        .checked_mul(per_axis)
+        .is_none_or(|n| n > MAX_ORIENTATIONS)
+    {
+        Err(OrientationError::TooMany { axes, per_axis })
+    } else {
+        Ok(())
     }
 }
 
@@ -463,5 +495,40 @@ mod tests {
             eprintln!("fibonacci {step}°: {} axes, gap {g:.2}°", dirs.len());
             assert!(g > lo && g < hi, "step {step}: gap {g}");
         }
+    }
+
+    #[test]
+    fn huge_sets_are_refused_before_allocation() {
+        let e = orientations(
+            StructureKind::Planes,
+            &Sampler::Box {
+                m1: 0.3,
+                m2: 100_000_000,
+            },
+            false,
+        )
+        .unwrap_err();
+        assert_eq!(
+            e,
+            OrientationError::TooMany {
+                axes: 162,
+                per_axis: 100_000_000
+            }
+        );
+        assert!(e.to_string().contains("16200000000 orientations"), "{e}");
+        let ok = orientations(
+            StructureKind::Planes,
+            &Sampler::Box { m1: 0.3, m2: 6000 },
+            false,
+        );
+        assert_eq!(ok.unwrap().len(), 162 * 6000);
+        assert!(orientations(
+            StructureKind::Planes,
+            &Sampler::Fibonacci {
+                step_degrees: MIN_STEP_DEGREES
+            },
+            false
+        )
+        .is_err());
     }
 }

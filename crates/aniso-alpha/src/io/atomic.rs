@@ -1,14 +1,34 @@
-//! Atomic outputs: complete or absent.
+//! Atomic outputs: complete or absent, and never in place of something
+//! that is not a regular file.
+//!
+//! * An output is written to a temporary file `.<name>.tmp-<pid>-<n>` in
+//!   the target's folder and renamed onto the target when complete.
+//! * An existing output that is not a regular file (a device node such as
+//!   `/dev/null`, a FIFO, a socket) is refused: a rename would replace it.
+//! * A symbolic link is followed deliberately: the file it points to (at
+//!   the end of the chain, which may not exist yet) is the one written,
+//!   atomically, in its own folder, and the link stays a link. The file's
+//!   permissions are kept.
+//! * Every temporary file is listed in a process-wide registry while it
+//!   exists; [`remove_temp_files`] deletes them (the CLI calls it from its
+//!   SIGINT/SIGTERM handler) and refuses new ones from then on.
 
 use std::fs::{self, File, OpenOptions};
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Mutex;
 
 use super::IoError;
 
 /// Size of the write buffer of [`atomic_write`].
 const BUFFER: usize = 1 << 20;
+
+/// Symbolic links followed at most (as the kernel's ELOOP limit).
+const MAX_LINKS: usize = 40;
+
+/// Temporary files that exist now, and whether new ones are refused.
+static TEMPS: Mutex<(Vec<PathBuf>, bool)> = Mutex::new((Vec::new(), false));
 
 /// The folder an output file goes into (`.` for a bare file name).
 fn output_folder(path: &Path) -> PathBuf {
@@ -18,9 +38,94 @@ fn output_folder(path: &Path) -> PathBuf {
     }
 }
 
-/// Checks that `path` can be an output: its folder exists and it is not
-/// itself a directory. Call it before long computations so that a typo in
-/// an output path fails at once. [`atomic_write`] checks it again.
+/// The file an output path writes: `path` itself, or the end of its chain
+/// of symbolic links (which need not exist yet).
+///
+/// ```
+/// use aniso_alpha::io::resolve_output;
+/// use std::path::Path;
+/// assert_eq!(resolve_output(Path::new("no/such/link")).unwrap(), Path::new("no/such/link"));
+/// ```
+pub fn resolve_output(path: &Path) -> Result<PathBuf, IoError> {
+    let mut p = path.to_path_buf();
+    for _ in 0..MAX_LINKS {
+        match fs::symlink_metadata(&p) {
+            Ok(m) if m.file_type().is_symlink() => {
+                let target = fs::read_link(&p).map_err(|source| IoError::Write {
+                    path: path.to_path_buf(),
+                    source,
+                })?;
+                p = if target.is_absolute() {
+                    target
+                } else {
+                    output_folder(&p).join(target)
+                };
+            }
+            _ => return Ok(p),
+        }
+    }
+    Err(IoError::Write {
+        path: path.to_path_buf(),
+        source: std::io::Error::other("too many levels of symbolic links"),
+    })
+}
+
+/// What a non-regular, non-directory file is, for error messages.
+fn kind_of(meta: &fs::Metadata) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        let t = meta.file_type();
+        if t.is_char_device() {
+            return "a character device";
+        }
+        if t.is_block_device() {
+            return "a block device";
+        }
+        if t.is_fifo() {
+            return "a FIFO (named pipe)";
+        }
+        if t.is_socket() {
+            return "a socket";
+        }
+    }
+    let _ = meta;
+    "a special file"
+}
+
+/// Resolves `path` ([`resolve_output`]) and checks the result can be
+/// replaced: its folder exists, and it is absent or a regular file.
+fn checked_target(path: &Path) -> Result<PathBuf, IoError> {
+    if path.file_name().is_none() {
+        return Err(IoError::IsDirectory {
+            path: path.to_path_buf(),
+        });
+    }
+    let target = resolve_output(path)?;
+    let folder = output_folder(&target);
+    if !folder.is_dir() {
+        return Err(IoError::MissingFolder {
+            folder,
+            path: path.to_path_buf(),
+        });
+    }
+    match fs::metadata(&target) {
+        Ok(m) if m.is_dir() => Err(IoError::IsDirectory {
+            path: path.to_path_buf(),
+        }),
+        Ok(m) if !m.is_file() => Err(IoError::NotRegularFile {
+            path: target,
+            kind: kind_of(&m),
+        }),
+        _ => Ok(target),
+    }
+}
+
+/// Checks that `path` can be an output: its folder exists and can be
+/// written into (a probe file is created and removed), and it is absent or
+/// a regular file (after following symbolic links), not a directory, a
+/// device node or a FIFO. Call it before long computations so that a bad
+/// output path fails at once. [`atomic_write`] checks it again.
 ///
 /// ```
 /// use aniso_alpha::io::{check_output_path, IoError};
@@ -28,34 +133,139 @@ fn output_folder(path: &Path) -> PathBuf {
 /// let err = check_output_path(Path::new("/no/such/folder/out.ply")).unwrap_err();
 /// assert!(matches!(err, IoError::MissingFolder { .. }));
 /// assert!(err.to_string().contains("/no/such/folder"));
+/// # #[cfg(unix)]
+/// let err = check_output_path(Path::new("/dev/null")).unwrap_err();
+/// # #[cfg(unix)]
+/// assert!(err.to_string().contains("not a regular file"), "{err}");
 /// ```
 pub fn check_output_path(path: &Path) -> Result<(), IoError> {
-    let folder = output_folder(path);
-    if !folder.is_dir() {
-        return Err(IoError::MissingFolder {
+    let target = checked_target(path)?;
+    let folder = output_folder(&target);
+    let probe = temp_name(&target, "probe");
+    match OpenOptions::new().write(true).create_new(true).open(&probe) {
+        Ok(f) => {
+            drop(f);
+            let _ = fs::remove_file(&probe);
+            Ok(())
+        }
+        Err(source) => Err(IoError::NotWritable {
             folder,
             path: path.to_path_buf(),
-        });
+            source,
+        }),
     }
-    if path.is_dir() || path.file_name().is_none() {
-        return Err(IoError::IsDirectory {
-            path: path.to_path_buf(),
-        });
-    }
-    Ok(())
 }
 
-/// Removes the temporary file unless it was renamed.
+/// Whether `a` and `b` name the same existing file (same device and inode
+/// on Unix, same canonical path elsewhere), through links of any kind.
+///
+/// ```
+/// use aniso_alpha::io::same_file;
+/// use std::path::Path;
+/// let me = Path::new(env!("CARGO_MANIFEST_DIR")).join("Cargo.toml");
+/// assert!(same_file(&me, &me.parent().unwrap().join(".").join("Cargo.toml")));
+/// assert!(!same_file(&me, Path::new("/no/such/file")));
+/// ```
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    let (Ok(ma), Ok(mb)) = (fs::metadata(a), fs::metadata(b)) else {
+        return false;
+    };
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        let _ = (&ma, &mb);
+        ma.dev() == mb.dev() && ma.ino() == mb.ino()
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = (ma, mb);
+        matches!((fs::canonicalize(a), fs::canonicalize(b)), (Ok(x), Ok(y)) if x == y)
+    }
+}
+
+/// The file an output path will write, as one comparable path: symbolic
+/// links followed, the folder canonicalized. Two outputs with the same
+/// key would overwrite each other.
+pub fn output_key(path: &Path) -> PathBuf {
+    let target = resolve_output(path).unwrap_or_else(|_| path.to_path_buf());
+    let folder = output_folder(&target);
+    let folder = fs::canonicalize(&folder).unwrap_or(folder);
+    match target.file_name() {
+        Some(name) => folder.join(name),
+        None => folder,
+    }
+}
+
+/// Deletes every temporary output file that exists now, and makes every
+/// later [`atomic_write`] fail: for a signal handler that then exits. Safe
+/// to call from any thread.
+pub fn remove_temp_files() {
+    let mut temps = TEMPS.lock().unwrap_or_else(|e| e.into_inner());
+    for p in temps.0.drain(..) {
+        let _ = fs::remove_file(p);
+    }
+    temps.1 = true;
+}
+
+fn temp_name(target: &Path, tag: &str) -> PathBuf {
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let name = target
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+    output_folder(target).join(format!(".{name}.{tag}-{}-{n}", std::process::id()))
+}
+
+/// A registered temporary file, removed (and unregistered) unless renamed.
 struct TempGuard {
     path: PathBuf,
-    armed: bool,
+}
+
+impl TempGuard {
+    /// Registers `path` and creates it (registered first, so that a signal
+    /// handler never misses a file).
+    fn create(path: PathBuf) -> std::io::Result<(TempGuard, File)> {
+        {
+            let mut temps = TEMPS.lock().unwrap_or_else(|e| e.into_inner());
+            if temps.1 {
+                return Err(std::io::Error::new(
+                    std::io::ErrorKind::Interrupted,
+                    "interrupted",
+                ));
+            }
+            temps.0.push(path.clone());
+        }
+        let guard = TempGuard { path };
+        let file = OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&guard.path)?;
+        Ok((guard, file))
+    }
+
+    /// Renames the file onto `target` and unregisters it.
+    fn commit(self, target: &Path) -> std::io::Result<()> {
+        let mut temps = TEMPS.lock().unwrap_or_else(|e| e.into_inner());
+        if temps.1 {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::Interrupted,
+                "interrupted",
+            ));
+        }
+        fs::rename(&self.path, target)?;
+        temps.0.retain(|p| p != &self.path);
+        drop(temps);
+        std::mem::forget(self);
+        Ok(())
+    }
 }
 
 impl Drop for TempGuard {
     fn drop(&mut self) {
-        if self.armed {
-            let _ = fs::remove_file(&self.path);
-        }
+        let mut temps = TEMPS.lock().unwrap_or_else(|e| e.into_inner());
+        let _ = fs::remove_file(&self.path);
+        temps.0.retain(|p| p != &self.path);
     }
 }
 
@@ -63,7 +273,9 @@ impl Drop for TempGuard {
 /// `.<name>.tmp-<pid>-<n>` in the same folder, which is renamed to `path`
 /// only when `write` and the flush succeed. On any error (or a panic in
 /// `write`) the temporary file is removed, so `path` is either complete or
-/// untouched. A missing folder is an [`IoError::MissingFolder`].
+/// untouched. A missing folder is an [`IoError::MissingFolder`]; an
+/// existing device node, FIFO or socket an [`IoError::NotRegularFile`]; a
+/// symbolic link is followed (see the module docs).
 ///
 /// Every output of the project goes through this function.
 ///
@@ -85,36 +297,39 @@ pub fn atomic_write<F>(path: &Path, write: F) -> Result<(), IoError>
 where
     F: FnOnce(&mut dyn Write) -> std::io::Result<()>,
 {
-    static COUNTER: AtomicU64 = AtomicU64::new(0);
-    check_output_path(path)?;
-    let folder = output_folder(path);
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-    let tmp = folder.join(format!(".{name}.tmp-{}-{n}", std::process::id()));
+    atomic_write_file(path, |file| {
+        let mut out = BufWriter::with_capacity(BUFFER, file);
+        write(&mut out)?;
+        out.into_inner().map_err(|e| e.into_error())
+    })
+}
+
+/// [`atomic_write`] handing the temporary [`File`] itself to `write`
+/// (for writers that seek), which gives it back when done.
+pub(crate) fn atomic_write_file<F>(path: &Path, write: F) -> Result<(), IoError>
+where
+    F: FnOnce(File) -> std::io::Result<File>,
+{
+    let target = checked_target(path)?;
     let werr = |source| IoError::Write {
         path: path.to_path_buf(),
         source,
     };
-    let file = OpenOptions::new()
-        .write(true)
-        .create_new(true)
-        .open(&tmp)
-        .map_err(werr)?;
-    let mut guard = TempGuard {
-        path: tmp,
-        armed: true,
-    };
-    let mut out = BufWriter::with_capacity(BUFFER, file);
-    write(&mut out).map_err(werr)?;
-    let file: File = out.into_inner().map_err(|e| werr(e.into_error()))?;
+    let (guard, file) = TempGuard::create(temp_name(&target, "tmp")).map_err(werr)?;
+    if let Ok(meta) = fs::metadata(&target) {
+        let _ = fs::set_permissions(&guard.path, meta.permissions());
+    }
+    // Test hook (CLI tests of the signal handler): hold the temporary file
+    // open for this many milliseconds before writing.
+    if let Some(ms) = std::env::var_os("ANISO_ALPHA_TEST_WRITE_DELAY_MS")
+        .and_then(|v| v.to_str().and_then(|s| s.parse::<u64>().ok()))
+    {
+        std::thread::sleep(std::time::Duration::from_millis(ms));
+    }
+    let file = write(file).map_err(werr)?;
     file.sync_all().map_err(werr)?;
     drop(file);
-    fs::rename(&guard.path, path).map_err(werr)?;
-    guard.armed = false;
-    Ok(())
+    guard.commit(&target).map_err(werr)
 }
 
 #[cfg(test)]
@@ -174,6 +389,73 @@ mod tests {
         assert!(e.to_string().contains("nope"));
         let e = atomic_write(&d, |w| w.write_all(b"x")).unwrap_err();
         assert!(matches!(e, IoError::IsDirectory { .. }), "{e}");
+        fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn symlinks_are_followed_and_kept() {
+        use std::os::unix::fs::PermissionsExt;
+        let d = dir("link");
+        let real = d.join("real.txt");
+        fs::write(&real, b"old").unwrap();
+        fs::set_permissions(&real, fs::Permissions::from_mode(0o640)).unwrap();
+        let link = d.join("link.txt");
+        std::os::unix::fs::symlink("real.txt", &link).unwrap();
+        atomic_write(&link, |w| w.write_all(b"new")).unwrap();
+        assert!(fs::symlink_metadata(&link)
+            .unwrap()
+            .file_type()
+            .is_symlink());
+        assert_eq!(fs::read(&real).unwrap(), b"new");
+        let mode = fs::metadata(&real).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode, 0o640);
+        // A dangling link: its target is created.
+        let dangling = d.join("dangling.txt");
+        std::os::unix::fs::symlink(d.join("later.txt"), &dangling).unwrap();
+        atomic_write(&dangling, |w| w.write_all(b"x")).unwrap();
+        assert_eq!(fs::read(d.join("later.txt")).unwrap(), b"x");
+        assert_eq!(output_key(&link), output_key(&real));
+        // A loop of links is an error, not a hang.
+        std::os::unix::fs::symlink("b", d.join("a")).unwrap();
+        std::os::unix::fs::symlink("a", d.join("b")).unwrap();
+        let e = atomic_write(&d.join("a"), |w| w.write_all(b"x")).unwrap_err();
+        assert!(e.to_string().contains("symbolic links"), "{e}");
+        fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn special_files_are_refused() {
+        let d = dir("fifo");
+        let fifo = d.join("pipe");
+        let st = std::process::Command::new("mkfifo").arg(&fifo).status();
+        if st.is_ok_and(|s| s.success()) {
+            let e = atomic_write(&fifo, |w| w.write_all(b"x")).unwrap_err();
+            assert!(matches!(e, IoError::NotRegularFile { .. }), "{e}");
+            assert!(e.to_string().contains("FIFO"), "{e}");
+            let link = d.join("to-pipe");
+            std::os::unix::fs::symlink(&fifo, &link).unwrap();
+            assert!(check_output_path(&link).is_err());
+            use std::os::unix::fs::FileTypeExt;
+            assert!(fs::metadata(&fifo).unwrap().file_type().is_fifo());
+        }
+        // /dev/null is only checked here, never written.
+        let e = check_output_path(Path::new("/dev/null")).unwrap_err();
+        assert!(e.to_string().contains("character device"), "{e}");
+        assert_eq!(
+            fs::read_dir(&d)
+                .unwrap()
+                .filter(|e| {
+                    e.as_ref()
+                        .unwrap()
+                        .file_name()
+                        .to_string_lossy()
+                        .contains(".tmp-")
+                })
+                .count(),
+            0
+        );
         fs::remove_dir_all(&d).unwrap();
     }
 }

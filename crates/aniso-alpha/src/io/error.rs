@@ -84,6 +84,24 @@ pub enum IoError {
         /// The underlying error.
         source: std::io::Error,
     },
+    /// An output path names something that is not a regular file (a
+    /// device node, a FIFO, a socket): writing it by rename would replace
+    /// it, so it is refused.
+    NotRegularFile {
+        /// The output path (after following symbolic links).
+        path: PathBuf,
+        /// What it is ("a character device", "a FIFO", ...).
+        kind: &'static str,
+    },
+    /// The folder of an output cannot be written into.
+    NotWritable {
+        /// The folder.
+        folder: PathBuf,
+        /// The output file.
+        path: PathBuf,
+        /// The operating system's error.
+        source: std::io::Error,
+    },
     /// The support for this format was not compiled in (LAS/LAZ without
     /// the `las` feature).
     Unsupported {
@@ -107,6 +125,8 @@ impl IoError {
             | IoError::NoPoints { path }
             | IoError::MissingFolder { path, .. }
             | IoError::Write { path, .. }
+            | IoError::NotRegularFile { path, .. }
+            | IoError::NotWritable { path, .. }
             | IoError::Unsupported { path, .. } => path,
         }
     }
@@ -182,6 +202,22 @@ impl fmt::Display for IoError {
             IoError::Write { path, source } => {
                 write!(f, "cannot write {}: {}", path.display(), source)
             }
+            IoError::NotRegularFile { path, kind } => write!(
+                f,
+                "{}: is {kind}, not a regular file: refusing to replace it with an output",
+                path.display()
+            ),
+            IoError::NotWritable {
+                folder,
+                path,
+                source,
+            } => write!(
+                f,
+                "cannot write into folder {} (for {}): {}",
+                folder.display(),
+                path.display(),
+                source
+            ),
             IoError::Unsupported { path, message } => {
                 write!(f, "{}: {}", path.display(), message)
             }
@@ -192,7 +228,9 @@ impl fmt::Display for IoError {
 impl std::error::Error for IoError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
-            IoError::Open { source, .. } | IoError::Write { source, .. } => Some(source),
+            IoError::Open { source, .. }
+            | IoError::Write { source, .. }
+            | IoError::NotWritable { source, .. } => Some(source),
             _ => None,
         }
     }

@@ -34,17 +34,21 @@ mod lzf;
 mod obj;
 mod pcd;
 mod ply;
+mod scene;
 mod text;
 
 use std::fs::File;
 use std::io::Read;
 use std::path::Path;
 
-pub use atomic::{atomic_write, check_output_path};
+pub use atomic::{
+    atomic_write, check_output_path, output_key, remove_temp_files, resolve_output, same_file,
+};
 pub use error::IoError;
 pub use labels::{read_labels, read_labels_bytes, write_labels};
 pub use obj::write_obj;
 pub use ply::{write_ply, write_ply_to, Mesh, PlyEncoding};
+pub use scene::{write_scene, write_xyz_labels, write_xyz_labels_parts};
 
 /// A point cloud read from a file.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -54,6 +58,32 @@ pub struct PointCloud {
     /// One label per point, when asked for and present (see
     /// [`ReadOptions`]); -1 conventionally means background.
     pub labels: Option<Vec<i64>>,
+    /// What the reader guessed and the user should hear about (e.g. a
+    /// first line taken as a header); the CLI prints them.
+    pub warnings: Vec<ReadWarning>,
+}
+
+/// Something a reader guessed: the file was read, but perhaps not as meant.
+#[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum ReadWarning {
+    /// A text file's first content line was skipped as a header.
+    HeaderLine {
+        /// 1-based line number.
+        line: usize,
+        /// The line (shortened).
+        text: String,
+    },
+}
+
+impl std::fmt::Display for ReadWarning {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ReadWarning::HeaderLine { line, text } => {
+                write!(f, "line {line} taken as a header: '{text}'")
+            }
+        }
+    }
 }
 
 /// How to read a point file.
@@ -66,6 +96,55 @@ pub struct ReadOptions {
     /// vertex property `structure` or `label`, the PCD field `label`, the
     /// LAS classification. Absent properties give `labels: None`.
     pub read_labels: bool,
+    /// The format, overriding the file's extension (`None`: by extension;
+    /// standard input, `-`, is text unless given).
+    pub format: Option<Format>,
+    /// LAS classes read as background (-1) when the classification gives
+    /// the labels; by default 0 and 1 (never classified, unclassified), 7
+    /// (low noise) and 18 (high noise), see [`ClassSet::LAS_BACKGROUND`].
+    pub background_classes: ClassSet,
+}
+
+/// A set of LAS classification codes (0–255).
+///
+/// ```
+/// use aniso_alpha::io::ClassSet;
+/// let s = ClassSet::from_classes(&[7, 18]);
+/// assert!(s.contains(18) && !s.contains(1));
+/// assert!(ClassSet::default().contains(1));
+/// assert_eq!(ClassSet::default(), ClassSet::LAS_BACKGROUND);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ClassSet([u64; 4]);
+
+impl ClassSet {
+    /// No class.
+    pub const EMPTY: ClassSet = ClassSet([0; 4]);
+    /// The classes that are not structures when a LAS classification is
+    /// used as truth: 0 (created, never classified), 1 (unclassified), 7
+    /// (low point, noise) and 18 (high noise).
+    pub const LAS_BACKGROUND: ClassSet = ClassSet([1 | 1 << 1 | 1 << 7 | 1 << 18, 0, 0, 0]);
+
+    /// The set of these classes.
+    pub fn from_classes(classes: &[u8]) -> ClassSet {
+        let mut s = ClassSet::EMPTY;
+        for &c in classes {
+            s.0[usize::from(c / 64)] |= 1 << (c % 64);
+        }
+        s
+    }
+
+    /// Whether `class` is in the set.
+    pub fn contains(&self, class: u8) -> bool {
+        self.0[usize::from(class / 64)] >> (class % 64) & 1 == 1
+    }
+}
+
+impl Default for ClassSet {
+    /// [`ClassSet::LAS_BACKGROUND`].
+    fn default() -> Self {
+        ClassSet::LAS_BACKGROUND
+    }
 }
 
 impl ReadOptions {
@@ -81,6 +160,8 @@ impl ReadOptions {
         ReadOptions {
             label_column: Some(label_column),
             read_labels: true,
+            format: None,
+            background_classes: ClassSet::LAS_BACKGROUND,
         }
     }
 }
@@ -107,24 +188,52 @@ impl Format {
     /// use aniso_alpha::io::Format;
     /// use std::path::Path;
     /// assert_eq!(Format::from_path(Path::new("a/B.PLY")).unwrap(), Format::Ply);
-    /// assert!(Format::from_path(Path::new("scan.e57")).is_err());
+    /// assert!(Format::from_path(Path::new("scan.e58")).is_err());
     /// ```
     pub fn from_path(path: &Path) -> Result<Format, IoError> {
         let ext = path
             .extension()
             .map(|e| e.to_string_lossy().to_ascii_lowercase())
             .unwrap_or_default();
-        match ext.as_str() {
-            "xyz" | "txt" | "csv" | "pts" => Ok(Format::Text),
-            "ply" => Ok(Format::Ply),
-            "las" | "laz" => Ok(Format::Las),
-            "pcd" => Ok(Format::Pcd),
-            _ => Err(IoError::UnknownFormat {
-                path: path.to_path_buf(),
-                expected: EXPECTED_POINTS,
-            }),
+        Format::from_name(&ext).ok_or_else(|| IoError::UnknownFormat {
+            path: path.to_path_buf(),
+            expected: EXPECTED_POINTS,
+        })
+    }
+
+    /// The format named by an extension or a `--format` value
+    /// (case-insensitive, without the dot): `xyz` `txt` `csv` `pts` `ply`
+    /// `las` `laz` `pcd`.
+    ///
+    /// ```
+    /// use aniso_alpha::io::Format;
+    /// assert_eq!(Format::from_name("LAZ"), Some(Format::Las));
+    /// assert_eq!(Format::from_name("obj"), None);
+    /// ```
+    pub fn from_name(name: &str) -> Option<Format> {
+        Some(match name.to_ascii_lowercase().as_str() {
+            "xyz" | "txt" | "csv" | "pts" => Format::Text,
+            "ply" => Format::Ply,
+            "las" | "laz" => Format::Las,
+            "pcd" => Format::Pcd,
+            _ => return None,
+        })
+    }
+
+    /// The format of `path` under `options`: `options.format`, else text
+    /// for standard input (`-`), else by extension.
+    pub fn resolve(path: &Path, options: &ReadOptions) -> Result<Format, IoError> {
+        match options.format {
+            Some(f) => Ok(f),
+            None if is_stdin(path) => Ok(Format::Text),
+            None => Format::from_path(path),
         }
     }
+}
+
+/// Whether `path` is `-`, standard input.
+pub fn is_stdin(path: &Path) -> bool {
+    path.as_os_str() == "-"
 }
 
 /// Reads a point file, its format chosen by extension.
@@ -140,22 +249,49 @@ pub fn read_points(path: &Path, options: &ReadOptions) -> Result<PointCloud, IoE
 }
 
 /// [`read_points`], calling `progress(bytes_read, file_size)` while the
-/// file is loaded (for a progress bar).
+/// file is read (for a progress bar). `-` reads standard input. Text is
+/// streamed through one buffer; the other formats are loaded whole.
 pub fn read_points_with_progress(
     path: &Path,
     options: &ReadOptions,
     progress: &mut dyn FnMut(u64, u64),
 ) -> Result<PointCloud, IoError> {
-    Format::from_path(path)?;
-    let bytes = read_file(path, progress)?;
-    read_points_bytes(path, &bytes, options)
+    let format = Format::resolve(path, options)?;
+    if format == Format::Text {
+        if is_stdin(path) {
+            let stdin = std::io::stdin().lock();
+            return text::read_text_stream(path, stdin, options.label_column, 0, &mut |done| {
+                progress(done, done)
+            });
+        }
+        let (file, total) = open_file(path)?;
+        return text::read_text_stream(
+            path,
+            file,
+            options.label_column,
+            usize::try_from(total).unwrap_or(0),
+            &mut |done| progress(done, total.max(done)),
+        );
+    }
+    let bytes = if is_stdin(path) {
+        let mut bytes = Vec::new();
+        std::io::stdin()
+            .lock()
+            .read_to_end(&mut bytes)
+            .map_err(|source| IoError::Open {
+                path: path.to_path_buf(),
+                source,
+            })?;
+        bytes
+    } else {
+        read_file(path, progress)?
+    };
+    parse_format(format, path, &bytes, options)
 }
 
-/// Loads a whole file, with clear errors for a missing file or a directory.
-pub(crate) fn read_file(
-    path: &Path,
-    progress: &mut dyn FnMut(u64, u64),
-) -> Result<Vec<u8>, IoError> {
+/// Opens a file for reading, with clear errors for a missing file or a
+/// directory; returns it with its size.
+fn open_file(path: &Path) -> Result<(File, u64), IoError> {
     let open_err = |source| IoError::Open {
         path: path.to_path_buf(),
         source,
@@ -166,8 +302,15 @@ pub(crate) fn read_file(
             path: path.to_path_buf(),
         });
     }
-    let total = meta.len();
-    let mut file = File::open(path).map_err(open_err)?;
+    Ok((File::open(path).map_err(open_err)?, meta.len()))
+}
+
+/// Loads a whole file, with clear errors for a missing file or a directory.
+pub(crate) fn read_file(
+    path: &Path,
+    progress: &mut dyn FnMut(u64, u64),
+) -> Result<Vec<u8>, IoError> {
+    let (mut file, total) = open_file(path)?;
     let mut bytes = Vec::with_capacity(usize::try_from(total).unwrap_or(0).saturating_add(1));
     let mut chunk = vec![0u8; 8 << 20];
     loop {
@@ -175,7 +318,12 @@ pub(crate) fn read_file(
             Ok(0) => break,
             Ok(k) => k,
             Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
-            Err(e) => return Err(open_err(e)),
+            Err(source) => {
+                return Err(IoError::Open {
+                    path: path.to_path_buf(),
+                    source,
+                })
+            }
         };
         bytes.extend_from_slice(&chunk[..k]);
         progress(bytes.len() as u64, total.max(bytes.len() as u64));
@@ -184,13 +332,22 @@ pub(crate) fn read_file(
 }
 
 /// Parses a point file held in memory; `path` picks the format by
-/// extension and names the file in errors.
+/// extension (unless `options.format` is set) and names the file in errors.
 pub fn read_points_bytes(
     path: &Path,
     bytes: &[u8],
     options: &ReadOptions,
 ) -> Result<PointCloud, IoError> {
-    match Format::from_path(path)? {
+    parse_format(Format::resolve(path, options)?, path, bytes, options)
+}
+
+fn parse_format(
+    format: Format,
+    path: &Path,
+    bytes: &[u8],
+    options: &ReadOptions,
+) -> Result<PointCloud, IoError> {
+    match format {
         Format::Text => read_xyz_bytes(path, bytes, options),
         Format::Ply => read_ply_bytes(path, bytes, options),
         Format::Las => read_las_bytes(path, bytes, options),
@@ -205,6 +362,7 @@ pub fn read_points_bytes(
 /// use aniso_alpha::io::{read_xyz_bytes, ReadOptions};
 /// let c = read_xyz_bytes("a.csv".as_ref(), b"x,y,z\n1,2,3\n", &ReadOptions::default()).unwrap();
 /// assert_eq!(c.points, vec![[1.0, 2.0, 3.0]]);
+/// assert_eq!(c.warnings[0].to_string(), "line 1 taken as a header: 'x,y,z'");
 /// ```
 pub fn read_xyz_bytes(
     name: &Path,
@@ -261,7 +419,11 @@ pub fn read_las_bytes(
 ) -> Result<PointCloud, IoError> {
     #[cfg(feature = "las")]
     {
-        las::read_las(name, bytes, options.read_labels)
+        las::read_las(
+            name,
+            bytes,
+            options.read_labels.then_some(options.background_classes),
+        )
     }
     #[cfg(not(feature = "las"))]
     {
@@ -273,7 +435,6 @@ pub fn read_las_bytes(
     }
 }
 
-/// Fails with [`IoError::NoPoints`] on an empty cloud.
 /// The next `\n`-terminated line of a binary file's text header, starting
 /// at `*pos` (without its `\n`; the last line may lack one), advancing
 /// `*pos` past it; `None` at the end of `bytes`.
@@ -290,6 +451,7 @@ pub(crate) fn next_header_line<'a>(bytes: &'a [u8], pos: &mut usize) -> Option<&
     Some(raw)
 }
 
+/// Fails with [`IoError::NoPoints`] on an empty cloud.
 pub(crate) fn non_empty(path: &Path, cloud: PointCloud) -> Result<PointCloud, IoError> {
     if cloud.points.is_empty() {
         Err(IoError::NoPoints {

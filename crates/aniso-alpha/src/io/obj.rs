@@ -21,6 +21,8 @@ pub fn write_obj(path: &Path, mesh: &Mesh<'_>) -> Result<(), IoError> {
     atomic_write(path, |w| {
         let mesh = Mesh {
             labels: None,
+            parts: None,
+            element_labels: &[],
             ..*mesh
         };
         mesh.validate()?;

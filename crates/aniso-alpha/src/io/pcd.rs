@@ -150,11 +150,39 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header, IoError> {
     {
         return Err(IoError::format(path, "PCD header: field too large"));
     }
-    let points = match (points, width, height) {
-        (Some(p), _, _) => p,
-        (None, Some(w), Some(h)) => w
-            .checked_mul(h)
-            .ok_or_else(|| IoError::format(path, "PCD header: WIDTH × HEIGHT overflows"))?,
+    // A zero-size field would make a zero stride: any POINTS would then
+    // "fit" in no data (issue 19: 12 bytes read as 10M points).
+    if let Some(f) = fields.iter().find(|f| f.size == 0 || f.count == 0) {
+        return Err(IoError::format(
+            path,
+            format!(
+                "PCD header: field '{}' has SIZE {} and COUNT {} (both must be at least 1)",
+                show_token(f.name.as_bytes()),
+                f.size,
+                f.count
+            ),
+        ));
+    }
+    let area = match (width, height) {
+        (Some(w), Some(h)) => Some(
+            w.checked_mul(h)
+                .ok_or_else(|| IoError::format(path, "PCD header: WIDTH × HEIGHT overflows"))?,
+        ),
+        _ => None,
+    };
+    let points = match (points, area) {
+        (Some(p), Some(a)) if p != a => {
+            return Err(IoError::format(
+                path,
+                format!(
+                    "PCD header: POINTS {p} differs from WIDTH × HEIGHT = {} × {} = {a}",
+                    width.unwrap_or(0),
+                    height.unwrap_or(0)
+                ),
+            ))
+        }
+        (Some(p), _) => p,
+        (None, Some(a)) => a,
         _ => return Err(IoError::format(path, "PCD header has no POINTS line")),
     };
     Ok(Header {
@@ -289,6 +317,7 @@ fn decode(
     let mut cloud = PointCloud {
         points: Vec::with_capacity(n),
         labels: label.map(|_| Vec::with_capacity(n)),
+        ..Default::default()
     };
     for i in 0..n {
         let p = [get(xyz[0], i)?, get(xyz[1], i)?, get(xyz[2], i)?];
@@ -320,6 +349,7 @@ fn read_ascii(
     let mut cloud = PointCloud {
         points: Vec::with_capacity(h.points.min(data.len() / 6)),
         labels: label.map(|_| Vec::new()),
+        ..Default::default()
     };
     let mut last = h.lines;
     let mut toks: Vec<&[u8]> = Vec::with_capacity(acc);

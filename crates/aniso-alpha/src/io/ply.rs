@@ -4,7 +4,7 @@ use std::io::Write;
 use std::path::Path;
 
 use super::error::show_token;
-use super::text::{parse_f64, parse_label};
+use super::text::parse_f64;
 use super::{atomic_write, check_finite, non_empty, IoError, PointCloud};
 
 /// A PLY scalar type.
@@ -48,6 +48,62 @@ impl Scalar {
         !matches!(self, Scalar::F32 | Scalar::F64)
     }
 
+    /// The range of an integer type.
+    fn int_range(self) -> Option<(i64, i64)> {
+        Some(match self {
+            Scalar::I8 => (i8::MIN.into(), i8::MAX.into()),
+            Scalar::U8 => (0, u8::MAX.into()),
+            Scalar::I16 => (i16::MIN.into(), i16::MAX.into()),
+            Scalar::U16 => (0, u16::MAX.into()),
+            Scalar::I32 => (i32::MIN.into(), i32::MAX.into()),
+            Scalar::U32 => (0, u32::MAX.into()),
+            Scalar::F32 | Scalar::F64 => return None,
+        })
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            Scalar::I8 => "char",
+            Scalar::U8 => "uchar",
+            Scalar::I16 => "short",
+            Scalar::U16 => "ushort",
+            Scalar::I32 => "int",
+            Scalar::U32 => "uint",
+            Scalar::F32 => "float",
+            Scalar::F64 => "double",
+        }
+    }
+
+    /// Parses an ascii value of this type: integers must be plain
+    /// integers within the type's range (`300`, `-5` and `1.5` are not
+    /// `uchar`s, `1e20` is not an `int`).
+    pub(crate) fn parse(self, tok: &[u8]) -> Result<f64, String> {
+        match self.int_range() {
+            None => parse_f64(tok).ok_or_else(|| "not a number".to_string()),
+            Some((lo, hi)) => {
+                let v = std::str::from_utf8(tok)
+                    .ok()
+                    .and_then(|s| s.strip_prefix('+').unwrap_or(s).parse::<i64>().ok())
+                    .ok_or_else(|| format!("not an integer ({} property)", self.name()))?;
+                if v < lo || v > hi {
+                    return Err(format!(
+                        "out of range for a {} property ({lo}..={hi})",
+                        self.name()
+                    ));
+                }
+                Ok(v as f64)
+            }
+        }
+    }
+}
+
+/// A label value read from a number: it must be an integer (a float
+/// label of NaN or 1.5 is an error, not 0 or 1).
+pub(crate) fn label_of(v: f64) -> Option<i64> {
+    (v.is_finite() && v.fract() == 0.0 && v.abs() < 9.0e18).then_some(v as i64)
+}
+
+impl Scalar {
     /// Decodes `b` (exactly `size()` bytes) as a number.
     #[inline]
     pub(crate) fn decode(self, b: &[u8], big: bool) -> f64 {
@@ -374,6 +430,9 @@ fn read_fixed_vertices(
     if stride == 0 {
         return Ok(());
     }
+    let bad_label = |i: usize, v: f64| {
+        IoError::format(path, format!("PLY vertex {i}: label {v} is not an integer"))
+    };
     cloud.points.reserve(el.count);
     let mut labels = Vec::new();
     for rec in data.chunks_exact(stride) {
@@ -385,7 +444,8 @@ fn read_fixed_vertices(
         check_finite(path, &p, cloud.points.len(), None)?;
         cloud.points.push(p);
         if let Some((o, s)) = fl {
-            labels.push(s.decode(&rec[o..], big) as i64);
+            let v = s.decode(&rec[o..], big);
+            labels.push(label_of(v).ok_or_else(|| bad_label(cloud.points.len() - 1, v))?);
         }
     }
     if fl.is_some() {
@@ -405,10 +465,18 @@ fn push_vertex(
     check_finite(path, &p, cloud.points.len(), line)?;
     cloud.points.push(p);
     if let Some(i) = layout.label {
-        cloud
-            .labels
-            .get_or_insert_with(Vec::new)
-            .push(values[i] as i64);
+        let v = values[i];
+        let label = label_of(v).ok_or_else(|| {
+            let at = cloud.points.len() - 1;
+            match line {
+                Some(line) => IoError::parse(path, line, format!("label {v} is not an integer")),
+                None => IoError::format(
+                    path,
+                    format!("PLY vertex {at}: label {v} is not an integer"),
+                ),
+            }
+        })?;
+        cloud.labels.get_or_insert_with(Vec::new).push(label);
     }
     Ok(())
 }
@@ -460,22 +528,17 @@ fn read_ascii(
             };
             for (pi, p) in el.props.iter().enumerate() {
                 match p.kind {
-                    Kind::Scalar(_) => {
+                    Kind::Scalar(s) => {
                         let t = toks.next().ok_or_else(missing)?;
                         let wanted =
                             is_vertex && (layout.xyz.contains(&pi) || layout.label == Some(pi));
                         if wanted {
-                            values[pi] = if layout.label == Some(pi) {
-                                parse_label(t).map(|v| v as f64)
-                            } else {
-                                parse_f64(t)
-                            }
-                            .ok_or_else(|| {
+                            values[pi] = s.parse(t).map_err(|why| {
                                 IoError::parse(
                                     path,
                                     ln,
                                     format!(
-                                        "invalid value '{}' for property '{}'",
+                                        "invalid value '{}' for property '{}': {why}",
                                         show_token(t),
                                         p.name
                                     ),
@@ -538,10 +601,17 @@ pub struct Mesh<'a> {
     /// One label per point (written as the int vertex property
     /// `structure`), if any.
     pub labels: Option<&'a [i64]>,
+    /// One part id per point (the int vertex property `part`), if any
+    /// (PLY only).
+    pub parts: Option<&'a [i64]>,
     /// Edges (PLY element `edge`, OBJ `l` lines).
     pub edges: &'a [[u32; 2]],
     /// Triangles (PLY element `face`, OBJ `f` lines).
     pub faces: &'a [[u32; 3]],
+    /// Per edge, then per face: (structure, part), written as the int
+    /// properties `structure` and `part` of the `edge` and `face` elements
+    /// (PLY only). Either empty or one per edge and face.
+    pub element_labels: &'a [[i64; 2]],
 }
 
 impl<'a> Mesh<'a> {
@@ -550,8 +620,10 @@ impl<'a> Mesh<'a> {
         Mesh {
             points,
             labels: None,
+            parts: None,
             edges: &[],
             faces: &[],
+            element_labels: &[],
         }
     }
 
@@ -559,13 +631,28 @@ impl<'a> Mesh<'a> {
     pub(crate) fn validate(&self) -> std::io::Result<()> {
         let invalid = |m: String| std::io::Error::new(std::io::ErrorKind::InvalidInput, m);
         let n = self.points.len();
-        if let Some(l) = self.labels {
+        for l in [self.labels, self.parts].into_iter().flatten() {
             if l.len() != n {
                 return Err(invalid(format!("{} labels for {} points", l.len(), n)));
             }
             if let Some(v) = l.iter().find(|v| i32::try_from(**v).is_err()) {
                 return Err(invalid(format!("label {v} does not fit a PLY int")));
             }
+        }
+        let ne = self.edges.len() + self.faces.len();
+        if !self.element_labels.is_empty() && self.element_labels.len() != ne {
+            return Err(invalid(format!(
+                "{} element labels for {ne} edges and faces",
+                self.element_labels.len()
+            )));
+        }
+        if let Some(v) = self
+            .element_labels
+            .iter()
+            .flatten()
+            .find(|v| i32::try_from(**v).is_err())
+        {
+            return Err(invalid(format!("label {v} does not fit a PLY int")));
         }
         let limit = n.min(i32::MAX as usize);
         let bad = self
@@ -624,12 +711,22 @@ pub fn write_ply_to(
     if mesh.labels.is_some() {
         w.write_all(b"property int structure\n")?;
     }
+    if mesh.parts.is_some() {
+        w.write_all(b"property int part\n")?;
+    }
+    let el = !mesh.element_labels.is_empty();
+    let el_props: &[u8] = if el {
+        b"property int structure\nproperty int part\n"
+    } else {
+        b""
+    };
     if !mesh.edges.is_empty() {
         write!(
             w,
             "element edge {}\nproperty int vertex1\nproperty int vertex2\n",
             mesh.edges.len()
         )?;
+        w.write_all(el_props)?;
     }
     if !mesh.faces.is_empty() {
         write!(
@@ -637,22 +734,36 @@ pub fn write_ply_to(
             "element face {}\nproperty list uchar int vertex_indices\n",
             mesh.faces.len()
         )?;
+        w.write_all(el_props)?;
     }
+    let (edge_labels, face_labels) = if el {
+        mesh.element_labels.split_at(mesh.edges.len())
+    } else {
+        (&[][..], &[][..])
+    };
     w.write_all(b"end_header\n")?;
     match encoding {
         PlyEncoding::Ascii => {
             for (i, p) in mesh.points.iter().enumerate() {
                 write!(w, "{} {} {}", p[0], p[1], p[2])?;
-                if let Some(l) = mesh.labels {
+                for l in [mesh.labels, mesh.parts].into_iter().flatten() {
                     write!(w, " {}", l[i])?;
                 }
                 w.write_all(b"\n")?;
             }
-            for e in mesh.edges {
-                writeln!(w, "{} {}", e[0], e[1])?;
+            for (k, e) in mesh.edges.iter().enumerate() {
+                write!(w, "{} {}", e[0], e[1])?;
+                if let Some([s, p]) = edge_labels.get(k) {
+                    write!(w, " {s} {p}")?;
+                }
+                w.write_all(b"\n")?;
             }
-            for f in mesh.faces {
-                writeln!(w, "3 {} {} {}", f[0], f[1], f[2])?;
+            for (k, f) in mesh.faces.iter().enumerate() {
+                write!(w, "3 {} {} {}", f[0], f[1], f[2])?;
+                if let Some([s, p]) = face_labels.get(k) {
+                    write!(w, " {s} {p}")?;
+                }
+                w.write_all(b"\n")?;
             }
         }
         PlyEncoding::BinaryLittleEndian => {
@@ -668,21 +779,31 @@ pub fn write_ply_to(
                 for c in p {
                     buf.extend_from_slice(&c.to_le_bytes());
                 }
-                if let Some(l) = mesh.labels {
+                for l in [mesh.labels, mesh.parts].into_iter().flatten() {
                     buf.extend_from_slice(&(l[i] as i32).to_le_bytes());
                 }
                 flush(&mut buf, false)?;
             }
-            for e in mesh.edges {
+            for (k, e) in mesh.edges.iter().enumerate() {
                 for v in e {
                     buf.extend_from_slice(&(*v as i32).to_le_bytes());
                 }
+                if let Some(sp) = edge_labels.get(k) {
+                    for x in sp {
+                        buf.extend_from_slice(&(*x as i32).to_le_bytes());
+                    }
+                }
                 flush(&mut buf, false)?;
             }
-            for f in mesh.faces {
+            for (k, f) in mesh.faces.iter().enumerate() {
                 buf.push(3);
                 for v in f {
                     buf.extend_from_slice(&(*v as i32).to_le_bytes());
+                }
+                if let Some(sp) = face_labels.get(k) {
+                    for x in sp {
+                        buf.extend_from_slice(&(*x as i32).to_le_bytes());
+                    }
                 }
                 flush(&mut buf, false)?;
             }

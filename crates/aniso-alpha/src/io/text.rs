@@ -2,25 +2,50 @@
 //!
 //! One point per line, columns separated by runs of whitespace and/or commas
 //! (so an empty CSV field does not count as a column). `#` starts a comment
-//! that runs to the end of the line. Blank lines are skipped. The first
-//! non-blank, non-comment line is a header, and skipped, when its first
-//! column is not a number; no other line may be a header. Columns past x, y,
-//! z (and the label column) are ignored. A first line holding a single
-//! number (the point count that `.pts` files start with) is skipped too.
+//! that runs to the end of the line. Blank lines are skipped. Lines end
+//! with LF, CRLF or a lone CR (also mixed in one file). The first
+//! non-blank, non-comment line is a header, skipped with a
+//! [`ReadWarning::HeaderLine`], when none of its first three columns is a
+//! number; a first line whose first column is not a number but whose next
+//! ones are (`−1 0 0` with a Unicode minus) is an error, as is a non-number
+//! on any later line. Columns past x, y, z (and the label column) are
+//! ignored. A first line holding a single number (the point count that
+//! `.pts` files start with) is skipped too.
+//!
+//! Commas that would be misread are refused:
+//! * a comma between two digits on a line whose columns are separated by
+//!   whitespace (`1,5 2,5 3,5`: decimal commas);
+//! * a comma-separated line whose field count differs from the first
+//!   comma-separated line's (header included), or a field with a leading
+//!   zero such as `000.0` (`1,234.5,2,000.0,3.0`: thousands separators).
+//!
+//! UTF-16 files (a byte-order mark, or NUL bytes) are refused with a clear
+//! message. The reader streams: it holds one buffer of the file
+//! ([`STREAM_BUFFER`]) and the points, not the whole file.
 
+use std::io::Read;
 use std::path::Path;
 
 use super::error::show_token;
-use super::{IoError, PointCloud};
+use super::{IoError, PointCloud, ReadWarning};
+
+/// Size of the read buffer of the streaming text reader (it grows only for
+/// a longer line).
+pub(crate) const STREAM_BUFFER: usize = 4 << 20;
 
 #[inline(always)]
 fn is_sep(b: u8) -> bool {
-    matches!(b, b' ' | b'\t' | b',' | b'\r' | b'\x0b' | b'\x0c')
+    matches!(b, b' ' | b'\t' | b',' | b'\x0b' | b'\x0c')
+}
+
+#[inline(always)]
+fn is_eol(b: u8) -> bool {
+    b == b'\n' || b == b'\r'
 }
 
 #[inline(always)]
 fn ends_token(b: u8) -> bool {
-    is_sep(b) || b == b'\n' || b == b'#'
+    is_sep(b) || is_eol(b) || b == b'#'
 }
 
 /// Parses a float token; `None` when it is not a number.
@@ -90,139 +115,391 @@ pub(crate) fn parse_label(tok: &[u8]) -> Option<i64> {
     }
 }
 
+/// The state of a text file being parsed, line by line, across buffers.
+pub(crate) struct TextParser<'p> {
+    path: &'p Path,
+    label_column: Option<usize>,
+    needed: usize,
+    line: usize,
+    seen_content: bool,
+    /// Field count of the first comma-separated line, and its line number.
+    comma_fields: Option<(usize, usize)>,
+    /// A CR ended the previous buffer: a LF starting this one is its pair.
+    pending_cr: bool,
+    first: bool,
+    cloud: PointCloud,
+}
+
+impl<'p> TextParser<'p> {
+    pub(crate) fn new(path: &'p Path, label_column: Option<usize>, size_hint: usize) -> Self {
+        let needed = match label_column {
+            Some(c) => c.max(2).saturating_add(1),
+            None => 3,
+        };
+        let mut cloud = PointCloud::default();
+        cloud.points.reserve(size_hint / 32 + 1);
+        if label_column.is_some() {
+            cloud.labels = Some(Vec::new());
+        }
+        TextParser {
+            path,
+            label_column,
+            needed,
+            line: 0,
+            seen_content: false,
+            comma_fields: None,
+            pending_cr: false,
+            first: true,
+            cloud,
+        }
+    }
+
+    fn err(&self, message: String) -> IoError {
+        IoError::parse(self.path, self.line, message)
+    }
+
+    /// Checks the start of the file for a BOM and for UTF-16.
+    fn check_start<'b>(&self, bytes: &'b [u8]) -> Result<&'b [u8], IoError> {
+        if bytes.starts_with(b"\xFF\xFE") || bytes.starts_with(b"\xFE\xFF") {
+            return Err(IoError::format(
+                self.path,
+                "the file is UTF-16 text (it starts with a UTF-16 byte-order mark): \
+                 convert it to UTF-8 or ASCII, e.g. iconv -f UTF-16 -t UTF-8",
+            ));
+        }
+        let probe = &bytes[..bytes.len().min(4096)];
+        if probe.contains(&0) {
+            let hint = if probe.iter().skip(1).step_by(2).filter(|&&b| b == 0).count() * 4
+                > probe.len()
+                || probe.iter().step_by(2).filter(|&&b| b == 0).count() * 4 > probe.len()
+            {
+                " (it looks like UTF-16: convert it to UTF-8, e.g. iconv -f UTF-16 -t UTF-8)"
+            } else {
+                " (a binary file?)"
+            };
+            return Err(IoError::format(
+                self.path,
+                format!("NUL bytes in a text point file{hint}"),
+            ));
+        }
+        Ok(bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes))
+    }
+
+    /// Parses `bytes`, which ends at a line end unless it is the file's
+    /// last piece (a trailing CR may be followed by a LF in the next piece).
+    pub(crate) fn feed(&mut self, bytes: &[u8]) -> Result<(), IoError> {
+        let bytes = if self.first {
+            self.first = false;
+            self.check_start(bytes)?
+        } else {
+            bytes
+        };
+        let n = bytes.len();
+        let mut i = 0usize;
+        if self.pending_cr && bytes.first() == Some(&b'\n') {
+            i = 1;
+        }
+        self.pending_cr = false;
+        while i < n {
+            self.line += 1;
+            let line_start = i;
+            let mut col = 0usize;
+            let mut xyz = [0.0f64; 3];
+            let mut label = 0i64;
+            let mut header = false;
+            let mut ws_sep = false;
+            let mut tight_comma: Option<usize> = None;
+            let mut has_comma = false;
+            let mut leading_zero: Option<(usize, usize)> = None;
+            loop {
+                let sep_start = i;
+                let mut comma = 0usize;
+                while i < n && is_sep(bytes[i]) {
+                    comma += usize::from(bytes[i] == b',');
+                    i += 1;
+                }
+                if i >= n || is_eol(bytes[i]) || bytes[i] == b'#' {
+                    break;
+                }
+                if col > 0 {
+                    if comma == 0 {
+                        ws_sep = true;
+                    } else {
+                        has_comma = true;
+                        if i - sep_start == 1
+                            && bytes[sep_start - 1].is_ascii_digit()
+                            && bytes[i].is_ascii_digit()
+                        {
+                            tight_comma.get_or_insert(sep_start);
+                        }
+                    }
+                } else if comma > 0 {
+                    has_comma = true;
+                }
+                let start = i;
+                while i < n && !ends_token(bytes[i]) {
+                    i += 1;
+                }
+                let tok = &bytes[start..i];
+                if tok.len() > 1 && tok[0] == b'0' && tok[1].is_ascii_digit() {
+                    leading_zero.get_or_insert((start, i));
+                }
+                if col >= self.needed {
+                    // Past what is read: only counted (comma files).
+                    col += 1;
+                    continue;
+                }
+                if col < 3 {
+                    match parse_f64(tok) {
+                        Some(v) => xyz[col] = v,
+                        None if col == 0 && !self.seen_content => {
+                            header = true;
+                            break;
+                        }
+                        None => return Err(self.bad_number(tok, col)),
+                    }
+                }
+                if Some(col) == self.label_column {
+                    label = parse_label(tok).ok_or_else(|| {
+                        self.err(format!(
+                            "invalid label '{}' in column {} (expected an integer)",
+                            show_token(tok),
+                            col + 1
+                        ))
+                    })?;
+                }
+                col += 1;
+                if col == self.needed && !has_comma {
+                    break;
+                }
+            }
+            // Skip the rest of the line (extra columns, comment).
+            while i < n && !is_eol(bytes[i]) {
+                i += 1;
+            }
+            let line_end = i;
+            if i < n {
+                if bytes[i] == b'\r' {
+                    if i + 1 < n {
+                        if bytes[i + 1] == b'\n' {
+                            i += 1;
+                        }
+                    } else {
+                        self.pending_cr = true;
+                    }
+                }
+                i += 1;
+            }
+            let text = &bytes[line_start..line_end];
+            if header {
+                self.header_line(text)?;
+                continue;
+            }
+            if col == 0 {
+                continue; // blank or comment line
+            }
+            if col == 1 && !self.seen_content {
+                // A lone number first: the point count line of `.pts` files.
+                self.seen_content = true;
+                continue;
+            }
+            self.seen_content = true;
+            if let (true, Some(at)) = (ws_sep, tight_comma) {
+                let tok = token_around(bytes, at, line_start, line_end);
+                return Err(self.err(format!(
+                    "ambiguous comma in '{}': decimal commas are not read (use '.' for decimals, \
+                     and commas or spaces between columns)",
+                    show_token(tok)
+                )));
+            }
+            if has_comma {
+                self.check_comma_fields(col)?;
+                if let Some((a, b)) = leading_zero {
+                    let tok = &bytes[a..b];
+                    return Err(self.err(format!(
+                        "field '{}' has a leading zero: a thousands separator? (write numbers \
+                         without digit grouping)",
+                        show_token(tok)
+                    )));
+                }
+            }
+            if col < 3 {
+                return Err(self.err(format!("expected 3 numeric columns, found {col}")));
+            }
+            if col < self.needed {
+                return Err(self.err(format!(
+                    "expected a label in column {}, found {col} columns",
+                    self.needed
+                )));
+            }
+            if !(xyz[0].is_finite() && xyz[1].is_finite() && xyz[2].is_finite()) {
+                return Err(IoError::NonFinite {
+                    path: self.path.to_path_buf(),
+                    line: Some(self.line),
+                    index: self.cloud.points.len(),
+                });
+            }
+            self.cloud.points.push(xyz);
+            if let Some(labels) = self.cloud.labels.as_mut() {
+                labels.push(label);
+            }
+        }
+        Ok(())
+    }
+
+    /// A first line whose first column is not a number: a header when none
+    /// of its first three columns is a number, else an error.
+    fn header_line(&mut self, text: &[u8]) -> Result<(), IoError> {
+        let toks: Vec<&[u8]> = text
+            .split(|&b| is_sep(b) || b == b'#')
+            .filter(|t| !t.is_empty())
+            .take(3)
+            .collect();
+        let comment_at = text.iter().position(|&b| b == b'#').unwrap_or(text.len());
+        let content = &text[..comment_at];
+        if toks.len() > 1 && toks[1..].iter().any(|t| parse_f64(t).is_some()) {
+            return Err(self.bad_number(toks[0], 0));
+        }
+        if content.contains(&b',') {
+            let fields = content
+                .split(|&b| is_sep(b))
+                .filter(|t| !t.is_empty())
+                .count();
+            self.comma_fields = Some((fields, self.line));
+        }
+        self.seen_content = true;
+        self.cloud.warnings.push(ReadWarning::HeaderLine {
+            line: self.line,
+            text: show_token(content.trim_ascii()),
+        });
+        Ok(())
+    }
+
+    fn check_comma_fields(&mut self, fields: usize) -> Result<(), IoError> {
+        match self.comma_fields {
+            None => {
+                self.comma_fields = Some((fields, self.line));
+                Ok(())
+            }
+            Some((f, _)) if f == fields => Ok(()),
+            Some((f, at)) => Err(self.err(format!(
+                "{fields} comma-separated fields where line {at} has {f}: a thousands separator \
+                 or a decimal comma? (every line of a CSV file needs the same fields)"
+            ))),
+        }
+    }
+
+    fn bad_number(&self, tok: &[u8], col: usize) -> IoError {
+        let hint = if std::str::from_utf8(tok)
+            .is_ok_and(|s| s.contains(['\u{2212}', '\u{2013}', '\u{2012}', '\u{FE63}', '\u{FF0D}']))
+        {
+            " (a Unicode minus or dash: use the ASCII '-')"
+        } else {
+            ""
+        };
+        self.err(format!(
+            "invalid number '{}' in column {}{hint}",
+            show_token(tok),
+            col + 1
+        ))
+    }
+
+    /// The points, or [`IoError::NoPoints`].
+    pub(crate) fn finish(self) -> Result<PointCloud, IoError> {
+        if self.cloud.points.is_empty() {
+            return Err(IoError::NoPoints {
+                path: self.path.to_path_buf(),
+            });
+        }
+        Ok(self.cloud)
+    }
+}
+
+/// The whitespace-free token around byte `at` of a line.
+fn token_around(bytes: &[u8], at: usize, start: usize, end: usize) -> &[u8] {
+    let ws = |b: u8| b.is_ascii_whitespace();
+    let a = bytes[start..at]
+        .iter()
+        .rposition(|&b| ws(b))
+        .map_or(start, |k| start + k + 1);
+    let b = bytes[at..end]
+        .iter()
+        .position(|&b| ws(b))
+        .map_or(end, |k| at + k);
+    &bytes[a..b]
+}
+
 /// Reads a text point file from memory. `path` only names it in errors.
 pub(crate) fn read_text(
     path: &Path,
     bytes: &[u8],
     label_column: Option<usize>,
 ) -> Result<PointCloud, IoError> {
-    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
-    // Classic Mac line ends (CR only) would otherwise read as one line.
-    let converted: Vec<u8>;
-    let bytes = if !bytes.contains(&b'\n') && bytes.contains(&b'\r') {
-        converted = bytes
-            .iter()
-            .map(|&b| if b == b'\r' { b'\n' } else { b })
-            .collect();
-        &converted[..]
-    } else {
-        bytes
-    };
-    let n = bytes.len();
-    let needed = match label_column {
-        Some(c) => c.max(2).saturating_add(1),
-        None => 3,
-    };
-    let mut points: Vec<[f64; 3]> = Vec::with_capacity(n / 32 + 1);
-    let mut labels: Vec<i64> = Vec::new();
-    let mut line = 0usize;
-    let mut seen_content = false;
-    let mut i = 0usize;
-    while i < n {
-        line += 1;
-        let mut col = 0usize;
-        let mut xyz = [0.0f64; 3];
-        let mut label = 0i64;
-        let mut header = false;
-        loop {
-            while i < n && is_sep(bytes[i]) {
-                i += 1;
+    let mut parser = TextParser::new(path, label_column, bytes.len());
+    parser.feed(bytes)?;
+    parser.finish()
+}
+
+/// Reads a text point file from a stream through one bounded buffer,
+/// calling `progress(bytes_read)` after each read.
+pub(crate) fn read_text_stream(
+    path: &Path,
+    source: impl Read,
+    label_column: Option<usize>,
+    size_hint: usize,
+    progress: &mut dyn FnMut(u64),
+) -> Result<PointCloud, IoError> {
+    read_text_stream_with(
+        path,
+        source,
+        label_column,
+        size_hint,
+        progress,
+        STREAM_BUFFER,
+    )
+}
+
+fn read_text_stream_with(
+    path: &Path,
+    mut source: impl Read,
+    label_column: Option<usize>,
+    size_hint: usize,
+    progress: &mut dyn FnMut(u64),
+    buffer: usize,
+) -> Result<PointCloud, IoError> {
+    let mut parser = TextParser::new(path, label_column, size_hint);
+    let mut buf = vec![0u8; buffer.max(1)];
+    let mut filled = 0usize;
+    let mut total = 0u64;
+    loop {
+        if filled == buf.len() {
+            // One line longer than the buffer: grow it.
+            buf.resize(buf.len() * 2, 0);
+        }
+        let k = match source.read(&mut buf[filled..]) {
+            Ok(k) => k,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(source) => {
+                return Err(IoError::Open {
+                    path: path.to_path_buf(),
+                    source,
+                })
             }
-            if i >= n || bytes[i] == b'\n' || bytes[i] == b'#' {
-                break;
-            }
-            let start = i;
-            while i < n && !ends_token(bytes[i]) {
-                i += 1;
-            }
-            let tok = &bytes[start..i];
-            if col < 3 {
-                match parse_f64(tok) {
-                    Some(v) => xyz[col] = v,
-                    None if col == 0 && !seen_content => {
-                        header = true;
-                        break;
-                    }
-                    None => {
-                        return Err(IoError::parse(
-                            path,
-                            line,
-                            format!("invalid number '{}' in column {}", show_token(tok), col + 1),
-                        ))
-                    }
-                }
-            }
-            if Some(col) == label_column {
-                label = parse_label(tok).ok_or_else(|| {
-                    IoError::parse(
-                        path,
-                        line,
-                        format!(
-                            "invalid label '{}' in column {} (expected an integer)",
-                            show_token(tok),
-                            col + 1
-                        ),
-                    )
-                })?;
-            }
-            col += 1;
-            if col == needed {
-                break;
-            }
+        };
+        total += k as u64;
+        progress(total);
+        filled += k;
+        if k == 0 {
+            parser.feed(&buf[..filled])?;
+            return parser.finish();
         }
-        // Skip the rest of the line (extra columns, comment).
-        while i < n && bytes[i] != b'\n' {
-            i += 1;
-        }
-        i += 1;
-        if header {
-            seen_content = true;
-            continue;
-        }
-        if col == 0 {
-            continue; // blank or comment line
-        }
-        if col == 1 && !seen_content {
-            // A lone number first: the point count line of `.pts` files.
-            seen_content = true;
-            continue;
-        }
-        seen_content = true;
-        if col < 3 {
-            return Err(IoError::parse(
-                path,
-                line,
-                format!("expected 3 numeric columns, found {col}"),
-            ));
-        }
-        if col < needed {
-            return Err(IoError::parse(
-                path,
-                line,
-                format!("expected a label in column {needed}, found {col} columns"),
-            ));
-        }
-        if !(xyz[0].is_finite() && xyz[1].is_finite() && xyz[2].is_finite()) {
-            return Err(IoError::NonFinite {
-                path: path.to_path_buf(),
-                line: Some(line),
-                index: points.len(),
-            });
-        }
-        points.push(xyz);
-        if label_column.is_some() {
-            labels.push(label);
+        // Parse up to the last line end; keep the partial line.
+        if let Some(last) = buf[..filled].iter().rposition(|&b| is_eol(b)) {
+            parser.feed(&buf[..=last])?;
+            buf.copy_within(last + 1..filled, 0);
+            filled -= last + 1;
         }
     }
-    if points.is_empty() {
-        return Err(IoError::NoPoints {
-            path: path.to_path_buf(),
-        });
-    }
-    Ok(PointCloud {
-        points,
-        labels: label_column.map(|_| labels),
-    })
 }
 
 #[cfg(test)]
@@ -268,7 +545,7 @@ mod tests {
     #[test]
     fn separators_comments_header_extra_columns() {
         let c = read(
-            "\u{feff}# comment\n\nx,y,z,intensity\n1,2,3,9\n 4\t5 6 # trailing\r\n7, 8 ,9\n#end",
+            "\u{feff}# comment\n\nx,y,z,intensity\n1,2,3,9\n 4\t5 6 # trailing\r\n7, 8 ,9, 0\n#end",
         )
         .unwrap();
         assert_eq!(
@@ -349,5 +626,111 @@ mod tests {
         assert_eq!(err("1 2 1e999\n").lines().count(), 1);
         assert!(err("1 1 1\nx y z\n").starts_with("t.xyz:2: invalid number 'x'"));
         assert!(err("1 \u{1} 1\n").contains("'\\u{1}'"));
+    }
+
+    #[test]
+    fn misreads_are_errors() {
+        assert!(err("1,5 2,5 3,5\n").contains("ambiguous comma in '1,5'"));
+        assert!(err("0 0 0\n1,5 2,5 3,5\n").starts_with("t.xyz:2: ambiguous comma"));
+        assert_eq!(
+            err("x,y,z\n1,234.5,2,000.0,3.0\n"),
+            "t.xyz:2: 5 comma-separated fields where line 1 has 3: a thousands separator or a \
+             decimal comma? (every line of a CSV file needs the same fields)"
+        );
+        assert!(err("1,234.5,2,000.0,3.0\n").contains("field '000.0' has a leading zero"));
+        assert!(err("1,2,3\n1,2,3,4\n").starts_with("t.xyz:2: 4 comma-separated fields"));
+        let e = err("\u{2212}1 0 0\n1 0 0\n");
+        assert!(
+            e.starts_with("t.xyz:1: invalid number '\u{2212}1' in column 1 (a Unicode minus"),
+            "{e}"
+        );
+        // Comma-space CSV and a header with the same fields stay fine.
+        let c = read("x, y, z, i\n1, 2, 3, 4\n-0.5, 0.25, 1e3, 0\n").unwrap();
+        assert_eq!(c.points, vec![[1.0, 2.0, 3.0], [-0.5, 0.25, 1000.0]]);
+        // 0.5 is not a leading zero.
+        assert_eq!(read("0.5,0,0.25\n").unwrap().points, vec![[0.5, 0.0, 0.25]]);
+    }
+
+    #[test]
+    fn line_ends_and_encodings() {
+        // A lone CR inside a LF file ends a line.
+        let c = read("1 2 3\r4 5 6\n7 8 9\r\n").unwrap();
+        assert_eq!(c.points.len(), 3);
+        assert_eq!(
+            err("1 2 3\r4 5\n6 7 8\n"),
+            "t.xyz:2: expected 3 numeric columns, found 2"
+        );
+        assert_eq!(
+            err("1 2 3\r\n4 5\r\n"),
+            "t.xyz:2: expected 3 numeric columns, found 2"
+        );
+        let e = err("\u{feff}").to_string();
+        assert_eq!(e, "t.xyz: no points in file");
+        let utf16: Vec<u8> = "\u{feff}1 2 3\n"
+            .encode_utf16()
+            .flat_map(|u| u.to_le_bytes())
+            .collect();
+        assert!(read_text(Path::new("t.xyz"), &utf16, None)
+            .unwrap_err()
+            .to_string()
+            .contains("UTF-16"));
+        let no_bom: Vec<u8> = "1 2 3\n4 5 6\n"
+            .encode_utf16()
+            .flat_map(|u| u.to_be_bytes())
+            .collect();
+        let e = read_text(Path::new("t.xyz"), &no_bom, None)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("NUL bytes") && e.contains("UTF-16"), "{e}");
+    }
+
+    #[test]
+    fn header_guess_is_a_warning() {
+        let c = read("X Y Z\n1 2 3\n").unwrap();
+        assert_eq!(c.warnings.len(), 1);
+        assert_eq!(
+            c.warnings[0].to_string(),
+            "line 1 taken as a header: 'X Y Z'"
+        );
+        assert!(read("1 2 3\n").unwrap().warnings.is_empty());
+        assert!(read("# c\n\n3\n1 2 3\n").unwrap().warnings.is_empty());
+    }
+
+    #[test]
+    fn streaming_matches_whole_reads_at_every_buffer_size() {
+        let text = "# c\r\nx,y,z,l\r\n1,2,3,4\r\n5,6,7,8\r9,10,11,12\n13,14,15,16";
+        let whole = read_text(Path::new("t.csv"), text.as_bytes(), Some(3)).unwrap();
+        assert_eq!(whole.points.len(), 4);
+        for buffer in 1..text.len() + 2 {
+            let mut seen = 0;
+            let c = read_text_stream_with(
+                Path::new("t.csv"),
+                text.as_bytes(),
+                Some(3),
+                0,
+                &mut |n| seen = n,
+                buffer,
+            )
+            .unwrap();
+            assert_eq!(c, whole, "buffer {buffer}");
+            assert_eq!(seen, text.len() as u64);
+        }
+        // Errors carry the same line numbers.
+        let bad = "1 2 3\r\n4 5 6\r\n7 8\r\n";
+        for buffer in 1..bad.len() + 2 {
+            let e = read_text_stream_with(
+                Path::new("t.xyz"),
+                bad.as_bytes(),
+                None,
+                0,
+                &mut |_| {},
+                buffer,
+            )
+            .unwrap_err();
+            assert_eq!(
+                e.to_string(),
+                "t.xyz:3: expected 3 numeric columns, found 2"
+            );
+        }
     }
 }

@@ -5,6 +5,7 @@ use crate::aniso::Anisotropy;
 use crate::detect::fit::{fit_line, fit_plane};
 use crate::detect::orientations::{orientations, Sampler};
 use crate::detect::StructureKind;
+use crate::io::{write_xyz_labels, write_xyz_labels_parts};
 
 fn members(scene: &Scene, label: i64) -> Vec<[f64; 3]> {
     scene
@@ -106,7 +107,7 @@ fn lines_scene() {
             }
         }
     }
-    // SPEC §5: background nearest-neighbour distance ≳ 1.25 d.
+    // docs/method.md §5: background nearest-neighbour distance ≳ 1.25 d.
     let nn = nearest_neighbour_mean(&members(&s, -1));
     assert!(nn > 1.15 * 7.0 && nn < 1.45 * 7.0, "{nn}");
 }

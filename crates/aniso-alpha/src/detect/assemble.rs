@@ -1,0 +1,924 @@
+//! Assembling structures from the union of the scanned anisotropic
+//! α-shapes (paper §4.3, last steps; method doc §4 and §7).
+//!
+//! 1. **Candidates.** Each connected component of the cleaned union is
+//!    split into straight or flat pieces ([`super::parts`]); the piece
+//!    fits, and the fit of the whole component, are candidate primitives.
+//!    Greedily, the candidate covering the most not yet covered vertices of
+//!    the component within τ (the ellipsoid's short semi-axis α, so a
+//!    detected structure's points lie inside it) is refitted on its inliers
+//!    and taken, until none covers `min_vertices` new ones.
+//! 2. **Support.** A candidate's *footprint* is the set of cells (side c,
+//!    the ellipsoid's long reach α·λ) that its vertices occupy on its plane
+//!    (or along its line), grown by one cell: the region the scanned
+//!    α-shapes covered.
+//! 3. **Members.** Every point within τ of the primitive whose projection
+//!    falls in the footprint claims the candidate (the α-shape's simplices
+//!    reach the structure's points; points of a noisy structure that no
+//!    simplex touched are recovered here). A point claimed by several
+//!    candidates goes to the one it is nearest to: parts are disjoint.
+//!    Candidates that are one plane or one line (within the part angle,
+//!    and most of the smaller one's points within τ of the larger one's
+//!    primitive) and that share claimed points are merged first, so a
+//!    plane is never reported twice. Members are refitted once and claimed again.
+//! 4. **Significance.** With a test enabled, each part's number of false
+//!    alarms is computed ([`super::significance`]) and parts above ε go.
+//! 5. **Structures.** Parts that share claimed points (where two facets
+//!    meet) and do not cross each other (crossing lines, planes cutting
+//!    through each other, a T-junction) are facets of one structure.
+//!    Structures are numbered by size (points), largest first, parts
+//!    likewise within each, and each planar part gets its outline and mesh
+//!    ([`super::outline`]), each straight part its segment.
+
+use super::detection::{first_occurrences, Detection, Part, Primitive, RunStats, Structure};
+use super::filter::{components, FilterError};
+use super::fit::fit_line;
+use super::outline::outline;
+use super::scan::Face;
+use super::significance::log10_nfa;
+use super::StructureKind;
+use crate::geometry::kdtree::KdTree;
+
+/// The scale of the candidates found by one group (mode) of orientations.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Scale {
+    /// Inlier distance τ (the α of the group's orientations).
+    pub tau: f64,
+    /// Footprint cell c (the ellipsoid's long reach α·λ).
+    pub cell: f64,
+}
+
+/// Settings of the assembly.
+#[derive(Debug, Clone)]
+pub(crate) struct Settings {
+    /// Lines or planes.
+    pub kind: StructureKind,
+    /// Angle tolerance (degrees) of straight/flat pieces and of merging.
+    pub part_angle_deg: f64,
+    /// Fewest points of a part.
+    pub min_vertices: usize,
+    /// Per group.
+    pub scales: Vec<Scale>,
+    /// log₁₀ ε of the significance test, or `None` for no test.
+    pub log10_epsilon: Option<f64>,
+    /// Orientations scanned (for the number of tests).
+    pub orientations: usize,
+}
+
+/// Relative share of a part's vertices on each side of another part's
+/// primitive for that primitive to cross it: 1/5.
+const CROSS_SHARE: usize = 5;
+
+/// Along a line, points within this fraction of the line's extent of the
+/// crossing point count as on neither side.
+const CROSS_LINE_MARGIN: f64 = 0.05;
+
+/// Ratio of the outer to the inner radius of the shell in which the local
+/// background density around a part is measured.
+const SHELL_RATIO: f64 = 4.0;
+
+/// A candidate part while it is assembled.
+#[derive(Debug, Clone)]
+struct Cand {
+    fit: Primitive,
+    tau: f64,
+    cell: f64,
+    seeds: Vec<u32>,
+    foot: Footprint,
+}
+
+/// The cells a candidate covers on its plane (2D) or along its line (1D).
+#[derive(Debug, Clone)]
+struct Footprint {
+    origin: [f64; 3],
+    axes: [[f64; 3]; 2],
+    cell: f64,
+    lo: [i64; 2],
+    dims: [usize; 2],
+    bits: Vec<bool>,
+}
+
+/// Largest number of cells of one footprint; beyond it the cell is
+/// doubled (a coarser footprint, never a failure).
+const MAX_CELLS: usize = 1 << 24;
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+impl Footprint {
+    fn frame(fit: &Primitive) -> Option<([f64; 3], [[f64; 3]; 2], bool)> {
+        match fit {
+            Primitive::Plane(f) => Some((f.centroid, f.axes, true)),
+            Primitive::Line(f) => Some((f.centroid, [f.direction, [0.0; 3]], false)),
+            Primitive::None => None,
+        }
+    }
+
+    fn coords(&self, p: &[f64; 3]) -> [i64; 2] {
+        let w = sub(*p, self.origin);
+        [
+            (dot(w, self.axes[0]) / self.cell).floor() as i64,
+            (dot(w, self.axes[1]) / self.cell).floor() as i64,
+        ]
+    }
+
+    fn new(fit: &Primitive, points: &[[f64; 3]], seeds: &[u32], cell: f64) -> Option<Self> {
+        let (origin, axes, _) = Self::frame(fit)?;
+        let mut cell = cell;
+        loop {
+            let mut f = Footprint {
+                origin,
+                axes,
+                cell,
+                lo: [0; 2],
+                dims: [0; 2],
+                bits: Vec::new(),
+            };
+            let cs: Vec<[i64; 2]> = seeds
+                .iter()
+                .map(|&v| f.coords(&points[v as usize]))
+                .collect();
+            if cs.is_empty() {
+                return None;
+            }
+            let mut lo = [i64::MAX; 2];
+            let mut hi = [i64::MIN; 2];
+            for c in &cs {
+                for k in 0..2 {
+                    lo[k] = lo[k].min(c[k]);
+                    hi[k] = hi[k].max(c[k]);
+                }
+            }
+            // One cell of margin for the dilation.
+            let lo = [lo[0] - 1, lo[1] - 1];
+            let dims = [(hi[0] + 2 - lo[0]) as usize, (hi[1] + 2 - lo[1]) as usize];
+            if dims[0].saturating_mul(dims[1]) > MAX_CELLS {
+                cell *= 2.0;
+                continue;
+            }
+            let mut marked = vec![false; dims[0] * dims[1]];
+            for c in &cs {
+                marked[(c[0] - lo[0]) as usize * dims[1] + (c[1] - lo[1]) as usize] = true;
+            }
+            // Dilate by one cell (8-neighbourhood; along a line, 2).
+            let mut bits = marked.clone();
+            for i in 0..dims[0] {
+                for j in 0..dims[1] {
+                    if !marked[i * dims[1] + j] {
+                        continue;
+                    }
+                    for di in -1i64..=1 {
+                        for dj in -1i64..=1 {
+                            let (a, b) = (i as i64 + di, j as i64 + dj);
+                            if a >= 0 && b >= 0 && (a as usize) < dims[0] && (b as usize) < dims[1]
+                            {
+                                bits[a as usize * dims[1] + b as usize] = true;
+                            }
+                        }
+                    }
+                }
+            }
+            f.lo = lo;
+            f.dims = dims;
+            f.bits = bits;
+            return Some(f);
+        }
+    }
+
+    fn contains(&self, p: &[f64; 3]) -> bool {
+        let c = self.coords(p);
+        let (a, b) = (c[0] - self.lo[0], c[1] - self.lo[1]);
+        a >= 0
+            && b >= 0
+            && (a as usize) < self.dims[0]
+            && (b as usize) < self.dims[1]
+            && self.bits[a as usize * self.dims[1] + b as usize]
+    }
+
+    /// Number of covered cells.
+    fn count(&self) -> usize {
+        self.bits.iter().filter(|&&b| b).count()
+    }
+
+    /// Centres (3D, on the primitive) of the covered cells.
+    fn centres(&self) -> impl Iterator<Item = [f64; 3]> + '_ {
+        (0..self.dims[0]).flat_map(move |i| {
+            (0..self.dims[1]).filter_map(move |j| {
+                if !self.bits[i * self.dims[1] + j] {
+                    return None;
+                }
+                let u = (self.lo[0] + i as i64) as f64 + 0.5;
+                let v = (self.lo[1] + j as i64) as f64 + 0.5;
+                Some([0, 1, 2].map(|k| {
+                    self.origin[k] + self.cell * (u * self.axes[0][k] + v * self.axes[1][k])
+                }))
+            })
+        })
+    }
+}
+
+/// Per-point marks that tell whether a query already reported a point,
+/// without clearing between queries.
+struct Stamps {
+    v: Vec<u32>,
+    mark: u32,
+}
+
+impl Stamps {
+    fn new(n: usize) -> Self {
+        Stamps {
+            v: vec![0; n],
+            mark: 0,
+        }
+    }
+    fn next(&mut self) -> u32 {
+        if self.mark == u32::MAX {
+            self.v.iter_mut().for_each(|x| *x = 0);
+            self.mark = 0;
+        }
+        self.mark += 1;
+        self.mark
+    }
+}
+
+/// Calls `f(point, distance)` for every indexed point within `radius` of
+/// the primitive and in the footprint (each once).
+fn for_near(
+    c: &Cand,
+    radius: f64,
+    points: &[[f64; 3]],
+    index: &KdTree,
+    stamps: &mut Stamps,
+    f: &mut dyn FnMut(u32, f64),
+) {
+    let mark = stamps.next();
+    let stamp = &mut stamps.v;
+    let planar = matches!(c.fit, Primitive::Plane(_));
+    let half = if planar {
+        c.foot.cell * std::f64::consts::FRAC_1_SQRT_2
+    } else {
+        0.5 * c.foot.cell
+    };
+    let r = (half * half + radius * radius).sqrt();
+    for centre in c.foot.centres() {
+        index.within(&centre, r, |i| {
+            if stamp[i as usize] == mark {
+                return;
+            }
+            let p = &points[i as usize];
+            let d = c.fit.distance(p);
+            if d <= radius && c.foot.contains(p) {
+                stamp[i as usize] = mark;
+                f(i, d);
+            }
+        });
+    }
+}
+
+/// Whether the primitive `fit` (of part A) passes through the interior of
+/// part B (its points `b`): B has at least 1/[`CROSS_SHARE`] of its points
+/// strictly on each side. For a plane, the sides of the plane (beyond
+/// 3·RMS); for a line, the two sides of the point of B's line closest to
+/// it, along B's direction.
+fn crosses(fit: &Primitive, b: &[u32], points: &[[f64; 3]]) -> bool {
+    if b.len() < 4 {
+        return false;
+    }
+    let side = |d: f64, tol: f64| {
+        if d > tol {
+            1
+        } else if d < -tol {
+            2
+        } else {
+            0
+        }
+    };
+    let (pos, neg) = match fit {
+        Primitive::Plane(pf) => {
+            let tol = 3.0 * pf.rms_residual + 1e-9 * (pf.extent[0] + pf.extent[1]);
+            let mut c = (0, 0);
+            for &v in b {
+                match side(dot(sub(points[v as usize], pf.centroid), pf.normal), tol) {
+                    1 => c.0 += 1,
+                    2 => c.1 += 1,
+                    _ => {}
+                }
+            }
+            c
+        }
+        Primitive::Line(la) => {
+            let bv: Vec<[f64; 3]> = b.iter().map(|&v| points[v as usize]).collect();
+            let Ok(lb) = fit_line(&bv) else {
+                return false;
+            };
+            let w = sub(lb.centroid, la.centroid);
+            let (u, v) = (la.direction, lb.direction);
+            let (a_, b_, c_) = (dot(u, u), dot(u, v), dot(v, v));
+            let (d_, e_) = (dot(u, w), dot(v, w));
+            let den = a_ * c_ - b_ * b_;
+            if den.abs() < 1e-12 {
+                return false; // parallel: no crossing
+            }
+            let t = (b_ * d_ - a_ * e_) / den; // parameter along B
+            let tol = CROSS_LINE_MARGIN * lb.extent.max(1e-12);
+            let mut c = (0, 0);
+            for p in &bv {
+                match side(dot(sub(*p, lb.centroid), v) - t, tol) {
+                    1 => c.0 += 1,
+                    2 => c.1 += 1,
+                    _ => {}
+                }
+            }
+            c
+        }
+        Primitive::None => return false,
+    };
+    usize::min(pos, neg) * CROSS_SHARE >= b.len()
+}
+
+/// Share of the smaller candidate's seeds that must lie within τ of the
+/// larger one's primitive for the two to be one.
+const SAME_SHARE: f64 = 0.8;
+
+/// Whether two candidates are one primitive: their planes (lines) are
+/// within the part angle of each other, and either each one's centroid
+/// lies within τ of the other's primitive or most of the smaller one's
+/// seeds lie within τ of the larger one's primitive. (The second test
+/// catches a strip along the edge of a plane, found by another mode: it
+/// fits a plane tilted across the strip, whose offset at the other's
+/// centroid says nothing.)
+fn same_primitive(a: &Cand, b: &Cand, angle_deg: f64, points: &[[f64; 3]]) -> bool {
+    let cos = angle_deg.to_radians().cos();
+    let parallel = match (&a.fit, &b.fit) {
+        (Primitive::Plane(fa), Primitive::Plane(fb)) => dot(fa.normal, fb.normal).abs() >= cos,
+        (Primitive::Line(fa), Primitive::Line(fb)) => dot(fa.direction, fb.direction).abs() >= cos,
+        _ => false,
+    };
+    if !parallel {
+        return false;
+    }
+    let centroid = |f: &Primitive| match f {
+        Primitive::Plane(p) => p.centroid,
+        Primitive::Line(l) => l.centroid,
+        Primitive::None => [f64::NAN; 3],
+    };
+    if a.fit.distance(&centroid(&b.fit)) <= a.tau && b.fit.distance(&centroid(&a.fit)) <= b.tau {
+        return true;
+    }
+    let (big, small) = if a.seeds.len() >= b.seeds.len() {
+        (a, b)
+    } else {
+        (b, a)
+    };
+    let near = small
+        .seeds
+        .iter()
+        .filter(|&&v| big.fit.distance(&points[v as usize]) <= big.tau)
+        .count();
+    near as f64 >= SAME_SHARE * small.seeds.len() as f64
+}
+
+struct Uf(Vec<u32>);
+impl Uf {
+    fn new(n: usize) -> Self {
+        Uf((0..n as u32).collect())
+    }
+    fn find(&mut self, mut x: u32) -> u32 {
+        while self.0[x as usize] != x {
+            self.0[x as usize] = self.0[self.0[x as usize] as usize];
+            x = self.0[x as usize];
+        }
+        x
+    }
+    fn union(&mut self, a: u32, b: u32) {
+        let (ra, rb) = (self.find(a), self.find(b));
+        if ra != rb {
+            self.0[ra.max(rb) as usize] = ra.min(rb);
+        }
+    }
+}
+
+/// Greedy extraction of straight/flat primitives from one connected
+/// component (step 1 of the module doc): their inlier vertices and fits.
+fn extract<S: Face>(
+    points: &[[f64; 3]],
+    local: &[S],
+    tol: f64,
+    min_vertices: usize,
+    angle: f64,
+) -> Vec<(Vec<u32>, Primitive)> {
+    let mut out = Vec::new();
+    let mut verts: Vec<u32> = local.iter().flat_map(|s| s.as_ref().to_vec()).collect();
+    verts.sort_unstable();
+    verts.dedup();
+    if verts.len() < min_vertices {
+        return out;
+    }
+    // Pieces of like-oriented simplices (a failure, which needs a NaN
+    // point, leaves the component in one piece).
+    let part = S::parts(points, local, angle).unwrap_or_else(|_| vec![0; local.len()]);
+    let n_parts = part.iter().map(|&p| p as usize + 1).max().unwrap_or(0);
+    let mut pv: Vec<Vec<u32>> = vec![Vec::new(); n_parts];
+    for (s, &p) in local.iter().zip(&part) {
+        pv[p as usize].extend_from_slice(s.as_ref());
+    }
+    // Candidates: pieces with at least two simplices' worth of points,
+    // largest first, at most 64 of them; plus the whole component.
+    let mut cands: Vec<Primitive> = Vec::new();
+    let mut by_size: Vec<(usize, usize)> = pv
+        .iter_mut()
+        .enumerate()
+        .map(|(i, v)| {
+            v.sort_unstable();
+            v.dedup();
+            (v.len(), i)
+        })
+        .collect();
+    by_size.sort_unstable_by(|a, b| b.0.cmp(&a.0).then(a.1.cmp(&b.1)));
+    for &(sz, i) in by_size.iter().take(64) {
+        if sz >= S::K + 2 {
+            cands.push(S::fit(points, &pv[i]));
+        }
+    }
+    cands.push(S::fit(points, &verts));
+    let mut covered = vec![false; verts.len()];
+    loop {
+        let mut best: Option<(usize, usize)> = None; // (new inliers, candidate)
+        for (ci, c) in cands.iter().enumerate() {
+            let new = verts
+                .iter()
+                .zip(&covered)
+                .filter(|(&v, &cov)| !cov && c.distance(&points[v as usize]) <= tol)
+                .count();
+            if best.is_none_or(|b| new > b.0) {
+                best = Some((new, ci));
+            }
+        }
+        let Some((new, ci)) = best else { break };
+        if new < min_vertices {
+            break;
+        }
+        let mut fit = cands.swap_remove(ci);
+        let inliers = |fit: &Primitive| -> Vec<u32> {
+            verts
+                .iter()
+                .copied()
+                .filter(|&v| fit.distance(&points[v as usize]) <= tol)
+                .collect()
+        };
+        for _ in 0..2 {
+            let refit = S::fit(points, &inliers(&fit));
+            if matches!(refit, Primitive::None) {
+                break;
+            }
+            fit = refit;
+        }
+        let inl = inliers(&fit);
+        let mut gained = 0;
+        for (k, &v) in verts.iter().enumerate() {
+            if !covered[k] && inl.binary_search(&v).is_ok() {
+                covered[k] = true;
+                gained += 1;
+            }
+        }
+        if gained < min_vertices || inl.len() < min_vertices {
+            break;
+        }
+        out.push((inl, fit));
+    }
+    out
+}
+
+/// Everything the assembly produces besides the [`Detection`] itself.
+pub(crate) struct Assembled {
+    pub detection: Detection,
+}
+
+/// The assembly (module doc) of the cleaned union `kept`, whose simplices
+/// were found by the groups `group`.
+pub(crate) fn assemble<S: Face>(
+    points: &[[f64; 3]],
+    kept: Vec<S>,
+    group: Vec<u32>,
+    settings: &Settings,
+    mut stats: RunStats,
+) -> Result<Assembled, FilterError> {
+    let n = points.len();
+    let first = first_occurrences(points);
+    let firsts: Vec<u32> = (0..n as u32).filter(|&i| first[i as usize] == i).collect();
+    let index = KdTree::new(points, Some(firsts.clone()));
+    // 1. Candidates, component by component within each group (the
+    // simplices found by one mode's orientations), at that group's scale:
+    // a component of the whole union can join a noisy wall (large α) to a
+    // clean roof (small α) along their common edge.
+    let n_groups = settings.scales.len();
+    let mut by_group: Vec<Vec<u32>> = vec![Vec::new(); n_groups];
+    for (s, &g) in group.iter().enumerate() {
+        by_group[g as usize].push(s as u32);
+    }
+    let mut comp_simplices: Vec<(u32, Vec<u32>)> = Vec::new();
+    for (g, ss) in by_group.iter().enumerate() {
+        if ss.is_empty() {
+            continue;
+        }
+        let local: Vec<S> = ss.iter().map(|&s| kept[s as usize]).collect();
+        let comp = components(&local)?;
+        let n_comp = comp.iter().map(|&c| c as usize + 1).max().unwrap_or(0);
+        let mut parts: Vec<Vec<u32>> = vec![Vec::new(); n_comp];
+        for (k, &c) in comp.iter().enumerate() {
+            parts[c as usize].push(ss[k]);
+        }
+        comp_simplices.extend(parts.into_iter().map(|p| (g as u32, p)));
+    }
+    let mut cands: Vec<Cand> = Vec::new();
+    for (g, ss) in &comp_simplices {
+        let scale = settings.scales[*g as usize];
+        let local: Vec<S> = ss.iter().map(|&s| kept[s as usize]).collect();
+        for (seeds, fit) in extract(
+            points,
+            &local,
+            scale.tau,
+            settings.min_vertices,
+            settings.part_angle_deg,
+        ) {
+            if let Some(foot) = Footprint::new(&fit, points, &seeds, scale.cell) {
+                cands.push(Cand {
+                    fit,
+                    tau: scale.tau,
+                    cell: scale.cell,
+                    seeds,
+                    foot,
+                });
+            }
+        }
+    }
+    // 3. Members: claims, merging of duplicates, resolution, refit, claims
+    // again.
+    let mut stamp = Stamps::new(n);
+    let claims_of = |cands: &[Cand], stamp: &mut Stamps| -> Vec<(u32, u32, f64)> {
+        // (point, candidate, distance)
+        let mut claims = Vec::new();
+        for (ci, c) in cands.iter().enumerate() {
+            for_near(c, c.tau, points, &index, stamp, &mut |i, d| {
+                claims.push((i, ci as u32, d));
+            });
+        }
+        claims.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.cmp(&b.1)));
+        claims
+    };
+    let mut claims = claims_of(&cands, &mut stamp);
+    // Merge candidates that are one primitive and share claimed points.
+    loop {
+        let mut uf = Uf::new(cands.len());
+        let mut merged = false;
+        let mut pairs: Vec<(u32, u32)> = Vec::new();
+        let mut i = 0;
+        while i < claims.len() {
+            let j = claims[i..]
+                .iter()
+                .take_while(|c| c.0 == claims[i].0)
+                .count();
+            for a in i..i + j {
+                for b in a + 1..i + j {
+                    pairs.push((claims[a].1, claims[b].1));
+                }
+            }
+            i += j;
+        }
+        pairs.sort_unstable();
+        pairs.dedup();
+        for (a, b) in pairs {
+            if uf.find(a) != uf.find(b)
+                && same_primitive(
+                    &cands[a as usize],
+                    &cands[b as usize],
+                    settings.part_angle_deg,
+                    points,
+                )
+            {
+                uf.union(a, b);
+                merged = true;
+            }
+        }
+        if !merged {
+            break;
+        }
+        let mut groups: Vec<Vec<u32>> = vec![Vec::new(); cands.len()];
+        for c in 0..cands.len() as u32 {
+            groups[uf.find(c) as usize].push(c);
+        }
+        let mut next: Vec<Cand> = Vec::new();
+        for g in groups.into_iter().filter(|g| !g.is_empty()) {
+            if g.len() == 1 {
+                next.push(cands[g[0] as usize].clone());
+                continue;
+            }
+            let mut seeds: Vec<u32> = g
+                .iter()
+                .flat_map(|&c| cands[c as usize].seeds.iter().copied())
+                .collect();
+            seeds.sort_unstable();
+            seeds.dedup();
+            let tau = g.iter().map(|&c| cands[c as usize].tau).fold(0.0, f64::max);
+            let cell = g
+                .iter()
+                .map(|&c| cands[c as usize].cell)
+                .fold(0.0, f64::max);
+            let fit = S::fit(points, &seeds);
+            if let Some(foot) = Footprint::new(&fit, points, &seeds, cell) {
+                next.push(Cand {
+                    fit,
+                    tau,
+                    cell,
+                    seeds,
+                    foot,
+                });
+            }
+        }
+        cands = next;
+        claims = claims_of(&cands, &mut stamp);
+    }
+    let resolve = |claims: &[(u32, u32, f64)], nc: usize| -> Vec<Vec<u32>> {
+        let mut members: Vec<Vec<u32>> = vec![Vec::new(); nc];
+        let mut i = 0;
+        while i < claims.len() {
+            let j = claims[i..]
+                .iter()
+                .take_while(|c| c.0 == claims[i].0)
+                .count();
+            let best = claims[i..i + j]
+                .iter()
+                .min_by(|a, b| a.2.total_cmp(&b.2).then(a.1.cmp(&b.1)))
+                .map_or(0, |c| c.1);
+            members[best as usize].push(claims[i].0);
+            i += j;
+        }
+        members
+    };
+    let members = resolve(&claims, cands.len());
+    // Refit on the members, claim again.
+    for (c, m) in cands.iter_mut().zip(&members) {
+        if m.len() > S::K {
+            let refit = S::fit(points, m);
+            if !matches!(refit, Primitive::None) {
+                if let Some(foot) = Footprint::new(&refit, points, m, c.cell) {
+                    c.fit = refit;
+                    c.foot = foot;
+                }
+            }
+        }
+    }
+    let claims = claims_of(&cands, &mut stamp);
+    let members = resolve(&claims, cands.len());
+    // Final parts: refit on members, drop the small ones.
+    struct P {
+        members: Vec<u32>,
+        fit: Primitive,
+        cand: usize,
+        log10_nfa: f64,
+    }
+    let mut parts: Vec<P> = Vec::new();
+    for (ci, m) in members.into_iter().enumerate() {
+        if m.len() < settings.min_vertices.max(S::K + 1) {
+            continue;
+        }
+        let fit = S::fit(points, &m);
+        if matches!(fit, Primitive::None) {
+            continue;
+        }
+        parts.push(P {
+            members: m,
+            fit,
+            cand: ci,
+            log10_nfa: f64::NEG_INFINITY,
+        });
+    }
+    // 4. Significance.
+    if let Some(log_eps) = settings.log10_epsilon {
+        let in_parts: usize = parts.iter().map(|p| p.members.len()).sum();
+        let (lo, hi) = crate::geometry::bounding_box(points);
+        let volume: f64 = (0..3).map(|k| (hi[k] - lo[k]).max(1e-300)).product();
+        let rho_global = firsts.len().saturating_sub(in_parts) as f64 / volume;
+        let n_tests = settings.orientations.max(1) as f64 * firsts.len() as f64;
+        for p in parts.iter_mut() {
+            let c = &cands[p.cand];
+            let thick = p
+                .members
+                .iter()
+                .map(|&v| p.fit.distance(&points[v as usize]))
+                .fold(0.0, f64::max)
+                .max(1e-6 * c.cell);
+            let tau = c.tau.max(thick);
+            // Footprint extent from the members (cells they occupy).
+            let foot = Footprint::new(&p.fit, points, &p.members, c.cell);
+            let Some(foot) = foot else { continue };
+            let cells = foot.count() as f64;
+            let planar = matches!(p.fit, Primitive::Plane(_));
+            let extent = if planar {
+                cells * c.cell * c.cell
+            } else {
+                cells * c.cell
+            };
+            let vol = |t: f64| {
+                if planar {
+                    2.0 * t * extent
+                } else {
+                    std::f64::consts::PI * t * t * extent
+                }
+            };
+            // Local density in the shell (τ, 4τ] over the footprint.
+            let outer = SHELL_RATIO * tau;
+            let probe = Cand {
+                fit: p.fit.clone(),
+                tau: outer,
+                cell: c.cell,
+                seeds: Vec::new(),
+                foot,
+            };
+            let mut shell = 0usize;
+            for_near(&probe, outer, points, &index, &mut stamp, &mut |_, d| {
+                if d > tau {
+                    shell += 1;
+                }
+            });
+            let rho_local = (shell as f64 + 1.0) / (vol(outer) - vol(tau)).max(1e-300);
+            let rho = rho_local.max(rho_global);
+            p.log10_nfa = log10_nfa(n_tests, rho * vol(thick), p.members.len() as u64);
+        }
+        let before = parts.len();
+        parts.retain(|p| p.log10_nfa <= log_eps);
+        stats.rejected_parts = before - parts.len();
+    }
+    // 5. Structures: parts sharing claims and not crossing.
+    let np = parts.len();
+    let mut part_of_cand = vec![u32::MAX; cands.len()];
+    for (pi, p) in parts.iter().enumerate() {
+        part_of_cand[p.cand] = pi as u32;
+    }
+    let mut uf = Uf::new(np);
+    let mut i = 0;
+    let mut pairs: Vec<(u32, u32)> = Vec::new();
+    while i < claims.len() {
+        let j = claims[i..]
+            .iter()
+            .take_while(|c| c.0 == claims[i].0)
+            .count();
+        for a in i..i + j {
+            for b in a + 1..i + j {
+                let (pa, pb) = (
+                    part_of_cand[claims[a].1 as usize],
+                    part_of_cand[claims[b].1 as usize],
+                );
+                if pa != u32::MAX && pb != u32::MAX && pa != pb {
+                    pairs.push((pa.min(pb), pa.max(pb)));
+                }
+            }
+        }
+        i += j;
+    }
+    pairs.sort_unstable();
+    pairs.dedup();
+    for (a, b) in pairs {
+        let (pa, pb) = (&parts[a as usize], &parts[b as usize]);
+        if !crosses(&pa.fit, &pb.members, points) && !crosses(&pb.fit, &pa.members, points) {
+            uf.union(a, b);
+        }
+    }
+    let mut members_of: Vec<Vec<u32>> = vec![Vec::new(); np];
+    for p in 0..np as u32 {
+        members_of[uf.find(p) as usize].push(p);
+    }
+    let mut groups: Vec<(usize, u32, Vec<u32>)> = members_of
+        .into_iter()
+        .filter(|g| !g.is_empty())
+        .map(|g| {
+            let size: usize = g.iter().map(|&p| parts[p as usize].members.len()).sum();
+            let first = g
+                .iter()
+                .map(|&p| parts[p as usize].members[0])
+                .min()
+                .unwrap_or(u32::MAX);
+            (size, first, g)
+        })
+        .collect();
+    groups.sort_unstable_by(|a, b| b.0.cmp(&a.0).then(a.1.cmp(&b.1)));
+    // Point → structure and part (global part numbering as in the report).
+    let mut vstruct = vec![u32::MAX; n];
+    let mut vpart = vec![u32::MAX; n];
+    let mut structures: Vec<Structure> = Vec::with_capacity(groups.len());
+    for (id, (_, _, g)) in groups.into_iter().enumerate() {
+        let mut ps: Vec<u32> = g;
+        ps.sort_by(|&a, &b| {
+            let (pa, pb) = (&parts[a as usize], &parts[b as usize]);
+            pb.members
+                .len()
+                .cmp(&pa.members.len())
+                .then(pa.members[0].cmp(&pb.members[0]))
+        });
+        let mut sparts: Vec<Part> = Vec::with_capacity(ps.len());
+        for &pi in &ps {
+            let p = &parts[pi as usize];
+            let c = &cands[p.cand];
+            let (outline_pts, mesh) = match &p.fit {
+                Primitive::Plane(f) => {
+                    let o = outline(points, &p.members, f, c.cell);
+                    (o.polygon, o.triangles)
+                }
+                Primitive::Line(f) => {
+                    let (mut t0, mut t1) = (f64::INFINITY, f64::NEG_INFINITY);
+                    for &v in &p.members {
+                        let t = dot(sub(points[v as usize], f.centroid), f.direction);
+                        t0 = t0.min(t);
+                        t1 = t1.max(t);
+                    }
+                    let at = |t: f64| [0, 1, 2].map(|k| f.centroid[k] + t * f.direction[k]);
+                    (vec![at(t0), at(t1)], Vec::new())
+                }
+                Primitive::None => (Vec::new(), Vec::new()),
+            };
+            sparts.push(Part {
+                simplices: Vec::new(),
+                vertices: p.members.clone(),
+                primitive: p.fit.clone(),
+                outline: outline_pts,
+                mesh,
+                log10_nfa: p.log10_nfa,
+            });
+        }
+        let mut v: Vec<u32> = sparts
+            .iter()
+            .flat_map(|p| p.vertices.iter().copied())
+            .collect();
+        v.sort_unstable();
+        let gid = structures.len() as u32;
+        let part_base: u32 = structures.iter().map(|s| s.parts.len() as u32).sum();
+        for (k, p) in sparts.iter().enumerate() {
+            for &x in &p.vertices {
+                vstruct[x as usize] = gid;
+                vpart[x as usize] = part_base + k as u32;
+            }
+        }
+        let log10_nfa = sparts
+            .iter()
+            .map(|p| p.log10_nfa)
+            .fold(f64::INFINITY, f64::min);
+        structures.push(Structure {
+            id: id as u32,
+            simplices: Vec::new(),
+            primitive: S::fit(points, &v),
+            vertices: v,
+            parts: sparts,
+            log10_nfa,
+        });
+    }
+    // Simplices of the union kept when all their vertices are in one
+    // structure; within it, in a part when all are in that part.
+    let mut simplices: Vec<Vec<u32>> = Vec::new();
+    let mut simplex_structure: Vec<u32> = Vec::new();
+    let part_index: Vec<(u32, u32)> = structures
+        .iter()
+        .enumerate()
+        .flat_map(|(s, st)| (0..st.parts.len() as u32).map(move |p| (s as u32, p)))
+        .collect();
+    for s in &kept {
+        let vs = s.as_ref();
+        let st = vstruct[vs[0] as usize];
+        if st == u32::MAX || !vs.iter().all(|&v| vstruct[v as usize] == st) {
+            continue;
+        }
+        let idx = simplices.len() as u32;
+        let gp = vpart[vs[0] as usize];
+        if vs.iter().all(|&v| vpart[v as usize] == gp) {
+            let (_, p) = part_index[gp as usize];
+            structures[st as usize].parts[p as usize]
+                .simplices
+                .push(idx);
+        }
+        structures[st as usize].simplices.push(idx);
+        simplices.push(vs.to_vec());
+        simplex_structure.push(st);
+    }
+    let labels: Vec<i64> = first
+        .iter()
+        .map(|&f| match vstruct[f as usize] {
+            u32::MAX => -1,
+            s => s as i64,
+        })
+        .collect();
+    stats.structure_simplices = simplices.len();
+    Ok(Assembled {
+        detection: Detection {
+            kind: settings.kind,
+            simplices,
+            simplex_structure,
+            structures,
+            labels,
+            first_occurrence: first,
+            stats,
+        },
+    })
+}

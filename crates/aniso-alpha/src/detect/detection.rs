@@ -1,0 +1,227 @@
+//! The result of a detection: structures, their parts with fitted planes
+//! or lines, outlines and meshes, per-point labels, and counters.
+
+use super::fit::{LineFit, PlaneFit};
+use super::StructureKind;
+
+/// A fitted primitive.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Primitive {
+    /// A least-squares line (k = 1).
+    Line(LineFit),
+    /// A least-squares plane (k = 2).
+    Plane(PlaneFit),
+    /// Too few or degenerate points to fit.
+    None,
+}
+
+impl Primitive {
+    /// The RMS distance of the fitted points to the primitive (∞ for none).
+    pub fn rms(&self) -> f64 {
+        match self {
+            Primitive::Line(f) => f.rms_residual,
+            Primitive::Plane(f) => f.rms_residual,
+            Primitive::None => f64::INFINITY,
+        }
+    }
+
+    /// The plane as `[a, b, c, d]` with (a, b, c) the unit normal and
+    /// a·x + b·y + c·z + d = 0.
+    pub fn plane_equation(&self) -> Option<[f64; 4]> {
+        match self {
+            Primitive::Plane(f) => {
+                let n = f.normal;
+                let d = -(n[0] * f.centroid[0] + n[1] * f.centroid[1] + n[2] * f.centroid[2]);
+                Some([n[0], n[1], n[2], d])
+            }
+            _ => None,
+        }
+    }
+
+    /// Distance from `p` to the primitive (∞ for none).
+    pub fn distance(&self, p: &[f64; 3]) -> f64 {
+        let w = |c: [f64; 3]| [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
+        match self {
+            Primitive::Plane(f) => {
+                let w = w(f.centroid);
+                (w[0] * f.normal[0] + w[1] * f.normal[1] + w[2] * f.normal[2]).abs()
+            }
+            Primitive::Line(f) => {
+                let w = w(f.centroid);
+                let d = f.direction;
+                let t = w[0] * d[0] + w[1] * d[1] + w[2] * d[2];
+                let r = [w[0] - t * d[0], w[1] - t * d[1], w[2] - t * d[2]];
+                (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt()
+            }
+            Primitive::None => f64::INFINITY,
+        }
+    }
+}
+
+/// A straight or flat piece of a structure: a plane with its outline, or a
+/// segment. Parts are disjoint: a point belongs to at most one part.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Part {
+    /// Indices into [`Detection::simplices`] (the union of the scanned
+    /// anisotropic α-shapes) of the simplices with all their vertices in
+    /// this part.
+    pub simplices: Vec<u32>,
+    /// Input indices of its points, ascending (first occurrences of
+    /// duplicated points).
+    pub vertices: Vec<u32>,
+    /// Its least-squares line or plane (on [`Self::vertices`]).
+    pub primitive: Primitive,
+    /// A plane part's outline: the boundary of the 2D α-shape of its
+    /// points on the plane (outer loop, counter-clockwise seen from the
+    /// normal), as points on the plane; a line part's segment: its two end
+    /// points (the extreme projections of its points on the line).
+    pub outline: Vec<[f64; 3]>,
+    /// A plane part's clean mesh: the triangles of that 2D α-shape, over
+    /// input point indices (one triangulation of the plane, so no two
+    /// triangles overlap and every edge has at most two triangles). Empty
+    /// for lines.
+    pub mesh: Vec<[u32; 3]>,
+    /// log₁₀ of its number of false alarms (see `detect::significance`);
+    /// `-inf` when the test was not run.
+    pub log10_nfa: f64,
+}
+
+impl Part {
+    /// The part's plane `[a, b, c, d]` (unit normal), for a plane part.
+    pub fn plane(&self) -> Option<[f64; 4]> {
+        self.primitive.plane_equation()
+    }
+
+    /// The part's segment (two end points), for a line part.
+    pub fn segment(&self) -> Option<[[f64; 3]; 2]> {
+        match (&self.primitive, self.outline.as_slice()) {
+            (Primitive::Line(_), [a, b]) => Some([*a, *b]),
+            _ => None,
+        }
+    }
+}
+
+/// A detected structure: a line, a plane, or a polyhedral surface (several
+/// flat parts meeting along their boundaries) or polyline.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Structure {
+    /// Its id (0 = largest), as used in [`Detection::labels`].
+    pub id: u32,
+    /// Indices into [`Detection::simplices`].
+    pub simplices: Vec<u32>,
+    /// Input indices of its points, ascending: the union of its parts'.
+    pub vertices: Vec<u32>,
+    /// Least-squares line (k = 1) or plane (k = 2) of all its points
+    /// (meaningful for a single part; a surface's is only indicative).
+    pub primitive: Primitive,
+    /// Its straight or flat parts, largest first (one for a plain line or
+    /// plane; the facets of a polyhedral surface).
+    pub parts: Vec<Part>,
+    /// log₁₀ of the smallest number of false alarms of its parts.
+    pub log10_nfa: f64,
+}
+
+impl Structure {
+    /// "line", "polyline", "plane" or "surface".
+    pub fn kind_name(&self) -> &'static str {
+        match (&self.primitive, self.parts.len()) {
+            (Primitive::Line(_), 1) => "line",
+            (Primitive::Line(_), _) => "polyline",
+            (Primitive::Plane(_), 1) => "plane",
+            (Primitive::Plane(_), _) => "surface",
+            (Primitive::None, _) => "unfitted",
+        }
+    }
+}
+
+/// Counters of a run.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct RunStats {
+    /// Orientations scanned.
+    pub orientations: usize,
+    /// Points triangulated, summed over orientations (after pruning, halos
+    /// included).
+    pub triangulated_points: u64,
+    /// Simplices of `F_{k,α,Q}` before the path filter, summed.
+    pub raw_simplices: u64,
+    /// Simplices after the path filter, summed over orientations.
+    pub filtered_simplices: u64,
+    /// Distinct simplices in the union.
+    pub union_simplices: usize,
+    /// Simplices left after the component clean-up.
+    pub kept_simplices: usize,
+    /// Simplices of the reported structures.
+    pub structure_simplices: usize,
+    /// Candidate parts rejected by the significance test.
+    pub rejected_parts: usize,
+}
+
+/// The result of [`super::detector::Detector::run`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Detection {
+    /// Lines (k = 1) or planes (k = 2).
+    pub kind: StructureKind,
+    /// The simplices of the structures (from the union of the scanned
+    /// anisotropic α-shapes): vertex index pairs (k = 1) or triples
+    /// (k = 2), ascending within each, sorted.
+    pub simplices: Vec<Vec<u32>>,
+    /// The structure of each simplex.
+    pub simplex_structure: Vec<u32>,
+    /// The structures, largest first.
+    pub structures: Vec<Structure>,
+    /// Per input point: the id of its structure, or −1 (background). An
+    /// exact duplicate has its first occurrence's.
+    pub labels: Vec<i64>,
+    /// Per input point: the index of the first input point with the same
+    /// coordinates (itself when no earlier point has them). Simplices,
+    /// structures and parts list first occurrences only.
+    pub first_occurrence: Vec<u32>,
+    /// Counters.
+    pub stats: RunStats,
+}
+
+impl Detection {
+    /// Per input point: the global id of its part (parts numbered
+    /// structure by structure, largest first, as in the report), or −1.
+    /// Parts are disjoint. An exact duplicate has its first occurrence's.
+    pub fn part_labels(&self) -> Vec<i64> {
+        let mut labels = vec![-1i64; self.labels.len()];
+        let mut id = 0i64;
+        for st in &self.structures {
+            for p in &st.parts {
+                for &v in &p.vertices {
+                    labels[v as usize] = id;
+                }
+                id += 1;
+            }
+        }
+        for (i, &f) in self.first_occurrence.iter().enumerate() {
+            labels[i] = labels[f as usize];
+        }
+        labels
+    }
+
+    /// Number of parts over all structures.
+    pub fn num_parts(&self) -> usize {
+        self.structures.iter().map(|s| s.parts.len()).sum()
+    }
+}
+
+/// Per point, the index of the first point with the same coordinates
+/// (itself when no earlier point has them).
+pub(crate) fn first_occurrences(points: &[[f64; 3]]) -> Vec<u32> {
+    let mut first: Vec<u32> = (0..points.len() as u32).collect();
+    let mut idx = first.clone();
+    // A stable sort: each run of equal points starts with its first index.
+    idx.sort_by(|&a, &b| {
+        points[a as usize]
+            .partial_cmp(&points[b as usize])
+            .unwrap_or(std::cmp::Ordering::Equal)
+    });
+    for w in idx.windows(2) {
+        if points[w[1] as usize] == points[w[0] as usize] {
+            first[w[1] as usize] = first[w[0] as usize];
+        }
+    }
+    first
+}

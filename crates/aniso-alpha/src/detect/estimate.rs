@@ -1,0 +1,424 @@
+//! Parameters and orientation set from the data (method doc §8).
+//!
+//! The paper's parameters are lengths and counts at the scale of the
+//! sampling (its Observations 3 and 4): α must stay below the distance from
+//! a structure to the background and above the structure's own thickness,
+//! α·λ must reach across the gaps between a structure's neighbouring
+//! points, and nb_c is the size under which a piece is chance. A user of a
+//! real scan knows none of these, so they are measured:
+//!
+//! 1. **Local shape** ([`super::local`]): per point, a PCA of its
+//!    neighbourhood at the scale where it looks most planar (k = 2) or
+//!    linear (k = 1): its axis (normal or direction), its spread across the
+//!    structure (noise), its spacing (distance to the nearest point), and
+//!    a score (planarity or linearity). Points scoring at least
+//!    [`SCORE_MIN`] are *structure-like*.
+//! 2. **Modes** ([`super::modes`]): the dominant axes of the
+//!    structure-like points (mean shift, kernel [`MODE_KERNEL_DEG`]).
+//! 3. **Per mode**, its *members*: every point whose axis lies within
+//!    [`CONE_DEG`] of the mode (a point of a plane with that normal has
+//!    its normal there; the others are background for that mode, so the
+//!    background each orientation sees is sparse, which is the paper's
+//!    regime). Among the structure-like members:
+//!    * spacing d = the 90th percentile of their spacings (so that the
+//!      sparser, farther parts of a scan with mixed density are reached:
+//!      a scanner's density falls with the square of the range, and one
+//!      global median would leave the far walls in pieces);
+//!    * noise σ = the median of their spreads.
+//! 4. **α and λ** (per mode, λ₂ = λ₃ = λ):
+//!    * thickness: α ≥ [`C_NOISE`]·σ, so the ellipsoid's short semi-axis
+//!      covers ±3σ of the structure's noise (99.7% of a Gaussian);
+//!    * reach: α·λ = [`C_REACH`]·d, so the long semi-axes reach across gaps
+//!      of up to 2·C_REACH·d between neighbours (Observation 4: the flat
+//!      ellipsoid must contain the circumcircle of the structure's
+//!      triangles; Observation 3 for lines);
+//!    * λ ≤ [`LAMBDA_MAX`] (the paper's Fig. 10 uses 8): thinner ellipsoids
+//!      need finer orientations; so α = max(C_NOISE·σ, C_REACH·d/λ_max)
+//!      and λ = clamp(C_REACH·d/α, 1, λ_max). Very noisy structures
+//!      (σ above about d/2) get λ = 1: the Euclidean α-shape, as measured
+//!      on the noisy walls of the CGAL building scan.
+//! 5. **nb_c** = [`NB_C_AUTO`]: the path filter then only cuts spurs and
+//!    fins of a few simplices; what is chance is decided by the
+//!    significance test ([`super::significance`]).
+//!
+//! Explicit values override the estimates (for every mode).
+
+use super::local::{local_shapes, LocalShape};
+use super::modes::{modes, Mode};
+use super::StructureKind;
+use crate::aniso::{completion_first_row, completion_third_row, Mat3};
+
+/// Score (planarity or linearity) from which a point is structure-like: the
+/// midpoint of the features' range [0, 1].
+pub const SCORE_MIN: f32 = 0.5;
+
+/// Angular radius of the mean-shift kernel of the modes (degrees): about
+/// the median angular error of local normals on the real scans measured
+/// (0.6–8°), so one plane gives one mode.
+pub const MODE_KERNEL_DEG: f64 = 5.0;
+
+/// Members of a mode: points whose axis is within this angle of it
+/// (degrees). On the CGAL building and polyhedron scans, 82–98% of each
+/// labelled plane's points have their normal within 20–25°; the rest lie
+/// along the plane's edges, where neighbourhoods straddle two planes, and
+/// are recovered by the assembly's claims.
+pub const CONE_DEG: f64 = 25.0;
+
+/// Smallest share of the points within the cone of a mode whose axis lies
+/// within the kernel of it. Measured on the CGAL building and polyhedron
+/// scans: 0.42–0.9 for the modes of labelled planes (the noisy walls
+/// lowest), 0.07–0.3 for the peaks made by edge normals.
+pub const MODE_CONCENTRATION: f64 = 0.25;
+
+/// A point joins the modes at most this much farther from its axis than
+/// its nearest mode (degrees): twice the mode kernel.
+pub const MARGIN_DEG: f64 = 2.0 * MODE_KERNEL_DEG;
+
+/// Half-thickness of the ellipsoid in units of the noise σ.
+pub const C_NOISE: f64 = 3.0;
+
+/// Reach of the ellipsoid in units of the spacing d.
+pub const C_REACH: f64 = 2.0;
+
+/// Largest elongation chosen.
+pub const LAMBDA_MAX: f64 = 8.0;
+
+/// The path filter's nb_c in the automatic mode.
+pub const NB_C_AUTO: u32 = 4;
+
+/// Smallest number of points of a mode (and the fraction of the
+/// structure-like points, whichever is larger: 0.1%).
+pub const MODE_MIN_POINTS: usize = 30;
+
+/// Values given by the user; `None` is estimated.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Given {
+    /// α.
+    pub alpha: Option<f64>,
+    /// λ₂ (planes).
+    pub lambda2: Option<f64>,
+    /// λ₃.
+    pub lambda3: Option<f64>,
+    /// nb_c.
+    pub min_size: Option<u32>,
+}
+
+/// A parameter's value, whether it was estimated, and why this value.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Param {
+    /// The value used.
+    pub value: f64,
+    /// Whether it was estimated from the data (false: given).
+    pub estimated: bool,
+    /// Where the value comes from.
+    pub reason: String,
+}
+
+/// One mode of the data orientation set with what it scans.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModeScan {
+    /// Unit axis: the normal (planes) or direction (lines) of the mode.
+    pub axis: [f64; 3],
+    /// Structure-like points near the axis (mean-shift support).
+    pub support: usize,
+    /// Its members (ascending input indices).
+    pub points: Vec<u32>,
+    /// Spacing d of its structure-like members (90th percentile).
+    pub spacing: f64,
+    /// Noise σ of its structure-like members (median spread).
+    pub noise: f64,
+    /// α of its orientations.
+    pub alpha: f64,
+    /// λ₂ (planes; 1 for lines).
+    pub lambda2: f64,
+    /// λ₃.
+    pub lambda3: f64,
+    /// Its orientations (rows of R): the normal as first row (planes) or
+    /// the direction as third row (lines).
+    pub rotations: Vec<Mat3>,
+}
+
+/// What was estimated from a cloud.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Estimate {
+    /// Lines or planes.
+    pub kind: StructureKind,
+    /// Number of points.
+    pub points: usize,
+    /// Median distance to the nearest point.
+    pub spacing_median: f64,
+    /// 90th percentile of the structure-like points' spacings.
+    pub spacing: f64,
+    /// Median spread across the structure of the structure-like points.
+    pub noise: f64,
+    /// Fraction of the points that are structure-like.
+    pub structure_fraction: f64,
+    /// α (the whole cloud's value; modes may have their own).
+    pub alpha: Param,
+    /// λ₂.
+    pub lambda2: Param,
+    /// λ₃.
+    pub lambda3: Param,
+    /// nb_c.
+    pub min_size: Param,
+    /// The data orientation set.
+    pub modes: Vec<ModeScan>,
+}
+
+fn quantile(v: &mut [f32], q: f64) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    let k = ((v.len() - 1) as f64 * q).round() as usize;
+    let (_, x, _) = v.select_nth_unstable_by(k, |a, b| a.total_cmp(b));
+    f64::from(*x)
+}
+
+/// α and λ from spacing and noise (module doc, step 4), with the values
+/// given by the user taking precedence. Returns (α, λ₂, λ₃).
+fn scales(kind: StructureKind, d: f64, sigma: f64, given: &Given) -> (f64, f64, f64) {
+    let reach = C_REACH * d;
+    let alpha = given
+        .alpha
+        .unwrap_or_else(|| (C_NOISE * sigma).max(reach / LAMBDA_MAX));
+    let lambda = (reach / alpha).clamp(1.0, LAMBDA_MAX);
+    let l3 = given.lambda3.unwrap_or(lambda);
+    let l2 = match kind {
+        StructureKind::Planes => given.lambda2.unwrap_or(given.lambda3.unwrap_or(lambda)),
+        StructureKind::Lines => 1.0,
+    };
+    (alpha, l2, l3)
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn axis64(s: &LocalShape, kind: StructureKind) -> [f64; 3] {
+    s.axis(kind).map(f64::from)
+}
+
+/// The rotations of a mode: its axis as the normal (first row, planes) or
+/// direction (third row, lines); for planes with λ₂ ≠ λ₃, `m2` turns
+/// about the normal (θ_j = −π/2 + jπ/m2 as the paper's box sampler).
+pub fn mode_rotations(
+    kind: StructureKind,
+    axis: [f64; 3],
+    lambda2: f64,
+    lambda3: f64,
+    m2: u32,
+) -> Vec<Mat3> {
+    match kind {
+        StructureKind::Lines => vec![completion_third_row(axis)],
+        StructureKind::Planes => {
+            let [n, a, b] = completion_first_row(axis);
+            if lambda2 == lambda3 || m2 <= 1 {
+                return vec![[n, a, b]];
+            }
+            (1..=m2)
+                .map(|j| {
+                    let t = -std::f64::consts::FRAC_PI_2
+                        + f64::from(j) * std::f64::consts::PI / f64::from(m2);
+                    let (s, c) = t.sin_cos();
+                    let r2 = [0, 1, 2].map(|k| c * a[k] + s * b[k]);
+                    let r3 = [0, 1, 2].map(|k| c * b[k] - s * a[k]);
+                    [n, r2, r3]
+                })
+                .collect()
+        }
+    }
+}
+
+/// Estimates the parameters and the data orientation set of `points` for
+/// structures of `kind`, keeping the values in `given` (module doc).
+/// `m2` is the number of turns about a plane's normal when λ₂ ≠ λ₃.
+///
+/// ```
+/// use aniso_alpha::detect::estimate::{estimate, Given};
+/// use aniso_alpha::detect::StructureKind;
+/// // Two perpendicular 30 × 30 grids of spacing 0.1 (a floor and a wall).
+/// let mut pts = Vec::new();
+/// for i in 0..30 {
+///     for j in 0..30 {
+///         pts.push([0.1 * i as f64, 0.1 * j as f64, 0.0]);
+///         pts.push([0.1 * i as f64, 0.0, 0.1 + 0.1 * j as f64]);
+///     }
+/// }
+/// let e = estimate(StructureKind::Planes, &pts, &Given::default(), 12);
+/// assert_eq!(e.modes.len(), 2);
+/// assert!((e.spacing - 0.1).abs() < 1e-6); // (spacings are kept as f32)
+/// assert!(e.alpha.estimated && e.alpha.value > 0.0);
+/// ```
+pub fn estimate(kind: StructureKind, points: &[[f64; 3]], given: &Given, m2: u32) -> Estimate {
+    let shapes = local_shapes(points, kind);
+    estimate_from(kind, points, &shapes, given, m2)
+}
+
+/// [`estimate`] from local shapes already computed.
+pub fn estimate_from(
+    kind: StructureKind,
+    points: &[[f64; 3]],
+    shapes: &[LocalShape],
+    given: &Given,
+    m2: u32,
+) -> Estimate {
+    let n = points.len();
+    let mut all_spacing: Vec<f32> = shapes
+        .iter()
+        .map(|s| s.spacing)
+        .filter(|s| s.is_finite())
+        .collect();
+    let spacing_median = quantile(&mut all_spacing, 0.5);
+    let structure: Vec<u32> = (0..n as u32)
+        .filter(|&i| shapes[i as usize].score(kind) >= SCORE_MIN)
+        .collect();
+    let mut sp: Vec<f32> = structure
+        .iter()
+        .map(|&i| shapes[i as usize].spacing)
+        .filter(|s| s.is_finite())
+        .collect();
+    let spacing = if sp.is_empty() {
+        spacing_median
+    } else {
+        quantile(&mut sp, 0.9)
+    };
+    let mut noise_v: Vec<f32> = structure
+        .iter()
+        .map(|&i| shapes[i as usize].spread(kind))
+        .collect();
+    let noise = if noise_v.is_empty() {
+        0.0
+    } else {
+        quantile(&mut noise_v, 0.5)
+    };
+    let (alpha, l2, l3) = scales(kind, spacing, noise, given);
+    let param = |value: f64, given: Option<f64>, why: String| Param {
+        value,
+        estimated: given.is_none(),
+        reason: if given.is_some() { "given".into() } else { why },
+    };
+    let alpha_p = param(
+        alpha,
+        given.alpha,
+        format!(
+            "max({C_NOISE}·noise, {C_REACH}·spacing/{LAMBDA_MAX}) with noise {noise:.4} (median spread \
+             across the local {}s) and spacing {spacing:.4} (90th percentile of the nearest-neighbour \
+             distances of structure-like points)",
+            match kind {
+                StructureKind::Planes => "plane",
+                StructureKind::Lines => "line",
+            }
+        ),
+    );
+    let lambda_why = format!("clamp({C_REACH}·spacing/alpha, 1, {LAMBDA_MAX})");
+    let lambda2_p = param(
+        l2,
+        if kind == StructureKind::Lines {
+            Some(1.0)
+        } else {
+            given.lambda2.or(given.lambda3)
+        },
+        lambda_why.clone(),
+    );
+    let lambda3_p = param(l3, given.lambda3, lambda_why);
+    let nb_c = given.min_size.unwrap_or(NB_C_AUTO);
+    let min_size_p = Param {
+        value: f64::from(nb_c),
+        estimated: given.min_size.is_none(),
+        reason: if given.min_size.is_some() {
+            "given".into()
+        } else {
+            "the path filter cuts spurs and fins of fewer simplices; the significance test decides what is chance"
+                .into()
+        },
+    };
+    // Modes of the structure-like axes.
+    let axes: Vec<[f64; 3]> = structure
+        .iter()
+        .map(|&i| axis64(&shapes[i as usize], kind))
+        .collect();
+    let min_support = MODE_MIN_POINTS.max(structure.len() / 1000);
+    let mut found: Vec<Mode> = modes(&axes, MODE_KERNEL_DEG.to_radians(), min_support);
+    // Keep the concentrated modes: at least MODE_CONCENTRATION of the
+    // points within the cone of a mode have their axis within the kernel.
+    let cos_cone = CONE_DEG.to_radians().cos();
+    found.retain(|m| {
+        let in_cone = shapes
+            .iter()
+            .filter(|s| dot(axis64(s, kind), m.axis).abs() >= cos_cone)
+            .count();
+        m.support as f64 >= MODE_CONCENTRATION * in_cone as f64
+    });
+    // Members: a point joins the modes within the cone of its axis, except
+    // those more than MARGIN_DEG farther than its nearest mode (so the
+    // shoulders of a large mode, local maxima made by the blurred normals
+    // near its edges, do not scan its points again).
+    let margin = MARGIN_DEG.to_radians();
+    let mut member_of: Vec<Vec<u32>> = vec![Vec::new(); found.len()];
+    let mut ang: Vec<f64> = vec![0.0; found.len()];
+    for i in 0..n as u32 {
+        let a = axis64(&shapes[i as usize], kind);
+        let mut best = f64::INFINITY;
+        for (k, m) in found.iter().enumerate() {
+            ang[k] = dot(a, m.axis).abs().min(1.0).acos();
+            best = best.min(ang[k]);
+        }
+        for k in 0..found.len() {
+            if ang[k].cos() >= cos_cone && ang[k] <= best + margin {
+                member_of[k].push(i);
+            }
+        }
+    }
+    let mut mode_scans = Vec::with_capacity(found.len());
+    for (m, members) in found.into_iter().zip(member_of) {
+        let core: Vec<u32> = members
+            .iter()
+            .copied()
+            .filter(|&i| shapes[i as usize].score(kind) >= SCORE_MIN)
+            .collect();
+        let mut sp: Vec<f32> = core
+            .iter()
+            .map(|&i| shapes[i as usize].spacing)
+            .filter(|s| s.is_finite())
+            .collect();
+        let d = if sp.is_empty() {
+            spacing
+        } else {
+            quantile(&mut sp, 0.9)
+        };
+        let mut nv: Vec<f32> = core
+            .iter()
+            .map(|&i| shapes[i as usize].spread(kind))
+            .collect();
+        let sigma = if nv.is_empty() {
+            noise
+        } else {
+            quantile(&mut nv, 0.5)
+        };
+        let (a, l2, l3) = scales(kind, d, sigma, given);
+        mode_scans.push(ModeScan {
+            axis: m.axis,
+            support: m.support,
+            points: members,
+            spacing: d,
+            noise: sigma,
+            alpha: a,
+            lambda2: l2,
+            lambda3: l3,
+            rotations: mode_rotations(kind, m.axis, l2, l3, m2),
+        });
+    }
+    Estimate {
+        kind,
+        points: n,
+        spacing_median,
+        spacing,
+        noise,
+        structure_fraction: structure.len() as f64 / n.max(1) as f64,
+        alpha: alpha_p,
+        lambda2: lambda2_p,
+        lambda3: lambda3_p,
+        min_size: min_size_p,
+        modes: mode_scans,
+    }
+}

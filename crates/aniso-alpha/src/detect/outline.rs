@@ -1,0 +1,251 @@
+//! Outlines and clean meshes of planar parts: the 2D α-shape of a part's
+//! points projected on its plane.
+//!
+//! The points are projected on the plane's two in-plane axes, triangulated
+//! in 2D (Delaunay, `spade`'s exact predicates), and the triangles whose
+//! circumradius is at most `r` are kept: the part's mesh (one planar
+//! triangulation, so it is a clean 2-manifold with boundary, unlike the
+//! union of the scanned α-shapes). Its boundary edges (edges of exactly one
+//! kept triangle) are chained into closed loops; the loop enclosing the
+//! largest area is the outline, oriented counter-clockwise seen from the
+//! plane's normal (a concave, L-shaped part keeps its notch: this is not a
+//! convex hull).
+//!
+//! `r` is the in-plane reach of the ellipsoid (α·λ): two points of the part
+//! closer than 2r along the plane are joined, as the anisotropic α-shape
+//! joins them.
+
+use super::fit::PlaneFit;
+use spade::{DelaunayTriangulation, HasPosition, Point2, Triangulation};
+
+#[derive(Clone, Copy)]
+struct V {
+    p: Point2<f64>,
+    id: u32,
+}
+
+impl HasPosition for V {
+    type Scalar = f64;
+    fn position(&self) -> Point2<f64> {
+        self.p
+    }
+}
+
+/// The 2D α-shape of a planar part: its triangles (over the given point
+/// indices) and its outline (points on the plane).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Outline {
+    /// Kept triangles, over input point indices, each counter-clockwise
+    /// seen from the normal.
+    pub triangles: Vec<[u32; 3]>,
+    /// The outer boundary loop, counter-clockwise seen from the normal.
+    pub polygon: Vec<[f64; 3]>,
+}
+
+fn circumradius2(a: Point2<f64>, b: Point2<f64>, c: Point2<f64>) -> f64 {
+    let (bx, by) = (b.x - a.x, b.y - a.y);
+    let (cx, cy) = (c.x - a.x, c.y - a.y);
+    let d = 2.0 * (bx * cy - by * cx);
+    if d == 0.0 {
+        return f64::INFINITY;
+    }
+    let b2 = bx * bx + by * by;
+    let c2 = cx * cx + cy * cy;
+    let ux = (cy * b2 - by * c2) / d;
+    let uy = (bx * c2 - cx * b2) / d;
+    ux * ux + uy * uy
+}
+
+/// The 2D α-shape of `points[ids[..]]` on `plane` with radius `r` (module
+/// doc). Points projecting onto one 2D position are merged (the first
+/// index is kept).
+pub fn outline(points: &[[f64; 3]], ids: &[u32], plane: &PlaneFit, r: f64) -> Outline {
+    let [a0, a1] = plane.axes;
+    let c = plane.centroid;
+    let uv = |p: &[f64; 3]| -> Point2<f64> {
+        let w = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
+        Point2::new(
+            w[0] * a0[0] + w[1] * a0[1] + w[2] * a0[2],
+            w[0] * a1[0] + w[1] * a1[1] + w[2] * a1[2],
+        )
+    };
+    let mut verts: Vec<V> = ids
+        .iter()
+        .map(|&i| V {
+            p: uv(&points[i as usize]),
+            id: i,
+        })
+        .filter(|v| v.p.x.is_finite() && v.p.y.is_finite())
+        .collect();
+    // Merge equal 2D positions (keep the smallest index).
+    verts.sort_by(|a, b| {
+        (a.p.x, a.p.y, a.id)
+            .partial_cmp(&(b.p.x, b.p.y, b.id))
+            .unwrap_or(std::cmp::Ordering::Equal)
+    });
+    verts.dedup_by(|b, a| a.p == b.p);
+    if verts.len() < 3 {
+        return Outline::default();
+    }
+    let Ok(tri) = DelaunayTriangulation::<V>::bulk_load(verts) else {
+        return Outline::default();
+    };
+    let r2 = r * r;
+    // Kept triangles (spade's faces are counter-clockwise in (u, v), and
+    // (a0, a1, normal) is right-handed, so they are counter-clockwise seen
+    // from the normal).
+    let mut triangles: Vec<[u32; 3]> = Vec::new();
+    let mut edges: Vec<(u32, u32)> = Vec::new(); // directed, of kept triangles
+    let mut pos: Vec<(u32, Point2<f64>)> = Vec::new();
+    for f in tri.inner_faces() {
+        let [a, b, cc] = f.vertices();
+        let (pa, pb, pc) = (a.data().p, b.data().p, cc.data().p);
+        if circumradius2(pa, pb, pc) <= r2 {
+            let t = [a.data().id, b.data().id, cc.data().id];
+            triangles.push(t);
+            edges.extend([(t[0], t[1]), (t[1], t[2]), (t[2], t[0])]);
+            pos.extend([(t[0], pa), (t[1], pb), (t[2], pc)]);
+        }
+    }
+    triangles.sort_unstable();
+    pos.sort_by_key(|x| x.0);
+    pos.dedup_by_key(|x| x.0);
+    // Boundary: directed edges whose reverse is not an edge.
+    edges.sort_unstable();
+    let boundary: Vec<(u32, u32)> = edges
+        .iter()
+        .copied()
+        .filter(|&(a, b)| edges.binary_search(&(b, a)).is_err())
+        .collect();
+    // Chain into loops: each boundary vertex may start several edges (a
+    // pinch); take them in order and mark used.
+    let mut used = vec![false; boundary.len()];
+    let start_of = |v: u32| boundary.partition_point(|e| e.0 < v);
+    let at = |v: u32| -> Point2<f64> {
+        let k = pos.partition_point(|x| x.0 < v);
+        pos[k].1
+    };
+    let mut best: (f64, Vec<u32>) = (0.0, Vec::new());
+    for e0 in 0..boundary.len() {
+        if used[e0] {
+            continue;
+        }
+        let mut loop_v = Vec::new();
+        let mut e = e0;
+        loop {
+            used[e] = true;
+            let (a, b) = boundary[e];
+            loop_v.push(a);
+            // Next edge starting at b, unused.
+            let mut k = start_of(b);
+            let mut next = None;
+            while k < boundary.len() && boundary[k].0 == b {
+                if !used[k] {
+                    next = Some(k);
+                    break;
+                }
+                k += 1;
+            }
+            match next {
+                Some(k) => e = k,
+                None => break,
+            }
+        }
+        // Shoelace area (positive for counter-clockwise).
+        let mut area = 0.0;
+        for i in 0..loop_v.len() {
+            let (p, q) = (at(loop_v[i]), at(loop_v[(i + 1) % loop_v.len()]));
+            area += p.x * q.y - q.x * p.y;
+        }
+        area *= 0.5;
+        if area > best.0 {
+            best = (area, loop_v);
+        }
+    }
+    let polygon = best
+        .1
+        .iter()
+        .map(|&v| {
+            let p = at(v);
+            [0, 1, 2].map(|k| c[k] + p.x * a0[k] + p.y * a1[k])
+        })
+        .collect();
+    Outline { triangles, polygon }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::detect::fit::fit_plane_indices;
+
+    fn area(poly: &[[f64; 3]]) -> f64 {
+        // Area of a polygon in the plane z = const.
+        let mut a = 0.0;
+        for i in 0..poly.len() {
+            let (p, q) = (poly[i], poly[(i + 1) % poly.len()]);
+            a += p[0] * q[1] - q[0] * p[1];
+        }
+        0.5 * a
+    }
+
+    #[test]
+    fn l_shaped_part_keeps_its_notch() {
+        // An L: a 20 × 20 grid minus its 10 × 10 upper-right quarter.
+        let mut pts = Vec::new();
+        for i in 0..=20 {
+            for j in 0..=20 {
+                if !(i > 10 && j > 10) {
+                    pts.push([i as f64, j as f64, 3.0]);
+                }
+            }
+        }
+        let ids: Vec<u32> = (0..pts.len() as u32).collect();
+        let plane = fit_plane_indices(&pts, &ids).unwrap();
+        let o = outline(&pts, &ids, &plane, 1.0);
+        // 300 unit squares, 2 triangles each, and the half square at the
+        // inner corner (10, 10), (11, 10), (10, 11), whose circumradius is
+        // 0.71.
+        assert_eq!(o.triangles.len(), 601);
+        let a = area(&o.polygon).abs();
+        assert!((a - 300.5).abs() < 1e-6, "area {a}");
+        // The convex hull would have area 400: the notch is there.
+        assert!(o.polygon.iter().all(|p| (p[2] - 3.0).abs() < 1e-9));
+        // A larger radius does not change a grid's α-shape much, a tiny one
+        // keeps nothing.
+        assert!(outline(&pts, &ids, &plane, 0.5).triangles.is_empty());
+    }
+
+    #[test]
+    fn mesh_is_manifold_and_outline_is_the_largest_loop() {
+        // Two squares far apart: the outline is the bigger one.
+        let mut pts = Vec::new();
+        for i in 0..=10 {
+            for j in 0..=10 {
+                pts.push([i as f64, j as f64, 0.0]);
+            }
+        }
+        for i in 0..=3 {
+            for j in 0..=3 {
+                pts.push([100.0 + i as f64, j as f64, 0.0]);
+            }
+        }
+        let ids: Vec<u32> = (0..pts.len() as u32).collect();
+        let plane = fit_plane_indices(&pts, &ids).unwrap();
+        let o = outline(&pts, &ids, &plane, 1.0);
+        assert!((area(&o.polygon).abs() - 100.0).abs() < 1e-6);
+        // Every undirected edge in at most two triangles.
+        let mut e: Vec<(u32, u32)> = o
+            .triangles
+            .iter()
+            .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[0], t[2])])
+            .map(|(a, b)| (a.min(b), a.max(b)))
+            .collect();
+        e.sort_unstable();
+        let mut i = 0;
+        while i < e.len() {
+            let j = e[i..].iter().take_while(|x| **x == e[i]).count();
+            assert!(j <= 2);
+            i += j;
+        }
+    }
+}

@@ -1,0 +1,318 @@
+//! The orientation scan (paper §4.3, first step): for every orientation of
+//! the set, `F_{k,α,Q}` of the points it looks at, path-filtered, and the
+//! union of them all.
+//!
+//! One [`Job`] is an orientation with its anisotropy, its α and the points
+//! it looks at: every point (the paper's samplers), or the points whose
+//! local axis agrees with a mode of the data (the data orientation set, see
+//! [`super::estimate`]). For each job: Q = diag(E)·R, transform the points,
+//! drop the points isolated at distance 2α (exact, [`super::prune`]),
+//! triangulate, select `F_{k,α,Q}` ([`super::faces`]: the same membership
+//! as [`crate::alpha::AlphaComplex`], computed for one α), map back to
+//! input indices and apply the path filter with `nb_c`.
+//!
+//! **Tiles** (method doc §8). `F_{k,α,Q}` is local: a simplex of it has an
+//! empty ellipsoid of "radius" α through its vertices, which lies within
+//! 2α·λ_max (Euclidean) of each vertex, and whether that ellipsoid is empty
+//! depends only on the points there. So a job's points can be cut into
+//! tiles (a grid of cubes of side `tile` over the original coordinates),
+//! each triangulated with the points of its halo (those within
+//! 2α·λ_max·(1 + 10⁻⁹) of the cube), and each tile keeps the simplices
+//! whose smallest input index lies in its cube: the union is exactly the
+//! job's `F_{k,α,Q}` (tested against the untiled result). Tiles bound the
+//! memory of one triangulation and are independent tasks (in parallel here,
+//! or spread over machines).
+//!
+//! The path filter is not local (a path can cross tiles): it runs on the
+//! job's gathered simplices. The union is a set, sorted; each simplex keeps
+//! the smallest group (mode) id of the jobs that found it. The result does
+//! not depend on the thread count.
+
+use super::detection::Primitive;
+use super::faces::{edges_at, triangles_at};
+use super::filter::{filter, FilterError, Simplex};
+use super::fit::{fit_line_indices, fit_plane_indices};
+use super::parts::{linear_parts, planar_parts, PartsError};
+use super::prune::{non_isolated, CandidatePairs};
+use crate::aniso::Anisotropy;
+use crate::delaunay::{DelaunayError, Triangulation};
+
+/// Relative inflation of the pruning and halo radii, so that rounding in
+/// the two ways of computing a distance never drops a point at exactly 2α.
+pub(crate) const RADIUS_SLACK: f64 = 1e-9;
+
+/// A simplex kind the detector works with: edges (k = 1) or triangles
+/// (k = 2).
+pub(crate) trait Face: Simplex + AsRef<[u32]> + Send + Sync + 'static {
+    /// The simplex dimension.
+    const K: usize;
+    /// `F_{k,α}` of a triangulation.
+    fn at(tri: &Triangulation, alpha: f64) -> Vec<Self>;
+    /// The simplex of the given vertices, sorted.
+    fn sorted(v: impl Iterator<Item = u32>) -> Self;
+    /// Straight or flat parts of a set of simplices.
+    fn parts(points: &[[f64; 3]], s: &[Self], angle: f64) -> Result<Vec<u32>, PartsError>;
+    /// Least-squares line or plane of points.
+    fn fit(points: &[[f64; 3]], vertices: &[u32]) -> Primitive;
+}
+
+impl Face for [u32; 2] {
+    const K: usize = 1;
+    fn at(tri: &Triangulation, alpha: f64) -> Vec<Self> {
+        edges_at(tri, alpha)
+    }
+    fn sorted(mut v: impl Iterator<Item = u32>) -> Self {
+        let mut s = [v.next().unwrap_or(0), v.next().unwrap_or(0)];
+        s.sort_unstable();
+        s
+    }
+    fn parts(points: &[[f64; 3]], s: &[Self], angle: f64) -> Result<Vec<u32>, PartsError> {
+        linear_parts(points, s, angle)
+    }
+    fn fit(points: &[[f64; 3]], vertices: &[u32]) -> Primitive {
+        fit_line_indices(points, vertices).map_or(Primitive::None, Primitive::Line)
+    }
+}
+
+impl Face for [u32; 3] {
+    const K: usize = 2;
+    fn at(tri: &Triangulation, alpha: f64) -> Vec<Self> {
+        triangles_at(tri, alpha)
+    }
+    fn sorted(mut v: impl Iterator<Item = u32>) -> Self {
+        let mut s = [
+            v.next().unwrap_or(0),
+            v.next().unwrap_or(0),
+            v.next().unwrap_or(0),
+        ];
+        s.sort_unstable();
+        s
+    }
+    fn parts(points: &[[f64; 3]], s: &[Self], angle: f64) -> Result<Vec<u32>, PartsError> {
+        planar_parts(points, s, angle)
+    }
+    fn fit(points: &[[f64; 3]], vertices: &[u32]) -> Primitive {
+        fit_plane_indices(points, vertices).map_or(Primitive::None, Primitive::Plane)
+    }
+}
+
+/// One orientation of the scan with what it looks at.
+#[derive(Debug, Clone)]
+pub(crate) struct Job<'p> {
+    /// Q = diag(E)·R.
+    pub anisotropy: Anisotropy,
+    /// The α of this orientation.
+    pub alpha: f64,
+    /// The points it looks at (ascending input indices), or every point.
+    pub ids: Option<&'p [u32]>,
+    /// The group (mode) it belongs to: the union keeps, per simplex, the
+    /// smallest group that found it.
+    pub group: u32,
+}
+
+/// What one job produced.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct JobResult<S> {
+    /// Filtered simplices, sorted.
+    pub faces: Vec<S>,
+    /// Points triangulated (after pruning), over its tiles.
+    pub triangulated: usize,
+    /// Simplices of `F_{k,α,Q}` before the path filter.
+    pub raw: usize,
+}
+
+/// Why a job failed.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum ScanError {
+    /// The triangulation refused the transformed points (out of range).
+    Triangulation(DelaunayError),
+    /// An internal invariant of the filter broke.
+    Filter(FilterError),
+}
+
+/// How the points of a job are pruned before triangulating.
+pub(crate) enum Pruning<'c> {
+    /// Not at all.
+    Off,
+    /// With a grid of the transformed points.
+    Grid,
+    /// With candidate pairs found once for all jobs over every point.
+    Pairs(&'c CandidatePairs),
+}
+
+/// Four sentinel points around a box, farther than 2α from every point in
+/// it (the distance from any point of the box to a sentinel is at least
+/// (√3/2)·`ext` > 2α), so that a flat or straight set becomes
+/// 3-dimensional without changing `F_α`. Not farther than needed: far
+/// sentinels make slivers, which the exact arithmetic pays for.
+fn sentinels(lo: [f64; 3], hi: [f64; 3], alpha: f64) -> [[f64; 3]; 4] {
+    let ext = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max) + 4.0 * alpha + 1.0;
+    let c = [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]));
+    [
+        [1.0, 1.0, 1.0],
+        [1.0, -1.0, -1.0],
+        [-1.0, 1.0, -1.0],
+        [-1.0, -1.0, 1.0],
+    ]
+    .map(|s| [c[0] + ext * s[0], c[1] + ext * s[1], c[2] + ext * s[2]])
+}
+
+/// `F_{k,α,Q}` of the transformed points `q` (which are the input points
+/// `map[..]`), as sorted input-index simplices. Points at positions ≥
+/// `owned_below` of `map` are halo points: a simplex is kept only when its
+/// smallest vertex (in input numbering) is owned.
+fn faces_of<S: Face>(
+    mut q: Vec<[f64; 3]>,
+    map: &[u32],
+    alpha: f64,
+    owned: &dyn Fn(u32) -> bool,
+) -> Result<Vec<S>, ScanError> {
+    if q.len() < 2 {
+        return Ok(Vec::new());
+    }
+    let n_real = q.len() as u32;
+    let mut tri = Triangulation::new(&q).map_err(ScanError::Triangulation)?;
+    if tri.dimension() < 3 {
+        let (lo, hi) = crate::geometry::bounding_box(&q);
+        q.extend(sentinels(lo, hi, alpha));
+        tri = Triangulation::new(&q).map_err(ScanError::Triangulation)?;
+    }
+    Ok(S::at(&tri, alpha)
+        .into_iter()
+        .filter(|f| f.as_ref().iter().all(|&v| v < n_real))
+        .map(|f| S::sorted(f.as_ref().iter().map(|&v| map[v as usize])))
+        .filter(|f| owned(f.as_ref()[0]))
+        .collect())
+}
+
+/// The points of `ids` kept by the pruning under `a`, and their transforms.
+fn pruned(
+    points: &[[f64; 3]],
+    ids: &[u32],
+    a: &Anisotropy,
+    radius: f64,
+    pruning: &Pruning<'_>,
+) -> (Vec<u32>, Vec<[f64; 3]>) {
+    match pruning {
+        Pruning::Pairs(c) => {
+            // Candidate pairs cover every point: `ids` is all of them.
+            let keep = c.non_isolated_under(points, &a.q(), radius);
+            let map: Vec<u32> = ids.iter().copied().filter(|&i| keep[i as usize]).collect();
+            let kept: Vec<[f64; 3]> = map.iter().map(|&i| points[i as usize]).collect();
+            let q = a.transform(&kept);
+            (map, q)
+        }
+        Pruning::Grid | Pruning::Off => {
+            let sub: Vec<[f64; 3]> = ids.iter().map(|&i| points[i as usize]).collect();
+            let q = a.transform(&sub);
+            if matches!(pruning, Pruning::Off) {
+                return (ids.to_vec(), q);
+            }
+            let keep = non_isolated(&q, radius);
+            let mut map = Vec::with_capacity(ids.len());
+            let mut out = Vec::with_capacity(ids.len());
+            for (t, &i) in ids.iter().enumerate() {
+                if keep[t] {
+                    map.push(i);
+                    out.push(q[t]);
+                }
+            }
+            (map, out)
+        }
+    }
+}
+
+/// Unfiltered `F_{k,α,Q}` of one job, as sorted input-index simplices, and
+/// the number of points triangulated. With `tile = Some(side)`, the job's
+/// points are cut into tiles with halos (module doc).
+pub(crate) fn raw_faces<S: Face>(
+    points: &[[f64; 3]],
+    job: &Job<'_>,
+    pruning: &Pruning<'_>,
+    tile: Option<f64>,
+) -> Result<(Vec<S>, usize), ScanError> {
+    let all: Vec<u32>;
+    let ids: &[u32] = match job.ids {
+        Some(ids) => ids,
+        None => {
+            all = (0..points.len() as u32).collect();
+            &all
+        }
+    };
+    let a = &job.anisotropy;
+    let radius = 2.0 * job.alpha * (1.0 + RADIUS_SLACK);
+    let lmax = a.lambdas().iter().fold(1.0f64, |m, &l| m.max(l));
+    let Some(side) = tile.filter(|&s| s.is_finite() && s > 0.0) else {
+        let (map, q) = pruned(points, ids, a, radius, pruning);
+        let n = map.len();
+        let mut faces = faces_of::<S>(q, &map, job.alpha, &|_| true)?;
+        faces.sort_unstable();
+        return Ok((faces, n));
+    };
+    // Tiles: integer cells of side `side`; halo `h` around each.
+    let h = 2.0 * job.alpha * lmax * (1.0 + RADIUS_SLACK) * (1.0 + RADIUS_SLACK);
+    let cell = |p: &[f64; 3]| -> [i64; 3] { p.map(|x| (x / side).floor() as i64) };
+    let mut keyed: Vec<([i64; 3], u32)> = ids
+        .iter()
+        .map(|&i| (cell(&points[i as usize]), i))
+        .collect();
+    keyed.sort_unstable();
+    let mut tiles: Vec<[i64; 3]> = keyed.iter().map(|k| k.0).collect();
+    tiles.dedup();
+    let index = crate::geometry::kdtree::KdTree::new(points, Some(ids.to_vec()));
+    let mut faces: Vec<S> = Vec::new();
+    let mut triangulated = 0usize;
+    for t in tiles {
+        let lo = t.map(|c| c as f64 * side);
+        let hi = t.map(|c| (c + 1) as f64 * side);
+        // Points of the tile's cube grown by h: the kd-tree gives those
+        // within the circumscribed sphere; keep those in the grown box.
+        let centre = [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]));
+        let r = (3.0f64).sqrt() * (0.5 * side + h);
+        let mut sub: Vec<u32> = Vec::new();
+        index.within(&centre, r, |i| {
+            let p = &points[i as usize];
+            if (0..3).all(|k| p[k] >= lo[k] - h && p[k] <= hi[k] + h) {
+                sub.push(i);
+            }
+        });
+        sub.sort_unstable();
+        let (map, q) = pruned(points, &sub, a, radius, &Pruning::Grid);
+        triangulated += map.len();
+        let owned = |v: u32| cell(&points[v as usize]) == t;
+        faces.extend(faces_of::<S>(q, &map, job.alpha, &owned)?);
+    }
+    faces.sort_unstable();
+    faces.dedup();
+    Ok((faces, triangulated))
+}
+
+/// One job: raw faces, then the path filter.
+pub(crate) fn run_job<S: Face>(
+    points: &[[f64; 3]],
+    job: &Job<'_>,
+    pruning: &Pruning<'_>,
+    tile: Option<f64>,
+    nb_c: u32,
+) -> Result<JobResult<S>, ScanError> {
+    let (faces, triangulated) = raw_faces::<S>(points, job, pruning, tile)?;
+    let raw = faces.len();
+    let faces = filter(&faces, nb_c).map_err(ScanError::Filter)?;
+    Ok(JobResult {
+        faces,
+        triangulated,
+        raw,
+    })
+}
+
+/// The union of the jobs' simplices (a sorted set) with, per simplex, the
+/// smallest group that found it.
+pub(crate) fn union<S: Face>(per_job: Vec<(u32, Vec<S>)>) -> (Vec<S>, Vec<u32>) {
+    let mut all: Vec<(S, u32)> = per_job
+        .into_iter()
+        .flat_map(|(g, faces)| faces.into_iter().map(move |f| (f, g)))
+        .collect();
+    all.sort_unstable();
+    all.dedup_by(|b, a| a.0 == b.0);
+    all.into_iter().unzip()
+}

@@ -1,0 +1,195 @@
+//! The JSON report of a detection (method doc §7), shared by the CLI's
+//! `--report` and the Python package (cargo feature `json`).
+//!
+//! ```
+//! use aniso_alpha::detect::detector::Detector;
+//! use aniso_alpha::report::detection_json;
+//! let scene = aniso_alpha::synth::lines(1);
+//! let d = Detector::lines(1.0, 10.0, 4);
+//! let det = d.run(&scene.points).unwrap();
+//! let r = detection_json(&det, &d);
+//! assert_eq!(r["parameters"]["alpha"]["value"], 1.0);
+//! assert_eq!(r["parameters"]["alpha"]["estimated"], false);
+//! let part = &r["structures"][0]["parts"][0];
+//! assert_eq!(part["segment"].as_array().unwrap().len(), 2);
+//! ```
+
+use crate::detect::detector::{Detection, Detector, OrientationSet, Part, Primitive, Structure};
+use crate::detect::orientations::Sampler;
+use crate::detect::StructureKind;
+use serde_json::{json, Value};
+
+/// A finite number, or null (JSON has no infinities).
+fn num(x: f64) -> Value {
+    if x.is_finite() {
+        json!(x)
+    } else {
+        Value::Null
+    }
+}
+
+fn param(value: f64, estimated: bool, reason: &str) -> Value {
+    json!({"value": num(value), "estimated": estimated, "reason": reason})
+}
+
+/// The `parameters` object: every value used, whether it was estimated,
+/// and why.
+pub fn parameters_json(d: &Detector<'_>) -> Value {
+    let kind = d.kind();
+    let (l2, l3) = d.lambdas();
+    let e = d.estimate();
+    let p = |name: &str, value: f64| -> Value {
+        match e {
+            Some(e) => {
+                let q = match name {
+                    "alpha" => &e.alpha,
+                    "lambda2" => &e.lambda2,
+                    "lambda3" => &e.lambda3,
+                    _ => &e.min_size,
+                };
+                param(q.value, q.estimated, &q.reason)
+            }
+            None => param(value, false, "given"),
+        }
+    };
+    let orientations = match d.orientations() {
+        OrientationSet::Sampler(Sampler::Box { m1, m2 }) => {
+            json!({"kind": "box", "m1": m1, "m2": m2, "count": d.orientation_count().unwrap_or(0)})
+        }
+        OrientationSet::Sampler(Sampler::Fibonacci { step_degrees }) => {
+            json!({"kind": "fibonacci", "step_degrees": step_degrees, "count": d.orientation_count().unwrap_or(0)})
+        }
+        OrientationSet::Rotations(r) => json!({"kind": "rotations", "count": r.len()}),
+        OrientationSet::Data(modes) => json!({
+            "kind": "data",
+            "count": d.orientation_count().unwrap_or(0),
+            "modes": modes.iter().map(|m| json!({
+                "axis": m.axis.map(num),
+                "support": m.support,
+                "points": m.points.len(),
+                "spacing": num(m.spacing),
+                "noise": num(m.noise),
+                "alpha": num(m.alpha),
+                "lambda2": num(m.lambda2),
+                "lambda3": num(m.lambda3),
+                "rotations": m.rotations.len(),
+            })).collect::<Vec<_>>(),
+        }),
+    };
+    let mut v = json!({
+        "structure": match kind { StructureKind::Lines => "lines", StructureKind::Planes => "planes" },
+        "k": kind.k(),
+        "alpha": p("alpha", d.alpha()),
+        "lambda2": if kind == StructureKind::Planes { p("lambda2", l2) } else { Value::Null },
+        "lambda3": p("lambda3", l3),
+        "min_size": p("min_size", f64::from(d.min_size())),
+        "epsilon": match d.epsilon() {
+            Some(eps) => param(eps, false, "default: at most one false alarm expected"),
+            None => Value::Null,
+        },
+        "elongation": d.elongation().map(num),
+        "orientations": orientations,
+    });
+    if let Some(e) = e {
+        v["estimates"] = json!({
+            "spacing_median": num(e.spacing_median),
+            "spacing": num(e.spacing),
+            "noise": num(e.noise),
+            "structure_fraction": num(e.structure_fraction),
+        });
+    }
+    v
+}
+
+fn point(p: [f64; 3]) -> Value {
+    json!(p.map(num))
+}
+
+/// One part: `plane`, `points`, `rms`, `polygon` for a planar part;
+/// `segment`, `points`, `rms` for a straight one; its `log10_nfa`.
+pub fn part_json(id: usize, p: &Part) -> Value {
+    let mut v = json!({
+        "id": id,
+        "points": p.vertices.len(),
+        "rms": num(p.primitive.rms()),
+        "log10_nfa": num(p.log10_nfa),
+        "simplices": p.simplices.len(),
+    });
+    match &p.primitive {
+        Primitive::Plane(f) => {
+            v["plane"] = json!(p.plane().unwrap_or([f64::NAN; 4]).map(num));
+            v["polygon"] = json!(p.outline.iter().map(|&q| point(q)).collect::<Vec<_>>());
+            v["triangles"] = json!(p.mesh.len());
+            v["centroid"] = point(f.centroid);
+            v["extent"] = json!(f.extent.map(num));
+        }
+        Primitive::Line(f) => {
+            if let Some([a, b]) = p.segment() {
+                v["segment"] = json!([point(a), point(b)]);
+            }
+            v["length"] = num(f.extent);
+            v["direction"] = point(f.direction);
+        }
+        Primitive::None => {}
+    }
+    v
+}
+
+/// One structure with its parts (`first_part` is the global id of its
+/// first part, as in the part labels).
+pub fn structure_json(s: &Structure, first_part: usize) -> Value {
+    let mut v = json!({
+        "id": s.id,
+        "kind": s.kind_name(),
+        "points": s.vertices.len(),
+        "simplices": s.simplices.len(),
+        "log10_nfa": num(s.log10_nfa),
+        "parts": s.parts.iter().enumerate().map(|(k, p)| part_json(first_part + k, p)).collect::<Vec<_>>(),
+    });
+    if s.parts.len() == 1 {
+        v["rms"] = num(s.primitive.rms());
+        if let Some(pl) = s.primitive.plane_equation() {
+            v["plane"] = json!(pl.map(num));
+        }
+    }
+    v
+}
+
+/// The structures array.
+pub fn structures_json(det: &Detection) -> Value {
+    let mut first = 0;
+    Value::Array(
+        det.structures
+            .iter()
+            .map(|s| {
+                let v = structure_json(s, first);
+                first += s.parts.len();
+                v
+            })
+            .collect(),
+    )
+}
+
+/// The whole report of a run: `parameters`, `orientations`, `stats`,
+/// `structures`, `parts` and `background_points` (the CLI adds the input's
+/// name, times and scores).
+pub fn detection_json(det: &Detection, d: &Detector<'_>) -> Value {
+    let s = &det.stats;
+    json!({
+        "points": det.labels.len(),
+        "parameters": parameters_json(d),
+        "orientations": s.orientations,
+        "stats": {
+            "triangulated_points": s.triangulated_points,
+            "raw_simplices": s.raw_simplices,
+            "filtered_simplices": s.filtered_simplices,
+            "union_simplices": s.union_simplices,
+            "kept_simplices": s.kept_simplices,
+            "structure_simplices": s.structure_simplices,
+            "rejected_parts": s.rejected_parts,
+        },
+        "structures": structures_json(det),
+        "parts": det.num_parts(),
+        "background_points": det.labels.iter().filter(|&&l| l < 0).count(),
+    })
+}
