@@ -29,7 +29,8 @@ follow the paper's Observations 3 and 4 so that the paper's parameters work (lin
 lambda3 10, min-size 4; planes and polyhedron: alpha 1, lambda2 4, lambda3 8, min-size 20); \
 the command prints the matching detect line.\n\n\
 Examples:\n  aniso-alpha synth lines --seed 7 --output lines.xyz\n  \
-aniso-alpha synth planes --structures 2 --crossing --jitter 0.1 --output crossing.xyz"
+aniso-alpha synth planes --structures 2 --crossing --jitter 0.1 --output crossing.xyz\n  \
+aniso-alpha synth lines --jitter-d 0.1 --density 0.03 --output hard.xyz"
 )]
 pub struct SynthArgs {
     /// Scene kind
@@ -41,16 +42,24 @@ pub struct SynthArgs {
     /// Output scene file
     #[arg(long, value_name = "OUT.xyz")]
     pub output: PathBuf,
-    /// Number of uniform background points (default: the paper's count)
+    /// Number of uniform background points (default: the paper's count,
+    /// scaled with --density)
     #[arg(long, value_name = "N")]
     pub background: Option<usize>,
-    /// Background density in points per alpha-ellipsoid (default 0.01);
-    /// sets the box size
+    /// Background density in points per alpha-ellipsoid (default 0.01).
+    /// Alone it keeps the paper's box and scales the background count
+    /// (--density 0.03: 3x the paper's background in the same box); with
+    /// --background N it sizes the box to hold N points at that density
     #[arg(long, value_name = "X", value_parser = parse_positive)]
     pub density: Option<f64>,
-    /// Gaussian jitter (standard deviation) of the structure points
-    #[arg(long, value_name = "SIGMA", default_value_t = 0.0)]
+    /// Gaussian jitter (standard deviation, input units) of every
+    /// coordinate of the structure points
+    #[arg(long, value_name = "SIGMA", default_value_t = 0.0, conflicts_with = "jitter_d")]
     pub jitter: f64,
+    /// Gaussian jitter as a fraction of the structure spacing d (lines
+    /// d = 7, planes and polyhedron d = 3): sigma = F * d
+    #[arg(long, value_name = "F", value_parser = parse_nonnegative)]
+    pub jitter_d: Option<f64>,
     /// Sample the structures at random positions instead of on a grid
     #[arg(long)]
     pub random_sampling: bool,
@@ -68,6 +77,14 @@ pub struct SynthArgs {
     pub common: crate::QuietArgs,
 }
 
+/// clap parser for a finite number >= 0.
+fn parse_nonnegative(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(x) if x.is_finite() && x >= 0.0 => Ok(x),
+        _ => Err(format!("expected a finite number >= 0, got '{s}'")),
+    }
+}
+
 /// Runs `synth`.
 pub fn run(args: &SynthArgs, timings: &mut Timings) -> Result<(), CliError> {
     common::check_io(&[], &[("--output", Some(&args.output))])?;
@@ -80,11 +97,14 @@ pub fn run(args: &SynthArgs, timings: &mut Timings) -> Result<(), CliError> {
     .jitter(args.jitter)
     .random_sampling(args.random_sampling)
     .crossing(args.crossing);
-    if let Some(n) = args.background {
-        opts = opts.background(n);
+    if let Some(f) = args.jitter_d {
+        opts = opts.jitter_of_spacing(f);
     }
-    if let Some(x) = args.density {
-        opts = opts.background_per_ellipsoid(x);
+    match (args.background, args.density) {
+        (Some(n), Some(x)) => opts = opts.background(n).background_per_ellipsoid(x),
+        (Some(n), None) => opts = opts.background(n),
+        (None, Some(x)) => opts = opts.background_density_in_box(x),
+        (None, None) => {}
     }
     if let Some(n) = args.structures {
         opts = opts.structures(n);

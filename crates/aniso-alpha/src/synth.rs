@@ -185,6 +185,7 @@ pub struct SceneOptions {
     background: usize,
     background_per_ellipsoid: f64,
     jitter: f64,
+    jitter_of_spacing: Option<f64>,
     random_sampling: bool,
     structures: usize,
     points_per_structure: usize,
@@ -203,6 +204,7 @@ impl SceneOptions {
                 background: 1500,
                 background_per_ellipsoid: 0.01,
                 jitter: 0.0,
+                jitter_of_spacing: None,
                 random_sampling: false,
                 structures: 5,
                 points_per_structure: 10,
@@ -216,6 +218,7 @@ impl SceneOptions {
                 background: 150,
                 background_per_ellipsoid: 0.01,
                 jitter: 0.0,
+                jitter_of_spacing: None,
                 random_sampling: false,
                 structures: 3,
                 points_per_structure: 40,
@@ -229,6 +232,7 @@ impl SceneOptions {
                 background: 800,
                 background_per_ellipsoid: 0.01,
                 jitter: 0.0,
+                jitter_of_spacing: None,
                 random_sampling: false,
                 structures: 1,
                 points_per_structure: 190,
@@ -274,9 +278,45 @@ impl SceneOptions {
     }
 
     /// Standard deviation of the Gaussian noise added to every coordinate
-    /// of the structure points (default 0).
+    /// of the structure points, in input units (default 0). Replaces a
+    /// jitter given by [`Self::jitter_of_spacing`].
     pub fn jitter(mut self, sigma: f64) -> Self {
         self.jitter = sigma;
+        self.jitter_of_spacing = None;
+        self
+    }
+
+    /// Gaussian jitter as a fraction of the structure spacing d (the
+    /// [`Self::spacing`]: 7 for lines, 3 for planes and the polyhedron):
+    /// σ = `fraction`·d on every coordinate of the structure points, the
+    /// way issue 14's robustness table states it (σ = 0.05 d, 0.1 d).
+    /// Replaces an absolute [`Self::jitter`]; follows a later change of
+    /// the spacing.
+    pub fn jitter_of_spacing(mut self, fraction: f64) -> Self {
+        self.jitter_of_spacing = Some(fraction);
+        self
+    }
+
+    /// The jitter σ in input units: the absolute one, or the fraction of
+    /// the spacing when one was given.
+    pub fn jitter_sigma(&self) -> f64 {
+        self.jitter_of_spacing
+            .map_or(self.jitter, |f| f * self.spacing)
+    }
+
+    /// Background density `x` (points per α-ellipsoid) in the *same box*:
+    /// the background count is scaled by `x` over the current density
+    /// (rounded), so the box side of [`Self::box_side`] does not change.
+    /// From the defaults, `background_density_in_box(0.03)` is the paper's
+    /// scene with 3× its background (4,500 points for lines), whereas
+    /// [`Self::background_per_ellipsoid`] alone keeps the count and
+    /// shrinks the box.
+    pub fn background_density_in_box(mut self, x: f64) -> Self {
+        let scale = x / self.background_per_ellipsoid;
+        if scale.is_finite() && scale > 0.0 {
+            self.background = (self.background as f64 * scale).round() as usize;
+        }
+        self.background_per_ellipsoid = x;
         self
     }
 
@@ -375,7 +415,7 @@ impl SceneOptions {
                 self.background_per_ellipsoid,
                 self.background_per_ellipsoid > 0.0,
             ),
-            ("jitter", self.jitter, self.jitter >= 0.0),
+            ("jitter", self.jitter_sigma(), self.jitter_sigma() >= 0.0),
             ("spacing", self.spacing, self.spacing > 0.0),
             ("clearance", self.clearance, self.clearance >= 0.0),
         ];
@@ -417,17 +457,18 @@ impl SceneOptions {
         let mut points = Vec::new();
         let mut labels = Vec::new();
         let mut parts = Vec::new();
+        let sigma = self.jitter_sigma();
         for (s, (pts, pp)) in placed.iter().zip(&parts_of).enumerate() {
             for (p, &part) in pts.iter().zip(pp) {
                 // Crossing structures: skip a point equal to an earlier one.
                 if self.crossing && s == 1 && placed[0].iter().any(|q| dist2(*q, *p) < 1e-18) {
                     continue;
                 }
-                let q = if self.jitter > 0.0 {
+                let q = if sigma > 0.0 {
                     [
-                        p[0] + self.jitter * rng.gaussian(),
-                        p[1] + self.jitter * rng.gaussian(),
-                        p[2] + self.jitter * rng.gaussian(),
+                        p[0] + sigma * rng.gaussian(),
+                        p[1] + sigma * rng.gaussian(),
+                        p[2] + sigma * rng.gaussian(),
                     ]
                 } else {
                     *p

@@ -353,3 +353,51 @@ fn write_format() {
     let last = text.lines().last().unwrap();
     assert_eq!(last.split(' ').count(), 5);
 }
+
+#[test]
+fn jitter_relative_to_spacing_and_density_in_the_same_box() {
+    // σ = 0.1 d: lines d = 7 → 0.7, planes h = 3 → 0.3; it follows the
+    // spacing and an absolute jitter replaces it.
+    let o = SceneOptions::lines().jitter_of_spacing(0.1);
+    assert!((o.jitter_sigma() - 0.7).abs() < 1e-12);
+    assert!((o.clone().spacing(10.0).jitter_sigma() - 1.0).abs() < 1e-12);
+    assert_eq!(o.clone().jitter(0.2).jitter_sigma(), 0.2);
+    assert!((SceneOptions::planes().jitter_of_spacing(0.05).jitter_sigma() - 0.15).abs() < 1e-12);
+    // The structure points' spread across their line is about σ·√2 (two
+    // of the three coordinates are across): measured on the fit.
+    let s = SceneOptions::lines()
+        .jitter_of_spacing(0.1)
+        .background(0)
+        .seed(3)
+        .generate()
+        .unwrap();
+    let mut rms = 0.0;
+    for l in 0..5 {
+        rms += fit_line(&members(&s, l)).unwrap().rms_residual / 5.0;
+    }
+    assert!(rms > 0.5 && rms < 1.4, "rms across {rms}, σ√2 = 0.99");
+    assert!(matches!(
+        SceneOptions::lines().jitter_of_spacing(-0.1).generate(),
+        Err(SynthError::BadOption { .. })
+    ));
+    // 3× the density in the same box: 3× the points, same side.
+    for base in [
+        SceneOptions::lines(),
+        SceneOptions::planes(),
+        SceneOptions::polyhedron(),
+    ] {
+        let dense = base.clone().background_density_in_box(0.03);
+        assert!((dense.box_side() - base.box_side()).abs() < 1e-6 * base.box_side());
+        let n_bg = |o: &SceneOptions| {
+            o.generate()
+                .unwrap()
+                .labels
+                .iter()
+                .filter(|&&l| l < 0)
+                .count()
+        };
+        assert_eq!(n_bg(&dense), 3 * n_bg(&base));
+        // Whereas the density alone shrinks the box.
+        assert!(base.clone().background_per_ellipsoid(0.03).box_side() < 0.7 * base.box_side());
+    }
+}
