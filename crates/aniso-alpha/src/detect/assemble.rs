@@ -35,7 +35,7 @@ use super::filter::{components, FilterError};
 use super::fit::fit_line;
 use super::outline::outline;
 use super::scan::Face;
-use super::significance::log10_nfa;
+use super::significance::{log10_n_tests, part_log10_nfa};
 use super::StructureKind;
 use crate::geometry::kdtree::KdTree;
 
@@ -61,8 +61,6 @@ pub(crate) struct Settings {
     pub scales: Vec<Scale>,
     /// log₁₀ ε of the significance test, or `None` for no test.
     pub log10_epsilon: Option<f64>,
-    /// Orientations scanned (for the number of tests).
-    pub orientations: usize,
 }
 
 /// Relative share of a part's vertices on each side of another part's
@@ -76,6 +74,115 @@ const CROSS_LINE_MARGIN: f64 = 0.05;
 /// Ratio of the outer to the inner radius of the shell in which the local
 /// background density around a part is measured.
 const SHELL_RATIO: f64 = 4.0;
+
+/// The path filter's nb_c in the scan of each orientation (docs/method.md
+/// §4). Without the significance test it is the user's nb_c (the paper).
+/// With it, for lines, at most [`LINE_SCAN_MIN`]: a line whose points are
+/// jittered by about the ellipsoid's radius, or crowded by background
+/// points that hang spurs on it, reaches one orientation's filter in
+/// pieces of two or three edges, which nb_c = 4 deletes in every
+/// orientation (issue 14: recall 0.3–0.5 at σ = 0.1 d, 0.6–0.7 at 10×
+/// the background). The pieces are joined along their fitted line by the
+/// claims, and the significance test, not nb_c, decides what chance
+/// explains. Planes keep nb_c: a plane's α-shape stays in one piece under
+/// the same jitter (its triangles span two directions), and the scan's
+/// cost grows with what the filter lets through.
+pub(crate) fn scan_min_size(
+    kind: StructureKind,
+    nb_c: u32,
+    significance: bool,
+    chance: ChanceScale,
+) -> u32 {
+    if kind != StructureKind::Lines || !significance {
+        return nb_c;
+    }
+    // Chance paths of l edges per orientation: about n·x^l, x the
+    // background points per α-ellipsoid (each further edge needs a point
+    // in the next ellipsoid along); over the scan, times the orientations.
+    // The shortest l with at most CHANCE_PATHS of them over the scan.
+    let x = chance.per_ellipsoid.clamp(1e-12, 1.0);
+    let mut l = LINE_SCAN_MIN;
+    while l < nb_c && chance.points * chance.orientations * x.powi(l as i32) > CHANCE_PATHS {
+        l += 1;
+    }
+    l.min(nb_c)
+}
+
+/// What the scan's threshold depends on: the cloud's size, the number of
+/// orientations and the background points per α-ellipsoid (the cloud's
+/// points over its bounding box's volume, times the ellipsoid's volume).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ChanceScale {
+    /// Points.
+    pub points: f64,
+    /// Orientations scanned.
+    pub orientations: f64,
+    /// Expected points per α-ellipsoid under a uniform background.
+    pub per_ellipsoid: f64,
+}
+
+impl ChanceScale {
+    /// Measured on `points` for the ellipsoid of radius `alpha` and
+    /// semi-axes `alpha/e_i` (`elongation` e).
+    pub(crate) fn measure(points: &[[f64; 3]], alpha: f64, elongation: [f64; 3], orientations: usize) -> Self {
+        let (lo, hi) = crate::geometry::bounding_box(points);
+        let volume: f64 = (0..3).map(|k| (hi[k] - lo[k]).max(1e-300)).product();
+        let ellipsoid = 4.0 / 3.0 * std::f64::consts::PI * alpha.powi(3)
+            / (elongation[0] * elongation[1] * elongation[2]);
+        ChanceScale {
+            points: points.len() as f64,
+            orientations: orientations as f64,
+            per_ellipsoid: points.len() as f64 / volume * ellipsoid,
+        }
+    }
+}
+
+/// Chance paths the line scan may let through to the assembly: 100. At
+/// the paper's density (0.01 points per ellipsoid, 1,550 points, 162
+/// orientations) paths of two edges number about 25, so the scan keeps
+/// them; at 3× the density three edges, at 10× the user's nb_c. Beyond a
+/// few hundred chance paths the union's components merge into a web
+/// that the assembly cannot take apart into lines (measured at 10×: 188,000
+/// union edges with two-edge paths, no line found).
+const CHANCE_PATHS: f64 = 100.0;
+
+/// The shortest path the line scan keeps under the significance test: two
+/// edges, three points, the fewest whose straightness says anything
+/// (two points always lie on a line).
+const LINE_SCAN_MIN: u32 = 2;
+
+/// Length of the segment that `members` span along the line `fit` (at
+/// least one ten-millionth of nothing: 0 when not a line).
+fn line_span(fit: &Primitive, members: &[u32], points: &[[f64; 3]]) -> f64 {
+    let Primitive::Line(f) = fit else { return 0.0 };
+    let (mut t0, mut t1) = (f64::INFINITY, f64::NEG_INFINITY);
+    for &v in members {
+        let t = dot(sub(points[v as usize], f.centroid), f.direction);
+        t0 = t0.min(t);
+        t1 = t1.max(t);
+    }
+    (t1 - t0).max(0.0)
+}
+
+/// Claim radii tried for a line candidate, in units of α (its τ): a line
+/// whose points are jittered by σ per coordinate has its distances to the
+/// line Rayleigh-distributed, 99% within 3.03σ; radii up to 3α keep such a
+/// line whole for σ up to α, the scale at which the paper's ellipsoid
+/// itself stops joining its points.
+const CLAIM_RADII: [f64; 3] = [1.0, 2.0, 3.0];
+
+/// log₁₀ of the factor by which a wider claim radius must lower a
+/// candidate's NFA to be preferred: 10×, so that a structure that is as
+/// significant in the thin tube keeps it (and the background points a
+/// wider tube would claim stay out).
+const WIDEN_GAIN: f64 = 1.0;
+
+/// The most background points, expected under the measured global
+/// density, that widening a line's claim tube may add: one. Past it (about
+/// 3× the paper's density for a 3α tube along a 63-unit line) the claims
+/// stay at α, as in the paper: a wider tube would buy the recall of a
+/// noisy line with the precision of every line.
+const MAX_WIDEN_BACKGROUND: f64 = 1.0;
 
 /// A candidate part while it is assembled.
 #[derive(Debug, Clone)]
@@ -534,6 +641,14 @@ pub(crate) fn assemble<S: Face>(
         }
         comp_simplices.extend(parts.into_iter().map(|p| (g as u32, p)));
     }
+    // Seeds: with the test on, lines start from the scan's shortest pieces
+    // (three points, [`scan_min_size`]); a part still needs min_vertices
+    // points once its claims have joined its pieces.
+    let seed_min = if settings.kind == StructureKind::Lines && settings.log10_epsilon.is_some() {
+        settings.min_vertices.min(LINE_SCAN_MIN as usize + 1)
+    } else {
+        settings.min_vertices
+    };
     let mut cands: Vec<Cand> = Vec::new();
     for (g, ss) in &comp_simplices {
         let scale = settings.scales[*g as usize];
@@ -542,7 +657,7 @@ pub(crate) fn assemble<S: Face>(
             points,
             &local,
             scale.tau,
-            settings.min_vertices,
+            seed_min,
             settings.part_angle_deg,
         ) {
             if let Some(foot) = Footprint::new(&fit, points, &seeds, scale.cell) {
@@ -556,9 +671,57 @@ pub(crate) fn assemble<S: Face>(
             }
         }
     }
+    let mut stamp = Stamps::new(n);
+    // 2b. Claim radius from the noise (lines under the test): the radius
+    // among CLAIM_RADII·τ whose tube makes the candidate least explicable
+    // by chance.
+    if settings.kind == StructureKind::Lines
+        && settings.log10_epsilon.is_some()
+    {
+        let (lo, hi) = crate::geometry::bounding_box(points);
+        let volume: f64 = (0..3).map(|k| (hi[k] - lo[k]).max(1e-300)).product();
+        let rho_global = firsts.len() as f64 / volume;
+        let log10_tests = log10_n_tests(firsts.len(), S::K) + (CLAIM_RADII.len() as f64).log10();
+        for c in cands.iter_mut() {
+            let base = c.tau;
+            let extent = line_span(&c.fit, &c.seeds, points);
+            let vol = |t: f64| std::f64::consts::PI * t * t * extent;
+            let mut best = (f64::INFINITY, base);
+            for f in CLAIM_RADII {
+                let r = f * base;
+                // A wider tube may cost at most MAX_WIDEN_BACKGROUND
+                // expected background points.
+                if f > 1.0 && rho_global * vol(r) > MAX_WIDEN_BACKGROUND {
+                    break;
+                }
+                let outer = SHELL_RATIO * r;
+                let mut residuals = Vec::new();
+                let mut shell = 0usize;
+                for_near(c, outer, points, &index, &mut stamp, &mut |_, d| {
+                    if d <= r {
+                        residuals.push(d);
+                    } else {
+                        shell += 1;
+                    }
+                });
+                let rho_local = (shell as f64 + 1.0) / (vol(outer) - vol(r)).max(1e-300);
+                let nfa = part_log10_nfa(
+                    &residuals,
+                    S::K,
+                    r,
+                    rho_local.max(rho_global),
+                    &vol,
+                    log10_tests,
+                );
+                if nfa < best.0 - WIDEN_GAIN {
+                    best = (nfa, r);
+                }
+            }
+            c.tau = best.1;
+        }
+    }
     // 3. Members: claims, merging of duplicates, resolution, refit, claims
     // again.
-    let mut stamp = Stamps::new(n);
     let claims_of = |cands: &[Cand], stamp: &mut Stamps| -> Vec<(u32, u32, f64)> {
         // (point, candidate, distance)
         let mut claims = Vec::new();
@@ -703,25 +866,29 @@ pub(crate) fn assemble<S: Face>(
         let (lo, hi) = crate::geometry::bounding_box(points);
         let volume: f64 = (0..3).map(|k| (hi[k] - lo[k]).max(1e-300)).product();
         let rho_global = firsts.len().saturating_sub(in_parts) as f64 / volume;
-        let n_tests = settings.orientations.max(1) as f64 * firsts.len() as f64;
+        let log10_tests = log10_n_tests(firsts.len(), S::K);
         for p in parts.iter_mut() {
             let c = &cands[p.cand];
-            let thick = p
+            let residuals: Vec<f64> = p
                 .members
                 .iter()
                 .map(|&v| p.fit.distance(&points[v as usize]))
-                .fold(0.0, f64::max)
-                .max(1e-6 * c.cell);
+                .collect();
+            let thick = residuals.iter().copied().fold(0.0, f64::max);
             let tau = c.tau.max(thick);
             // Footprint extent from the members (cells they occupy).
             let foot = Footprint::new(&p.fit, points, &p.members, c.cell);
             let Some(foot) = foot else { continue };
-            let cells = foot.count() as f64;
             let planar = matches!(p.fit, Primitive::Plane(_));
+            // A plane's area: the cells its members cover, grown by one
+            // (generous: the region the scan could have found it in). A
+            // line's length: the span of its members (a line's footprint
+            // is one row of cells; its dilation also marks the rows beside
+            // it, which tripled the length before).
             let extent = if planar {
-                cells * c.cell * c.cell
+                foot.count() as f64 * c.cell * c.cell
             } else {
-                cells * c.cell
+                line_span(&p.fit, &p.members, points)
             };
             let vol = |t: f64| {
                 if planar {
@@ -747,7 +914,7 @@ pub(crate) fn assemble<S: Face>(
             });
             let rho_local = (shell as f64 + 1.0) / (vol(outer) - vol(tau)).max(1e-300);
             let rho = rho_local.max(rho_global);
-            p.log10_nfa = log10_nfa(n_tests, rho * vol(thick), p.members.len() as u64);
+            p.log10_nfa = part_log10_nfa(&residuals, S::K, tau, rho, &vol, log10_tests);
         }
         let before = parts.len();
         parts.retain(|p| p.log10_nfa <= log_eps);

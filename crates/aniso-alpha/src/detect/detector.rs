@@ -569,11 +569,15 @@ impl<'a> Detector<'a> {
         let done = AtomicUsize::new(0);
         let cancelled = AtomicBool::new(false);
         let total = jobs.len();
+        let chance =
+            super::assemble::ChanceScale::measure(points, self.alpha, self.elongation(), total);
+        let scan_nb_c =
+            super::assemble::scan_min_size(self.kind, self.nb_c, self.epsilon.is_some(), chance);
         let one = |job: &Job<'_>| -> Result<JobResult<S>, DetectError> {
             if cancelled.load(Ordering::Relaxed) {
                 return Err(DetectError::Cancelled);
             }
-            let r = run_job::<S>(points, job, &pruning, self.tile, self.nb_c)?;
+            let r = run_job::<S>(points, job, &pruning, self.tile, scan_nb_c)?;
             let d = done.fetch_add(1, Ordering::Relaxed) + 1;
             if let Some(cb) = self.progress {
                 if !cb(d, total) {
@@ -606,7 +610,7 @@ impl<'a> Detector<'a> {
         }
         let (all, groups) = union(found);
         stats.union_simplices = all.len();
-        let keep = component_size_mask(&all, self.nb_c)?;
+        let keep = component_size_mask(&all, scan_nb_c)?;
         let mut kept = Vec::with_capacity(all.len());
         let mut kept_groups = Vec::with_capacity(all.len());
         for ((s, g), k) in all.into_iter().zip(groups).zip(keep) {
@@ -626,7 +630,6 @@ impl<'a> Detector<'a> {
             min_vertices,
             scales,
             log10_epsilon: self.epsilon.map(f64::log10),
-            orientations: total,
         };
         Ok(assemble::<S>(points, kept, kept_groups, &settings, stats)?.detection)
     }

@@ -99,6 +99,55 @@ pub fn log10_nfa(n_tests: f64, mu: f64, m: u64) -> f64 {
     n_tests.max(1.0).log10() + log10_poisson_tail(mu, m)
 }
 
+/// Number of thicknesses tried per part: the claim radius τ and its
+/// halvings down to τ/2¹¹ ≈ τ/2000. Twelve steps reach from the scale of
+/// the ellipsoid to far below any sampling noise worth telling apart (an
+/// exact grid line has residuals of 1e-15·τ and is caught by the last
+/// step anyway); each step doubles the tube's or slab's thinness, so the
+/// best width is within a factor 2 of the part's own.
+pub const WIDTHS: u32 = 12;
+
+/// log₁₀ of the number of tests: the primitives a part can be, a line
+/// through 2 of the `n` points (k = 1) or a plane through 3 (k = 2), i.e.
+/// C(n, k + 1), times the [`WIDTHS`] thicknesses tried on each.
+pub fn log10_n_tests(n: usize, k: usize) -> f64 {
+    let (n, r) = (n as f64, (k + 1) as f64);
+    if n < r {
+        return f64::from(WIDTHS).log10();
+    }
+    let ln_binom = ln_gamma(n + 1.0) - ln_gamma(r + 1.0) - ln_gamma(n - r + 1.0);
+    ln_binom / std::f64::consts::LN_10 + f64::from(WIDTHS).log10()
+}
+
+/// log₁₀ NFA of a part (module doc): `residuals` are its points' distances
+/// to its fitted primitive of dimension `k`, `volume(t)` the volume of the
+/// tube (k = 1) or slab (k = 2) of half-thickness `t` over its extent,
+/// `rho` the background density, `tau` the largest thickness tried and
+/// `log10_tests` from [`log10_n_tests`]. For each of the [`WIDTHS`]
+/// thicknesses t = τ/2^j it counts the m points within t, of which the
+/// k + 1 that define the primitive are not random, and keeps the smallest
+/// log₁₀ [`log10_nfa`] of the m − k − 1 others in Poisson(ρ·V(t)).
+pub fn part_log10_nfa(
+    residuals: &[f64],
+    k: usize,
+    tau: f64,
+    rho: f64,
+    volume: &dyn Fn(f64) -> f64,
+    log10_tests: f64,
+) -> f64 {
+    let mut best = f64::INFINITY;
+    let mut t = tau;
+    for _ in 0..WIDTHS {
+        let m = residuals.iter().filter(|&&d| d <= t).count();
+        if m > k + 1 {
+            let tail = log10_poisson_tail(rho * volume(t), (m - k - 1) as u64);
+            best = best.min(log10_tests + tail);
+        }
+        t *= 0.5;
+    }
+    best
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -147,6 +196,30 @@ mod tests {
         assert!(a.is_finite() && b < a);
         assert_eq!(log10_poisson_tail(0.0, 3), f64::NEG_INFINITY);
         assert_eq!(log10_poisson_tail(5.0, 0), 0.0);
+    }
+
+    #[test]
+    fn part_nfa_picks_the_thinnest_telling_width() {
+        let vol = |t: f64| std::f64::consts::PI * t * t * 60.0;
+        let tests = log10_n_tests(1550, 1);
+        // C(1550, 2) = 1,200,475 lines, times 12 widths.
+        assert!((tests - (1_200_475f64 * 12.0).log10()).abs() < 1e-9);
+        let rho = 0.01 / 41.9;
+        // Ten exactly collinear points: significant whatever the clutter
+        // that a claim radius of 1 adds.
+        let mut exact = vec![0.0; 10];
+        exact.extend([0.6, 0.9, 0.95]);
+        assert!(part_log10_nfa(&exact, 1, 1.0, 100.0 * rho, &vol, tests) < -10.0);
+        // Five points spread over the whole tube at 10x the paper's
+        // density: chance (about 0.2 expected in the tube, 3 counted).
+        let chain = [0.2, 0.5, 0.7, 0.8, 0.95];
+        assert!(part_log10_nfa(&chain, 1, 1.0, 10.0 * rho, &vol, tests) > 0.0);
+        // The best width is at most as bad as the widest alone.
+        let widest = tests + log10_poisson_tail(rho * vol(1.0), 11);
+        assert!(part_log10_nfa(&exact, 1, 1.0, rho, &vol, tests) <= widest);
+        // Too few points for any width: +inf, never kept.
+        assert_eq!(part_log10_nfa(&[0.1, 0.2], 1, 1.0, rho, &vol, tests), f64::INFINITY);
+        assert!(log10_n_tests(2, 2).is_finite());
     }
 
     #[test]
