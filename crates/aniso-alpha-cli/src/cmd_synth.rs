@@ -54,7 +54,12 @@ pub struct SynthArgs {
     pub density: Option<f64>,
     /// Gaussian jitter (standard deviation, input units) of every
     /// coordinate of the structure points
-    #[arg(long, value_name = "SIGMA", default_value_t = 0.0, conflicts_with = "jitter_d")]
+    #[arg(
+        long,
+        value_name = "SIGMA",
+        default_value_t = 0.0,
+        conflicts_with = "jitter_d"
+    )]
     pub jitter: f64,
     /// Gaussian jitter as a fraction of the structure spacing d (lines
     /// d = 7, planes and polyhedron d = 3): sigma = F * d

@@ -112,8 +112,11 @@ fn euclidean_alpha_shape_does_clearly_worse_on_lines() {
     let mut best = (0.0, 0.0);
     for k in 1..=40 {
         let alpha = 0.5 * k as f64;
+        // The paper's Euclidean α-shape: nb_c alone, no significance test
+        // (scripts/eval_robustness.py's baseline).
         let det = Detector::lines(alpha, 1.0, 4)
             .rotations(vec![id])
+            .significance(None)
             .run(&scene.points)
             .unwrap();
         let f1 = score(&scene, &det).f1;
@@ -185,8 +188,12 @@ fn progress_and_cancellation() {
 fn duplicates_take_their_first_occurrences_labels() {
     let id = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
     let pts = [[-4.0, -4.0, -4.0], [-4.0, -4.0, -4.0], [-3.0, -2.0, 0.0]];
+    // Two distinct points: a line through them explains them exactly, so
+    // the significance test (which needs k + 2 = 3 points) keeps nothing;
+    // nb_c alone, as in the paper, keeps the pair.
     let det = Detector::lines(1000.0, 4.0, 1)
         .rotations(vec![id])
+        .significance(None)
         .run(&pts)
         .unwrap();
     assert_eq!(det.first_occurrence, [0, 0, 2]);

@@ -124,15 +124,28 @@ pub(crate) struct ChanceScale {
 impl ChanceScale {
     /// Measured on `points` for the ellipsoid of radius `alpha` and
     /// semi-axes `alpha/e_i` (`elongation` e).
-    pub(crate) fn measure(points: &[[f64; 3]], alpha: f64, elongation: [f64; 3], orientations: usize) -> Self {
+    pub(crate) fn measure(
+        points: &[[f64; 3]],
+        alpha: f64,
+        elongation: [f64; 3],
+        orientations: usize,
+    ) -> Self {
         let (lo, hi) = crate::geometry::bounding_box(points);
         let volume: f64 = (0..3).map(|k| (hi[k] - lo[k]).max(1e-300)).product();
         let ellipsoid = 4.0 / 3.0 * std::f64::consts::PI * alpha.powi(3)
             / (elongation[0] * elongation[1] * elongation[2]);
+        // Distinct points (copies are one point to the scan; −0.0 is 0.0).
+        let mut keys: Vec<[u64; 3]> = points
+            .iter()
+            .map(|p| p.map(|c| (c + 0.0).to_bits()))
+            .collect();
+        keys.sort_unstable();
+        keys.dedup();
+        let n = keys.len() as f64;
         ChanceScale {
-            points: points.len() as f64,
+            points: n,
             orientations: orientations as f64,
-            per_ellipsoid: points.len() as f64 / volume * ellipsoid,
+            per_ellipsoid: n / volume * ellipsoid,
         }
     }
 }
@@ -653,13 +666,7 @@ pub(crate) fn assemble<S: Face>(
     for (g, ss) in &comp_simplices {
         let scale = settings.scales[*g as usize];
         let local: Vec<S> = ss.iter().map(|&s| kept[s as usize]).collect();
-        for (seeds, fit) in extract(
-            points,
-            &local,
-            scale.tau,
-            seed_min,
-            settings.part_angle_deg,
-        ) {
+        for (seeds, fit) in extract(points, &local, scale.tau, seed_min, settings.part_angle_deg) {
             if let Some(foot) = Footprint::new(&fit, points, &seeds, scale.cell) {
                 cands.push(Cand {
                     fit,
@@ -675,9 +682,7 @@ pub(crate) fn assemble<S: Face>(
     // 2b. Claim radius from the noise (lines under the test): the radius
     // among CLAIM_RADII·τ whose tube makes the candidate least explicable
     // by chance.
-    if settings.kind == StructureKind::Lines
-        && settings.log10_epsilon.is_some()
-    {
+    if settings.kind == StructureKind::Lines && settings.log10_epsilon.is_some() {
         let (lo, hi) = crate::geometry::bounding_box(points);
         let volume: f64 = (0..3).map(|k| (hi[k] - lo[k]).max(1e-300)).product();
         let rho_global = firsts.len() as f64 / volume;

@@ -3,38 +3,46 @@
 //!
 //! **Model.** Under the background hypothesis H₀, the points near a part
 //! are a Poisson process of density ρ (points per unit volume). A part is
-//! m points inside a thin region of volume V around its primitive: a slab
-//! of thickness 2t over its footprint of area A (planes, V = 2tA) or a
-//! tube of radius t along its length L (lines, V = πt²L), where t is the
-//! largest distance of its points to the fitted primitive (its actual
-//! thickness, not a parameter). Under H₀ that region holds Poisson(μ)
-//! points, μ = ρ·V, so
+//! a primitive (a line or a plane) with the m points it claimed. For a
+//! thickness t, the region within t of the primitive over the part's
+//! extent has volume V(t): a tube πt²L along a line (L the span of its
+//! points), a slab 2tA over a plane (A the area of the cells its points
+//! cover, grown by one cell). Under H₀ it holds Poisson(ρ·V(t)) points.
+//! The primitive itself is fitted to the points; as in the a-contrario
+//! detection of point alignments (Lezama, Morel, Randall & Grompone von
+//! Gioi, 2015), it is counted as *one of the lines through two points*
+//! (planes: through three) of the cloud, and those k + 1 points are not
+//! random: of the m(t) points within t, m(t) − k − 1 are. So
 //!
-//! NFA = N_tests · P[Poisson(μ) ≥ m],
+//! NFA(t) = N_tests · P[Poisson(ρ·V(t)) ≥ m(t) − k − 1],
 //!
-//! the expected number of parts at least this populated that chance alone
-//! would produce among the N_tests candidates tried. A part is kept when
-//! NFA ≤ ε (ε = 1 by default: on average less than one false detection per
-//! image, the usual choice).
+//! and the part's NFA is the smallest over the [`WIDTHS`] thicknesses
+//! t = τ, τ/2, …, τ/2¹¹ (τ the part's claim radius, or its largest
+//! residual if larger): a clean structure is significant in a thin tube
+//! that chance cannot fill, a noisy one in a wider tube. The number of
+//! tests is N_tests = C(n, k + 1)·[`WIDTHS`], n the number of distinct
+//! points: every primitive a part could have been, at every thickness
+//! tried. A part is kept when NFA ≤ ε (ε = 1 by default: on average less
+//! than one false detection per cloud, the usual choice).
 //!
 //! **The density.** ρ is the larger of two estimates measured from the
 //! data: the *global* background density (points outside every candidate
 //! part, over the volume of the cloud's bounding box: right for a uniform
 //! background, the paper's scenes) and the *local* one around the part
-//! (points at distance between t and 4t from the primitive over the same
-//! footprint, plus one, over that shell's volume: right for clutter that
-//! crowds some structures and not others). Taking the larger makes the test
-//! conservative.
-//!
-//! **The number of tests.** N_tests = (orientations scanned) × (points): a
-//! candidate is seeded by a point in an orientation.
+//! (points at distance between τ and 4τ from the primitive over the same
+//! extent, plus one, over that shell's volume: right for clutter that
+//! crowds some structures and not others). Taking the larger makes the
+//! test conservative.
 //!
 //! **Assumptions, and where they fail.** Background points are independent
-//! and locally uniform (clustered clutter, e.g. foliage, is denser than ρ
-//! in places and can pass); the part's thickness t is measured on the part
-//! itself (a part's points were selected for being close to its primitive,
-//! so t is optimistic for chance alignments with few points, which the
-//! number of tests compensates).
+//! and locally uniform: clustered clutter (foliage, a second structure
+//! nearby) is denser than ρ in places and can pass, which the local
+//! density only partly catches. The extent (length, footprint) is
+//! measured on the part and not counted among the tests; the area of a
+//! plane is taken generously (cells grown by one) to compensate. The
+//! count of tests ignores the orientations scanned: the primitive is
+//! fitted to points, not taken from the orientation that found them.
+//! Structures of fewer than k + 2 points are never significant.
 
 /// ln Γ(x) for x > 0 (Lanczos, g = 7, n = 9; relative error < 1e-13).
 pub fn ln_gamma(x: f64) -> f64 {
@@ -218,7 +226,10 @@ mod tests {
         let widest = tests + log10_poisson_tail(rho * vol(1.0), 11);
         assert!(part_log10_nfa(&exact, 1, 1.0, rho, &vol, tests) <= widest);
         // Too few points for any width: +inf, never kept.
-        assert_eq!(part_log10_nfa(&[0.1, 0.2], 1, 1.0, rho, &vol, tests), f64::INFINITY);
+        assert_eq!(
+            part_log10_nfa(&[0.1, 0.2], 1, 1.0, rho, &vol, tests),
+            f64::INFINITY
+        );
         assert!(log10_n_tests(2, 2).is_finite());
     }
 

@@ -362,7 +362,14 @@ fn jitter_relative_to_spacing_and_density_in_the_same_box() {
     assert!((o.jitter_sigma() - 0.7).abs() < 1e-12);
     assert!((o.clone().spacing(10.0).jitter_sigma() - 1.0).abs() < 1e-12);
     assert_eq!(o.clone().jitter(0.2).jitter_sigma(), 0.2);
-    assert!((SceneOptions::planes().jitter_of_spacing(0.05).jitter_sigma() - 0.15).abs() < 1e-12);
+    assert!(
+        (SceneOptions::planes()
+            .jitter_of_spacing(0.05)
+            .jitter_sigma()
+            - 0.15)
+            .abs()
+            < 1e-12
+    );
     // The structure points' spread across their line is about σ·√2 (two
     // of the three coordinates are across): measured on the fit.
     let s = SceneOptions::lines()
