@@ -419,7 +419,7 @@ impl<'a> Detector<'a> {
         }
     }
 
-    fn check_values(&self) -> Result<(), DetectError> {
+    pub(crate) fn check_values(&self) -> Result<(), DetectError> {
         let bad = |m: String| Err(DetectError::BadParameter(m));
         if !(self.alpha.is_finite() && self.alpha > 0.0) {
             return bad(format!(
@@ -484,7 +484,7 @@ impl<'a> Detector<'a> {
     }
 
     /// The jobs of the run and the scale of each group.
-    fn jobs<'p>(
+    pub(crate) fn jobs<'p>(
         &self,
         modes: &'p [ModeScan],
         rotations: &[Mat3],
@@ -532,7 +532,9 @@ impl<'a> Detector<'a> {
         ))
     }
 
-    fn run_k<S: Face>(&self, points: &[[f64; 3]]) -> Result<Detection, DetectError> {
+    /// The jobs of a run over this detector's orientation set (checked
+    /// against [`MAX_ORIENTATIONS`]) and the scale of each group.
+    pub(crate) fn scan_jobs(&self) -> Result<(Vec<Job<'_>>, Vec<Scale>), DetectError> {
         let (modes, rotations): (&[ModeScan], Vec<Mat3>) = match &self.set {
             OrientationSet::Data(m) => (m.as_slice(), Vec::new()),
             _ => (&[], self.orientation_set()?),
@@ -544,6 +546,35 @@ impl<'a> Detector<'a> {
                 jobs.len()
             )));
         }
+        Ok((jobs, scales))
+    }
+
+    /// A copy of this detector without its progress callback (so that it
+    /// can outlive the callback, e.g. in a [`super::split::Plan`]).
+    pub(crate) fn detached(&self) -> Detector<'static> {
+        Detector {
+            kind: self.kind,
+            alpha: self.alpha,
+            lambda2: self.lambda2,
+            lambda3: self.lambda3,
+            nb_c: self.nb_c,
+            set: self.set.clone(),
+            prune: self.prune,
+            part_angle_deg: self.part_angle_deg,
+            epsilon: self.epsilon,
+            threads: self.threads,
+            tile: self.tile,
+            estimate: self.estimate.clone(),
+            progress: None,
+        }
+    }
+
+    fn run_k<S: Face>(&self, points: &[[f64; 3]]) -> Result<Detection, DetectError> {
+        let (jobs, scales) = self.scan_jobs()?;
+        let modes: &[ModeScan] = match &self.set {
+            OrientationSet::Data(m) => m.as_slice(),
+            _ => &[],
+        };
         // Candidate pairs for the pruning, once for all orientations over
         // every point (unless there are too many).
         let lmax = self
@@ -604,6 +635,20 @@ impl<'a> Detector<'a> {
             stats.filtered_simplices += r.faces.len() as u64;
             found.push((job.group, r.faces));
         }
+        self.finish_k(points, found, scales, stats)
+    }
+
+    /// The steps after the scan: the union of the jobs' filtered simplices
+    /// (`found`: per job, its group and its simplices), the component
+    /// filter and the assembly. `stats` holds the scan's figures.
+    pub(crate) fn finish_k<S: Face>(
+        &self,
+        points: &[[f64; 3]],
+        found: Vec<(u32, Vec<S>)>,
+        scales: Vec<Scale>,
+        mut stats: RunStats,
+    ) -> Result<Detection, DetectError> {
+        let total = stats.orientations;
         let (all, groups) = union(found);
         stats.union_simplices = all.len();
         let keep = component_size_mask(&all, self.nb_c)?;
@@ -686,7 +731,7 @@ fn elongation(kind: StructureKind, lambda2: f64, lambda3: f64) -> [f64; 3] {
 }
 
 /// Input checks: not empty, finite, in the range of exact arithmetic.
-fn check_points(points: &[[f64; 3]]) -> Result<(), DetectError> {
+pub(crate) fn check_points(points: &[[f64; 3]]) -> Result<(), DetectError> {
     if points.is_empty() {
         return Err(DetectError::Empty);
     }
