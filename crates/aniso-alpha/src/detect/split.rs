@@ -211,10 +211,9 @@ impl Plan {
     /// more: [`Step::run`] selects each job's own halo exactly), in cell
     /// order.
     ///
-    /// # Panics
-    /// Never for the cloud the plan was made for; `points` of another
-    /// length give tiles that [`Step::run`] still accepts but
-    /// [`Self::finish`] rejects.
+    /// Cost: every point is listed once per tile whose grown cell holds it,
+    /// about (1 + 2·halo/side)³ times: tiles much smaller than the halo
+    /// repeat points many times.
     pub fn tiles(&self, points: &[[f64; 3]]) -> Vec<Tile> {
         let side = self.step.side;
         let used: Vec<bool> = match &self.groups {
@@ -557,12 +556,13 @@ mod tests {
     #[test]
     fn planes_split_equals_run() {
         let scene = synth::polyhedron(1);
-        let d = Detector::planes(1.0, 4.0, 8.0, 20).sampler(
-            crate::detect::orientations::Sampler::Box { m1: 0.6, m2: 6 },
-        );
+        // λ₂ = λ₃ = 4 (no turns about the normals): a halo of 8, tiles of
+        // 6 cut the box's faces (step 3, a dozen points a side).
+        let d = Detector::planes(1.0, 4.0, 4.0, 20)
+            .sampler(crate::detect::orientations::Sampler::Box { m1: 0.6, m2: 1 });
         let whole = d.run(&scene.points).unwrap();
         assert!(!whole.structures.is_empty());
-        let (split, tiles) = split_run(&d, &scene.points, 7.0);
+        let (split, tiles) = split_run(&d, &scene.points, 6.0);
         assert!(tiles > 8, "{tiles} tiles");
         same(&split, &whole);
     }
