@@ -154,11 +154,7 @@ impl Detector<'_> {
     pub fn plan(&self, points: &[[f64; 3]], side: f64) -> Result<Plan, DetectError> {
         self.check_values()?;
         check_points(points)?;
-        if !(side.is_finite() && side > 0.0) {
-            return Err(DetectError::BadParameter(format!(
-                "tile must be positive and finite, got {side}"
-            )));
-        }
+        check_side(side)?;
         let detector = self.detached();
         let (jobs, _) = detector.scan_jobs()?;
         let halo = jobs.iter().map(halo_width).fold(0.0, f64::max);
@@ -189,6 +185,18 @@ impl Detector<'_> {
 }
 
 impl Plan {
+    /// The same plan with tiles of another side (the parameters, already
+    /// estimated, are kept).
+    ///
+    /// # Errors
+    /// A side that is not positive and finite.
+    pub fn with_side(&self, side: f64) -> Result<Plan, DetectError> {
+        check_side(side)?;
+        let mut p = self.clone();
+        p.step.side = side;
+        Ok(p)
+    }
+
     /// The per-tile step (what every worker needs).
     pub fn step(&self) -> &Step {
         &self.step
@@ -362,6 +370,16 @@ impl Plan {
         }
         let (_, scales) = self.detector.scan_jobs()?;
         self.detector.finish_k(points, found, scales, stats)
+    }
+}
+
+fn check_side(side: f64) -> Result<(), DetectError> {
+    if side.is_finite() && side > 0.0 {
+        Ok(())
+    } else {
+        Err(DetectError::BadParameter(format!(
+            "tile must be positive and finite, got {side}"
+        )))
     }
 }
 
@@ -624,6 +642,8 @@ mod tests {
         assert!(d.plan(&scene.points, 0.0).is_err());
         assert!(d.plan(&scene.points, f64::NAN).is_err());
         let plan = d.plan(&scene.points, 50.0).unwrap();
+        assert!(plan.with_side(-1.0).is_err());
+        assert_eq!(plan.with_side(20.0).unwrap().step().side, 20.0);
         let step = plan.step();
         let p = [[0.0; 3], [1.0, 0.0, 0.0]];
         assert!(step.run([0; 3], &p, &[1, 0], &Members::All).is_err());
