@@ -267,7 +267,15 @@ def _run(client: Any, p: "_native.Plan", points: np.ndarray, task_threads: int) 
 
     pending = as_completed([submit(t) for _, t in zip(range(limit), tiles)])
     for done in pending:
-        outputs.append(done.result())
+        faces, offsets, triangulated = done.result()
+        # Unpickled from one frame, the arrays may be unaligned (see _run_tile).
+        outputs.append(
+            (
+                np.require(faces, requirements=("C", "A")),
+                np.require(offsets, requirements=("C", "A")),
+                triangulated,
+            )
+        )
         done.release()
         nxt = next(tiles, None)
         if nxt is not None:
