@@ -75,22 +75,24 @@ def test_auto_planes_equal_in_process(client):
     assert_crossing(pts, det.labels, tile)
 
 
-def test_paper_lines_from_a_file_equal_in_process(client, scenes):
+def test_paper_lines_from_a_file_equal_in_process(client, scenes, detections):
+    """The paper's Fig. 12 scene and parameters (the box of orientations);
+    its lines are about 100 long, the tiles 20."""
     structure, params = PAPER["lines"]
-    ref = aa.detect(aa.read(scenes["lines"]), structure, **params)
+    pts, ref = detections["lines"]
     assert len(ref.structures) >= 4
     det = distributed.detect(str(scenes["lines"]), structure, tile=20.0, client=client, **params)
     assert_same(det, ref)
-    assert_crossing(aa.read(scenes["lines"]), det.labels, 20.0)
+    assert_crossing(pts, det.labels, 20.0)
 
 
 def test_default_tile_gives_the_same_result(client):
     pts = room(5)
-    ref = aa.detect(pts, "planes", alpha=0.1, lambda3=4.0, min_size=10)
-    p = distributed.plan(pts, "planes", workers=2, alpha=0.1, lambda3=4.0, min_size=10)
+    ref = aa.detect(pts, "planes", min_size=10)
+    p = distributed.plan(pts, "planes", workers=2, min_size=10)
     # 4 tiles per worker at least, no side below 2 halos.
     assert len(p.tiles(pts)) >= 8 and p.tile >= 2 * p.halo
-    det = distributed.detect(pts, "planes", client=client, alpha=0.1, lambda3=4.0, min_size=10)
+    det = distributed.detect(pts, "planes", client=client, min_size=10)
     assert_same(det, ref)
 
 
