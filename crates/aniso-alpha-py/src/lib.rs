@@ -254,9 +254,9 @@ fn _panic(py: Python<'_>, on_worker: bool) -> PyResult<()> {
 #[pymodule(name = "_native")]
 mod native {
     #[pymodule_export]
-    use super::{_panic, _points_address, alpha_intervals, delaunay, detect, read};
-    #[pymodule_export]
     use super::split::{plan, tile_step, PyPlan};
+    #[pymodule_export]
+    use super::{_panic, _points_address, alpha_intervals, delaunay, detect, read};
 
     use pyo3::prelude::*;
 

@@ -9,8 +9,7 @@ use aniso_alpha::detect::split::{Members, Plan, SplitJob, Step, TileOutput};
 use aniso_alpha::detect::StructureKind;
 use numpy::ndarray::Array3;
 use numpy::{
-    IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1,
-    PyReadonlyArray2, PyReadonlyArray3,
+    IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,
 };
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -156,7 +155,10 @@ impl PyPlan {
             rot.into_pyarray(py),
             rows_to_numpy(
                 py,
-                step.jobs.iter().map(|s| s.anisotropy.elongation()).collect(),
+                step.jobs
+                    .iter()
+                    .map(|s| s.anisotropy.elongation())
+                    .collect(),
             ),
             step.jobs
                 .iter()
@@ -179,11 +181,7 @@ impl PyPlan {
         &self,
         py: Python<'py>,
         points: &Bound<'py, PyAny>,
-        outputs: Vec<(
-            PyReadonlyArray1<'py, u32>,
-            PyReadonlyArray1<'py, u64>,
-            u64,
-        )>,
+        outputs: Vec<(PyReadonlyArray1<'py, u32>, PyReadonlyArray1<'py, u64>, u64)>,
         threads: Option<i64>,
     ) -> PyResult<DetectOut<'py>> {
         let points = Points::extract(points)?;

@@ -393,8 +393,7 @@ fn check_output(o: &TileOutput, jobs: usize, k1: usize, n: usize) -> Result<(), 
             o.faces.len()
         ));
     }
-    if o
-        .offsets
+    if o.offsets
         .windows(2)
         .any(|w| w[1] < w[0] || (w[1] - w[0]) % k1 != 0)
     {
@@ -514,7 +513,13 @@ fn tile_job<S: Face>(
     owned: &dyn Fn(u32) -> bool,
 ) -> Result<(Vec<u32>, usize), DetectError> {
     let job = job.job(None);
-    let (map, q) = pruned(points, sub, &job.anisotropy, prune_radius(&job), &Pruning::Grid);
+    let (map, q) = pruned(
+        points,
+        sub,
+        &job.anisotropy,
+        prune_radius(&job),
+        &Pruning::Grid,
+    );
     let triangulated = map.len();
     // Positions ascend with the global ids, so a simplex sorted by
     // position is sorted by id and its smallest vertex is the same.
@@ -568,7 +573,10 @@ mod tests {
         assert!(tiles > 8, "{tiles} tiles");
         same(&split, &whole);
         // The in-process tiled run is the same too.
-        same(&d.clone().tile(Some(20.0)).run(&scene.points).unwrap(), &whole);
+        same(
+            &d.clone().tile(Some(20.0)).run(&scene.points).unwrap(),
+            &whole,
+        );
     }
 
     #[test]
@@ -591,7 +599,9 @@ mod tests {
         let mut pts = Vec::new();
         let mut s = 7u64;
         let mut noise = || {
-            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             ((s >> 33) as f64 / (1u64 << 31) as f64 - 0.5) * 0.02
         };
         for i in 0..40 {
@@ -603,7 +613,7 @@ mod tests {
         }
         let d = Detector::auto(StructureKind::Planes, &pts, &Given::default()).unwrap();
         let whole = d.run(&pts).unwrap();
-        assert!(whole.structures.len() >= 1);
+        assert!(!whole.structures.is_empty());
         assert!(whole.labels.iter().filter(|&&l| l >= 0).count() > pts.len() / 2);
         let (split, tiles) = split_run(&d, &pts, 2.5);
         assert!(tiles > 8, "{tiles} tiles");
