@@ -65,7 +65,7 @@ pub fn structure_color(k: usize) -> [u8; 3] {
 /// structure's, alternating lightness.
 pub fn part_color(k: usize, j: usize) -> [u8; 3] {
     const SHIFT: [f64; 7] = [0.0, 40.0, -40.0, 80.0, -80.0, 120.0, -120.0];
-    let l = if (j / SHIFT.len()) % 2 == 0 {
+    let l = if (j / SHIFT.len()).is_multiple_of(2) {
         0.55
     } else {
         0.42
