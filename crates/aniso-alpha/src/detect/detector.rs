@@ -42,7 +42,7 @@ use super::filter::{component_size_mask, FilterError};
 use super::orientations::{orientations, OrientationError, Sampler};
 use super::prune::CandidatePairs;
 use super::scan::{run_job, union, Face, Job, JobResult, Pruning, ScanError, RADIUS_SLACK};
-use super::StructureKind;
+pub use super::StructureKind;
 use crate::aniso::{Anisotropy, AnisotropyError};
 use std::fmt;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
