@@ -34,6 +34,7 @@ const NO_LABELS: ReadOptions = ReadOptions {
     read_labels: false,
     format: None,
     background_classes: ClassSet::LAS_BACKGROUND,
+    attributes: false,
 };
 
 #[test]

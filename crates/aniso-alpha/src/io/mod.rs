@@ -26,10 +26,16 @@
 //! ```
 
 mod atomic;
+mod attributes;
 mod error;
+mod labelled;
 mod labels;
 #[cfg(feature = "las")]
 mod las;
+#[cfg(feature = "las")]
+mod las_attrs;
+#[cfg(feature = "las")]
+mod las_write;
 mod lzf;
 mod obj;
 mod pcd;
@@ -44,7 +50,9 @@ use std::path::Path;
 pub use atomic::{
     atomic_write, check_output_path, output_key, remove_temp_files, resolve_output, same_file,
 };
+pub use attributes::{Attribute, AttributeType, LasSource, Values, Vlr};
 pub use error::IoError;
+pub use labelled::{write_labelled_cloud, Labelled};
 pub use labels::{read_labels, read_labels_bytes, write_labels};
 pub use obj::write_obj;
 pub use ply::{write_ply, write_ply_to, Mesh, PlyEncoding};
@@ -58,6 +66,15 @@ pub struct PointCloud {
     /// One label per point, when asked for and present (see
     /// [`ReadOptions`]); -1 conventionally means background.
     pub labels: Option<Vec<i64>>,
+    /// Every other per-point property of the file, typed as in the file
+    /// (colours, normals, intensity, classification, GPS time, any PLY
+    /// vertex property, PCD field, LAS record field or extra bytes), when
+    /// asked for with [`ReadOptions::attributes`]; empty otherwise.
+    pub attributes: Vec<Attribute>,
+    /// For a LAS/LAZ file read with [`ReadOptions::attributes`]: its
+    /// header, VLRs and point records as in the file, so that a LAS output
+    /// keeps every record byte for byte ([`write_labelled_cloud`]).
+    pub las: Option<Box<LasSource>>,
     /// What the reader guessed and the user should hear about (e.g. a
     /// first line taken as a header); the CLI prints them.
     pub warnings: Vec<ReadWarning>,
@@ -103,6 +120,11 @@ pub struct ReadOptions {
     /// the labels; by default 0 and 1 (never classified, unclassified), 7
     /// (low noise) and 18 (high noise), see [`ClassSet::LAS_BACKGROUND`].
     pub background_classes: ClassSet,
+    /// Keep every per-point attribute of the file in
+    /// [`PointCloud::attributes`] (PLY, PCD, LAS/LAZ, E57), and a LAS
+    /// file's records in [`PointCloud::las`]. Off, a reader decodes x, y,
+    /// z (and the labels) only, as fast as before.
+    pub attributes: bool,
 }
 
 /// A set of LAS classification codes (0–255).
@@ -162,6 +184,7 @@ impl ReadOptions {
             read_labels: true,
             format: None,
             background_classes: ClassSet::LAS_BACKGROUND,
+            attributes: false,
         }
     }
 }
@@ -387,7 +410,7 @@ pub fn read_ply_bytes(
     bytes: &[u8],
     options: &ReadOptions,
 ) -> Result<PointCloud, IoError> {
-    ply::read_ply(name, bytes, options.read_labels)
+    ply::read_ply(name, bytes, options.read_labels, options.attributes)
 }
 
 /// Parses a PCD file (ascii, binary or binary_compressed) held in memory;
@@ -405,7 +428,7 @@ pub fn read_pcd_bytes(
     bytes: &[u8],
     options: &ReadOptions,
 ) -> Result<PointCloud, IoError> {
-    pcd::read_pcd(name, bytes, options.read_labels)
+    pcd::read_pcd(name, bytes, options.read_labels, options.attributes)
 }
 
 /// Parses a LAS or LAZ file held in memory (scale and offset applied);
@@ -423,6 +446,7 @@ pub fn read_las_bytes(
             name,
             bytes,
             options.read_labels.then_some(options.background_classes),
+            options.attributes,
         )
     }
     #[cfg(not(feature = "las"))]
