@@ -16,10 +16,11 @@
 //!    falls in the footprint claims the candidate (the α-shape's simplices
 //!    reach the structure's points; points of a noisy structure that no
 //!    simplex touched are recovered here). A point claimed by several
-//!    candidates goes to the one it is nearest to: parts are disjoint. Candidates that are one plane (normals within the part
-//!    angle, each centroid within τ of the other's plane) or one line and
-//!    that share claimed points are merged first, so a plane is never
-//!    reported twice. Members are refitted once and claimed again.
+//!    candidates goes to the one it is nearest to: parts are disjoint.
+//!    Candidates that are one plane or one line (within the part angle,
+//!    and most of the smaller one's points within τ of the larger one's
+//!    primitive) and that share claimed points are merged first, so a
+//!    plane is never reported twice. Members are refitted once and claimed again.
 //! 4. **Significance.** With a test enabled, each part's number of false
 //!    alarms is computed ([`super::significance`]) and parts above ε go.
 //! 5. **Structures.** Parts that share claimed points (where two facets
@@ -339,22 +340,42 @@ fn crosses(fit: &Primitive, b: &[u32], points: &[[f64; 3]]) -> bool {
     usize::min(pos, neg) * CROSS_SHARE >= b.len()
 }
 
-/// Whether two candidates are one primitive.
-fn same_primitive(a: &Cand, b: &Cand, angle_deg: f64) -> bool {
+/// Share of the smaller candidate's seeds that must lie within τ of the
+/// larger one's primitive for the two to be one.
+const SAME_SHARE: f64 = 0.8;
+
+/// Whether two candidates are one primitive: their planes (lines) are
+/// within the part angle of each other, and either each one's centroid
+/// lies within τ of the other's primitive or most of the smaller one's
+/// seeds lie within τ of the larger one's primitive. (The second test
+/// catches a strip along the edge of a plane, found by another mode: it
+/// fits a plane tilted across the strip, whose offset at the other's
+/// centroid says nothing.)
+fn same_primitive(a: &Cand, b: &Cand, angle_deg: f64, points: &[[f64; 3]]) -> bool {
     let cos = angle_deg.to_radians().cos();
-    match (&a.fit, &b.fit) {
-        (Primitive::Plane(fa), Primitive::Plane(fb)) => {
-            dot(fa.normal, fb.normal).abs() >= cos
-                && a.fit.distance(&fb.centroid) <= a.tau
-                && b.fit.distance(&fa.centroid) <= b.tau
-        }
-        (Primitive::Line(fa), Primitive::Line(fb)) => {
-            dot(fa.direction, fb.direction).abs() >= cos
-                && a.fit.distance(&fb.centroid) <= a.tau
-                && b.fit.distance(&fa.centroid) <= b.tau
-        }
+    let parallel = match (&a.fit, &b.fit) {
+        (Primitive::Plane(fa), Primitive::Plane(fb)) => dot(fa.normal, fb.normal).abs() >= cos,
+        (Primitive::Line(fa), Primitive::Line(fb)) => dot(fa.direction, fb.direction).abs() >= cos,
         _ => false,
+    };
+    if !parallel {
+        return false;
     }
+    let centroid = |f: &Primitive| match f {
+        Primitive::Plane(p) => p.centroid,
+        Primitive::Line(l) => l.centroid,
+        Primitive::None => [f64::NAN; 3],
+    };
+    if a.fit.distance(&centroid(&b.fit)) <= a.tau && b.fit.distance(&centroid(&a.fit)) <= b.tau {
+        return true;
+    }
+    let (big, small) = if a.seeds.len() >= b.seeds.len() { (a, b) } else { (b, a) };
+    let near = small
+        .seeds
+        .iter()
+        .filter(|&&v| big.fit.distance(&points[v as usize]) <= big.tau)
+        .count();
+    near as f64 >= SAME_SHARE * small.seeds.len() as f64
 }
 
 struct Uf(Vec<u32>);
@@ -572,6 +593,7 @@ pub(crate) fn assemble<S: Face>(
                     &cands[a as usize],
                     &cands[b as usize],
                     settings.part_angle_deg,
+                    points,
                 )
             {
                 uf.union(a, b);

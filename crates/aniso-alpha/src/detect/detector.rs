@@ -247,7 +247,7 @@ impl<'a> Detector<'a> {
         check_points(points)?;
         let probe = Detector {
             alpha: given.alpha.unwrap_or(1.0),
-            lambda2: given.lambda2.or(given.lambda3).unwrap_or(1.0),
+            lambda2: given.lambda2.unwrap_or(1.0),
             lambda3: given.lambda3.unwrap_or(1.0),
             nb_c: given.min_size.unwrap_or(1),
             ..Self::lines(1.0, 1.0, 1)

@@ -246,7 +246,7 @@ pub fn mode_rotations(
 /// }
 /// let e = estimate(StructureKind::Planes, &pts, &Given::default(), 12);
 /// assert_eq!(e.modes.len(), 2);
-/// assert!((e.spacing - 0.1).abs() < 1e-9);
+/// assert!((e.spacing - 0.1).abs() < 1e-6); // (spacings are kept as f32)
 /// assert!(e.alpha.estimated && e.alpha.value > 0.0);
 /// ```
 pub fn estimate(kind: StructureKind, points: &[[f64; 3]], given: &Given, m2: u32) -> Estimate {

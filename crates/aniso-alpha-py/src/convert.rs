@@ -1,0 +1,97 @@
+//! Points in (any array-like of shape (n, 3)), numpy arrays out.
+
+use numpy::ndarray::Array2;
+use numpy::{
+    IntoPyArray, PyArray2, PyArrayMethods, PyReadonlyArray2, PyUntypedArray, PyUntypedArrayMethods,
+};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// Points borrowed from a C-contiguous float64 numpy array of shape (n, 3):
+/// the caller's own array when it is one, else a converted copy.
+pub struct Points<'py> {
+    array: PyReadonlyArray2<'py, f64>,
+}
+
+impl<'py> Points<'py> {
+    /// Converts `obj` (an array-like of shape (n, 3)).
+    ///
+    /// A C-contiguous float64 ndarray is borrowed as it is, without a copy;
+    /// anything else (lists, other dtypes, Fortran order, strided views) is
+    /// converted by `numpy.ascontiguousarray(obj, dtype=float64)`.
+    ///
+    /// # Errors
+    /// `ValueError` for a wrong shape or a non-real dtype (numpy's own
+    /// errors for what it cannot convert).
+    pub fn extract(obj: &Bound<'py, PyAny>) -> PyResult<Self> {
+        if let Ok(a) = obj.cast::<PyArray2<f64>>() {
+            if a.is_c_contiguous() {
+                check_shape(a.as_untyped())?;
+                return Ok(Points {
+                    array: a.try_readonly()?,
+                });
+            }
+        }
+        let py = obj.py();
+        let np = py.import("numpy")?;
+        let a = np.call_method1("asarray", (obj,))?;
+        let dtype = a.getattr("dtype")?;
+        let kind: String = dtype.getattr("kind")?.extract()?;
+        if !matches!(kind.as_str(), "i" | "u" | "f") {
+            return Err(PyValueError::new_err(format!(
+                "points must be real numbers, got an array of dtype {}",
+                dtype.str()?
+            )));
+        }
+        let kwargs = PyDict::new(py);
+        kwargs.set_item("dtype", np.getattr("float64")?)?;
+        let a = np.call_method("ascontiguousarray", (a,), Some(&kwargs))?;
+        check_shape(a.cast::<PyUntypedArray>()?)?;
+        let a = a.cast_into::<PyArray2<f64>>()?;
+        Ok(Points {
+            array: a.try_readonly()?,
+        })
+    }
+
+    /// The points, in the array's memory.
+    pub fn as_slice(&self) -> &[[f64; 3]] {
+        // Contiguous by construction, and the shape was checked: (n, 3).
+        let flat = self.array.as_slice().unwrap_or(&[]);
+        flat.as_chunks::<3>().0
+    }
+
+    /// The address of the first coordinate (for the tests that check that
+    /// a float64 C-contiguous array is not copied).
+    pub fn address(&self) -> usize {
+        self.as_slice().as_ptr() as usize
+    }
+}
+
+fn check_shape(a: &Bound<'_, PyUntypedArray>) -> PyResult<()> {
+    let shape = a.shape();
+    if shape.len() != 2 || shape[1] != 3 {
+        let dims: Vec<String> = shape.iter().map(|d| d.to_string()).collect();
+        let dims = if dims.len() == 1 {
+            format!("({},)", dims[0])
+        } else {
+            format!("({})", dims.join(", "))
+        };
+        return Err(PyValueError::new_err(format!(
+            "points must be an array of shape (n, 3), got shape {dims}"
+        )));
+    }
+    Ok(())
+}
+
+/// `rows` as a numpy array of shape (rows.len(), N), without a copy.
+pub fn rows_to_numpy<'py, T: numpy::Element, const N: usize>(
+    py: Python<'py>,
+    rows: Vec<[T; N]>,
+) -> Bound<'py, PyArray2<T>> {
+    let m = rows.len();
+    let flat: Vec<T> = rows.into_flattened();
+    Array2::from_shape_vec((m, N), flat)
+        .expect("m * N elements")
+        .into_pyarray(py)
+}
