@@ -603,6 +603,31 @@ mod tests {
     }
 
     #[test]
+    fn fuzz_regression_gps_time_switch_recursion() {
+        // libFuzzer: corrupt GPS times coded as endless "switch to another
+        // time sequence"; laz 0.13 recursed once per switch and overflowed
+        // the stack (SIGSEGV with a 2 MiB thread stack, this file; 8 MiB
+        // for others). The vendored laz loops and gives an error. Read on
+        // a thread with a 1 MiB stack so that a recursion would show.
+        let bytes = include_bytes!("../../tests/fuzz_regressions/laz-gps-switch-recursion.laz");
+        for attributes in [false, true] {
+            let e = std::thread::Builder::new()
+                .stack_size(1 << 20)
+                .spawn(move || {
+                    read_las(Path::new("gps.laz"), bytes, Some(ClassSet::EMPTY), attributes)
+                })
+                .unwrap()
+                .join()
+                .unwrap()
+                .unwrap_err();
+            assert!(
+                e.to_string().contains("endless GPS time sequence switches"),
+                "{e}"
+            );
+        }
+    }
+
+    #[test]
     fn fuzz_regression_huge_record_length() {
         // libFuzzer found a header with a huge record length and point
         // count: the reader allocated 2.7 GB at once.
