@@ -9,7 +9,7 @@ point sets.
     python3 scripts/diff_vs_cgal.py --what alpha     # intervals vs cgal_intervals
 
 CGAL's perturbed Delaunay triangulation is unique whatever the insertion
-order, and ours follows the same perturbation (SPEC §1), so the two sets of
+order, and ours follows the same perturbation (docs/method.md §1), so the two sets of
 finite tets must be equal, tet for tet. Each case is written as a text
 `.xyz` file with every coordinate printed exactly (Python's `repr`), and
 read by both programs: our CLI's `delaunay` command and the peer program
@@ -29,7 +29,7 @@ tolerance of the fixture tests); the largest deviation seen is printed.
 
 Families (each case draws its sizes and maps from the seeded generator):
   grid          integer n1 x n2 x n3 grid, a random subset, shuffled
-  grid_affine   a grid mapped by diag(e)·R (rounded as SPEC's Q·p)
+  grid_affine   a grid mapped by diag(e)·R (rounded as our Q·p)
   grid_dup      a grid with a third of its points repeated
   sphere        integer points on a few concentric integer spheres
   cocircular    stacked planes of cocircular integer points

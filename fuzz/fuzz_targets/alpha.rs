@@ -11,6 +11,7 @@
 use std::collections::BTreeMap;
 
 use aniso_alpha::alpha::AlphaComplex;
+use aniso_alpha::delaunay::VertexId;
 use libfuzzer_sys::fuzz_target;
 
 mod points;
@@ -27,8 +28,8 @@ fn le(a: f64, b: f64) -> bool {
 /// Every simplex's sorted vertex coordinates (as bits) with its interval.
 fn table(ac: &AlphaComplex) -> BTreeMap<Vec<[u64; 3]>, (f64, f64)> {
     let tri = ac.triangulation();
-    let key = |vs: &[u32]| {
-        let mut k: Vec<[u64; 3]> = vs.iter().map(|&v| coordinate_key(tri.point(v))).collect();
+    let key = |vs: &[VertexId]| {
+        let mut k: Vec<[u64; 3]> = vs.iter().map(|&v| coordinate_key(tri.point(v.0))).collect();
         k.sort_unstable();
         k
     };

@@ -6,7 +6,7 @@
 //! on empty, non-finite or out-of-range input; the result passes
 //! `validate_with_input`; and building the reversed input gives the same
 //! tets, compared by their vertices' coordinates (the perturbed
-//! triangulation is unique whatever the order, see SPEC §1).
+//! triangulation is unique whatever the order, see docs/method.md §1).
 #![no_main]
 
 use aniso_alpha::delaunay::{DelaunayError, Triangulation};

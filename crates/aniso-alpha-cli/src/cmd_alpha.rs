@@ -7,7 +7,7 @@ use aniso_alpha::alpha::AlphaComplex;
 use aniso_alpha::aniso::Anisotropy;
 use aniso_alpha::delaunay::Triangulation;
 use aniso_alpha::io::{Mesh, ReadOptions};
-use clap::Args;
+use clap::{ArgGroup, Args};
 
 use crate::common::{
     self, parse_positive, parse_positive_triple, parse_triple, push_u32, CliError, Timings,
@@ -16,20 +16,37 @@ use crate::common::{
 /// Arguments of `alpha`.
 #[derive(Debug, Args)]
 #[command(
-    after_help = "With --intervals: CSV with header `dim,v0,v1,v2,alpha_min,alpha_max`, one row \
+    // Something to do; --alpha alone then asks for an output of the shape.
+    group(ArgGroup::new("action").required(true).multiple(true)
+        .args(["intervals", "alpha", "output", "png", "optimal_alpha"])),
+    group(ArgGroup::new("shape_out").multiple(true).args(["output", "png"])),
+    group(ArgGroup::new("which_alpha").args(["alpha", "optimal_alpha"])),
+    override_usage = "aniso-alpha alpha <INPUT> --intervals <OUT.csv> [--elongation <e1,e2,e3>] [--euler <theta,psi,phi>]\n       \
+aniso-alpha alpha <INPUT> (--alpha <A> | --optimal-alpha) [--surface] (--output <shape.ply> | --png <OUT.png>)\n       \
+aniso-alpha alpha <INPUT> --optimal-alpha",
+    after_help = "Alpha is a radius: the ball (or, with --elongation, the ellipsoid's unit \
+semi-axis) of radius alpha. CGAL's Alpha_shape_3 takes the squared radius instead: alpha 0.5 \
+here is CGAL's alpha 0.25.\n\
+With --intervals: CSV with header `dim,v0,v1,v2,alpha_min,alpha_max`, one row \
 per Delaunay edge (dim 1, v2 empty) and triangle (dim 2) of Del(Q·P), vertex indices ascending, \
-`inf` for an unbounded alpha_max. Q = diag(e1,e2,e3)·R(theta,psi,phi), R = Rz(theta)·Rx(psi)·Ry(phi); \
-the default is the identity (Euclidean).\n\
-With --alpha A --output shape.ply: the edges and triangles with alpha_min <= A <= alpha_max.\n\n\
+`inf` for an unbounded alpha_max (radii, like --alpha). Q = diag(e1,e2,e3)·R(theta,psi,phi), \
+R = Rz(theta)·Rx(psi)·Ry(phi); the default is the identity (Euclidean). See docs/method.md §1-§2.\n\
+With --alpha A --output shape.ply: the alpha-shape F_alpha of the paper, every edge and triangle \
+with alpha_min <= A <= alpha_max (unoriented triangles, plus the edges that bound no triangle). \
+With --surface: only the boundary of the alpha-complex's solid part, triangles oriented outward \
+(CGAL's REGULAR facets; the mesh Open3D and CGAL users call the alpha shape).\n\
+--optimal-alpha: the smallest alpha at which the alpha-complex is one solid holding every point \
+(CGAL's find_optimal_alpha(1)); printed on stdout, and used by --output/--png.\n\n\
 Examples:\n  aniso-alpha alpha scan.xyz --intervals intervals.csv\n  \
 aniso-alpha alpha scan.xyz --intervals aniso.csv --elongation 1,1,0.125 --euler=0,0.3,-1.2\n  \
-aniso-alpha alpha scan.xyz --alpha 0.5 --output shape.ply"
+aniso-alpha alpha scan.xyz --alpha 0.5 --output shape.ply\n  \
+aniso-alpha alpha scan.xyz --optimal-alpha --surface --output surface.ply --png surface.png"
 )]
 pub struct AlphaArgs {
     /// Input point file (.xyz .txt .csv .pts .ply .las .laz .pcd)
     pub input: PathBuf,
     /// Write the alpha interval of every edge and triangle to this CSV file
-    #[arg(long, value_name = "OUT.csv", required_unless_present = "output")]
+    #[arg(long, value_name = "OUT.csv")]
     pub intervals: Option<PathBuf>,
     /// Elongation e1,e2,e3 (each > 0) of the metric Q = diag(e)·R
     #[arg(long, value_name = "e1,e2,e3", value_parser = parse_positive_triple)]
@@ -37,12 +54,28 @@ pub struct AlphaArgs {
     /// Orientation angles theta,psi,phi (radians) of R = Rz(theta)·Rx(psi)·Ry(phi)
     #[arg(long, value_name = "theta,psi,phi", value_parser = parse_triple, allow_hyphen_values = true)]
     pub euler: Option<[f64; 3]>,
-    /// Alpha of the shape written by --output
-    #[arg(long, value_name = "A", value_parser = parse_positive, requires = "output")]
+    /// Alpha of the shape written by --output/--png: a radius (CGAL's
+    /// Alpha_shape_3 takes its square)
+    #[arg(long, value_name = "A", value_parser = parse_positive, requires = "shape_out")]
     pub alpha: Option<f64>,
-    /// Write the alpha-shape at --alpha (PLY, or OBJ by extension)
-    #[arg(long, value_name = "shape.ply", requires = "alpha")]
+    /// Use (and print) the optimal alpha: the smallest at which the
+    /// alpha-complex is one solid holding every point
+    #[arg(long)]
+    pub optimal_alpha: bool,
+    /// Write the alpha-shape (PLY, or OBJ by extension)
+    #[arg(long, value_name = "shape.ply", requires = "which_alpha")]
     pub output: Option<PathBuf>,
+    /// Write only the oriented boundary surface (regular triangles, normals
+    /// outward) instead of every edge and triangle of F_alpha
+    #[arg(long, requires = "shape_out")]
+    pub surface: bool,
+    /// Write a picture of the alpha-shape (PNG, fixed view)
+    #[arg(long, value_name = "OUT.png", requires = "which_alpha")]
+    pub png: Option<PathBuf>,
+    #[command(flatten)]
+    pub input_format: crate::FormatArgs,
+    #[command(flatten)]
+    pub common: crate::CommonArgs,
 }
 
 /// Runs `alpha`.
@@ -55,6 +88,7 @@ pub fn run(args: &AlphaArgs, timings: &mut Timings) -> Result<(), CliError> {
         &[
             ("--intervals", args.intervals.as_deref()),
             ("--output", args.output.as_deref()),
+            ("--png", args.png.as_deref()),
         ],
     )?;
     let cloud = common::read_input(&args.input, &ReadOptions::default(), timings)?;
@@ -92,7 +126,31 @@ pub fn run(args: &AlphaArgs, timings: &mut Timings) -> Result<(), CliError> {
             path.display()
         ));
     }
-    if let (Some(alpha), Some(path)) = (args.alpha, &args.output) {
+    let alpha = if args.optimal_alpha {
+        match ac.optimal_alpha() {
+            Some(a) => {
+                common::print_stdout(&format!("optimal alpha {a:?}\n"))?;
+                Some(a)
+            }
+            None => {
+                return Err(CliError::in_file(
+                    &args.input,
+                    "no tetrahedra (the points are coplanar or collinear): no optimal alpha",
+                ))
+            }
+        }
+    } else {
+        args.alpha
+    };
+    let Some(alpha) = alpha else {
+        return Ok(());
+    };
+    if args.output.is_none() && args.png.is_none() {
+        return Ok(());
+    }
+    let (faces, edges) = if args.surface {
+        (ac.regular_surface(alpha), Vec::new())
+    } else {
         let faces: Vec<[u32; 3]> = ac.triangles_at(alpha).collect();
         // Edges of F_alpha that bound no triangle of F_alpha.
         let mut in_tri: Vec<[u32; 2]> = faces
@@ -105,19 +163,33 @@ pub fn run(args: &AlphaArgs, timings: &mut Timings) -> Result<(), CliError> {
             .edges_at(alpha)
             .filter(|e| in_tri.binary_search(e).is_err())
             .collect();
+        (faces, edges)
+    };
+    if let Some(path) = &args.output {
         let mesh = Mesh {
             edges: &edges,
             faces: &faces,
             ..Mesh::new(&cloud.points)
         };
         common::write_mesh(path, &mesh, timings)?;
-        common::info(format_args!(
-            "alpha {alpha}: {} triangles, {} dangling edges -> {}",
-            faces.len(),
-            edges.len(),
-            path.display()
-        ));
     }
+    if let Some(path) = &args.png {
+        let png = timings.phase("picture", || {
+            crate::picture::shape_png(&cloud.points, &faces, &edges)
+        })?;
+        common::write_output(path, timings, |w| w.write_all(&png))?;
+    }
+    let what = if args.surface {
+        format!("{} boundary triangles", faces.len())
+    } else {
+        format!("{} triangles, {} dangling edges", faces.len(), edges.len())
+    };
+    let dest: Vec<String> = [&args.output, &args.png]
+        .into_iter()
+        .flatten()
+        .map(|p| p.display().to_string())
+        .collect();
+    common::info(format_args!("alpha {alpha}: {what} -> {}", dest.join(", ")));
     Ok(())
 }
 

@@ -22,6 +22,10 @@ pub struct DelaunayArgs {
     /// Output file of tetrahedra
     #[arg(long, value_name = "OUT")]
     pub tets: PathBuf,
+    #[command(flatten)]
+    pub input_format: crate::FormatArgs,
+    #[command(flatten)]
+    pub common: crate::CommonArgs,
 }
 
 /// Runs `delaunay`: input is read (and its errors reported) before anything else.

@@ -116,6 +116,16 @@ pub struct DetectArgs {
     /// structures and their parts (planes, outlines, segments, NFA)
     #[arg(long, value_name = "OUT.json")]
     pub report: Option<PathBuf>,
+    /// Write an interactive 3D view of the result (one self-contained HTML file)
+    #[arg(long, value_name = "OUT.html")]
+    pub html: Option<PathBuf>,
+    /// Write a picture of the result (PNG, fixed view)
+    #[arg(long, value_name = "OUT.png")]
+    pub png: Option<PathBuf>,
+    #[command(flatten)]
+    pub input_format: crate::FormatArgs,
+    #[command(flatten)]
+    pub common: crate::CommonArgs,
 }
 
 /// The orientation sampler.
@@ -200,6 +210,7 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
     let parts_path = pick(&args.part_labels, "parts.txt");
     let output_path = pick(&args.output, "structures.ply");
     let report_path = pick(&args.report, "report.json");
+    let html_path = pick(&args.html, "view.html");
     let scene_path = example.then(|| dir.join("scene.xyz"));
     if example {
         std::fs::create_dir_all(&dir)
@@ -234,6 +245,8 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
             ("--union", args.union.as_deref()),
             ("--report", report_path.as_deref()),
             ("(scene)", scene_path.as_deref()),
+            ("--html", html_path.as_deref()),
+            ("--png", args.png.as_deref()),
         ],
     )?;
     let (cloud, truth, name) = match &args.input {
@@ -370,17 +383,31 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
         r["timings"] = timings.to_value();
         common::write_json(p, &r, timings)?;
     }
+    if let Some(p) = &html_path {
+        crate::view::write_html(
+            p,
+            &name,
+            &points,
+            &det.labels,
+            &part_labels,
+            &report,
+            timings,
+        )?;
+    }
+    if let Some(p) = &args.png {
+        crate::picture::write_detection_png(p, &points, &det, &part_labels, timings)?;
+    }
     let mut out = summary(&name, &det, &detector, &report, seconds);
     if let Some(ev) = &scores {
         out.push_str(&format!("\nAgainst the scene's ground truth:\n{ev}\n"));
     }
     if example {
         out.push_str(&format!(
-            "\nWrote {}: scene.xyz (x y z label part), labels.txt, parts.txt, structures.ply, report.json\n",
+            "\nWrote {}: scene.xyz (x y z label part), labels.txt, parts.txt, structures.ply, report.json, view.html\n",
             dir.display()
         ));
     }
-    common::print_stdout(&out)
+    common::print_summary(&out)
 }
 
 /// Point insertions above which a run is announced as long: at roughly a

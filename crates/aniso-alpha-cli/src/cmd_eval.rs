@@ -1,4 +1,4 @@
-//! `aniso-alpha eval`: scores of a detection against ground truth (SPEC §6).
+//! `aniso-alpha eval`: scores of a detection against ground truth (docs/method.md §6).
 
 use std::path::PathBuf;
 
@@ -15,7 +15,7 @@ use crate::common::{self, CliError, Timings};
     after_help = "TRUTH is a point file with labels: text `x y z label` (label column set by \
 --label-column), PLY with a `structure` vertex property, PCD with a `label` field, LAS \
 classification. LABELS has one integer per line, as written by `detect --labels`.\n\n\
-Scores (SPEC §6): per-point precision, recall and F1 of structure vs background, and \
+Scores (docs/method.md §6): per-point precision, recall and F1 of structure vs background, and \
 structures found (one detected structure holds at least half of a true structure's points, \
 and most of its own points are that structure's).\n\n\
 Examples:\n  aniso-alpha eval --truth scene.xyz --labels labels.txt --json\n  \
@@ -45,6 +45,10 @@ pub struct EvalArgs {
     /// `none` [default: 0,1,7,18: never classified, unclassified, noise]
     #[arg(long, value_name = "C1,C2,...", value_parser = common::parse_classes)]
     pub background_classes: Option<aniso_alpha::io::ClassSet>,
+    #[command(flatten)]
+    pub input_format: crate::FormatArgs,
+    #[command(flatten)]
+    pub common: crate::QuietArgs,
 }
 
 /// Runs `eval`.

@@ -64,6 +64,8 @@ pub struct SynthArgs {
     /// Also write the facet id of each point as a 5th column (polyhedron)
     #[arg(long)]
     pub parts: bool,
+    #[command(flatten)]
+    pub common: crate::QuietArgs,
 }
 
 /// Runs `synth`.

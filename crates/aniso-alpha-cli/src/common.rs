@@ -88,6 +88,22 @@ pub fn info(message: impl fmt::Display) {
     }
 }
 
+static SILENT: AtomicBool = AtomicBool::new(false);
+
+/// Sets `--quiet` as the user gave it (not implied by `--timings`): the
+/// summaries on stdout are silenced too.
+pub fn set_silent(silent: bool) {
+    SILENT.store(silent, Ordering::Relaxed);
+}
+
+/// Writes a summary (e.g. `detect`'s table) to stdout, unless `--quiet`.
+pub fn print_summary(text: &str) -> Result<(), CliError> {
+    if SILENT.load(Ordering::Relaxed) {
+        return Ok(());
+    }
+    print_stdout(text)
+}
+
 /// Writes `text` to stdout; a closed pipe (`| head`) is not an error.
 pub fn print_stdout(text: &str) -> Result<(), CliError> {
     let mut out = std::io::stdout().lock();

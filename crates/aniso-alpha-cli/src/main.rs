@@ -10,7 +10,10 @@ mod cmd_delaunay;
 mod cmd_detect;
 mod cmd_eval;
 mod cmd_synth;
+mod cmd_view;
 mod common;
+mod picture;
+mod view;
 
 use std::num::NonZeroUsize;
 use std::process::ExitCode;
@@ -27,34 +30,66 @@ use common::{CliError, Timings};
 #[command(
     after_help = "Point files: .xyz .txt .csv .pts (text), .ply, .las/.laz, .pcd; `-` reads text from \
 standard input; --format overrides the extension.\n\
+Alpha is a radius throughout (CGAL's Alpha_shape_3 takes its square). The method: docs/method.md.\n\
 Errors exit with status 1 and one line on stderr; bad usage exits with 2.\n\n\
 Example:\n  aniso-alpha synth planes --seed 1 --output scene.xyz\n  \
 aniso-alpha detect scene.xyz --structure planes --alpha 1 --lambda3 8 --min-size 20 --labels labels.txt\n  \
 aniso-alpha eval --truth scene.xyz --labels labels.txt"
 )]
 struct Cli {
-    #[command(flatten)]
-    global: GlobalArgs,
     #[command(subcommand)]
     command: Command,
 }
 
-/// Options every subcommand accepts.
-#[derive(Debug, Args)]
-struct GlobalArgs {
+/// The options of the subcommands that compute (`delaunay`, `alpha`,
+/// `detect`), listed under their own heading in `--help`.
+#[derive(Debug, Clone, Copy, Args)]
+#[command(next_help_heading = "Common options")]
+pub struct CommonArgs {
     /// Worker threads (default: all cores)
-    #[arg(long, global = true, value_name = "N")]
-    threads: Option<NonZeroUsize>,
-    /// No progress bars or informational messages
-    #[arg(long, global = true)]
-    quiet: bool,
+    #[arg(long, value_name = "N")]
+    pub threads: Option<NonZeroUsize>,
+    /// No progress bars, messages or summary: nothing but errors, the files
+    /// asked for, and a value asked for on stdout (alpha --optimal-alpha)
+    #[arg(long)]
+    pub quiet: bool,
     /// Print the wall time of each phase (seconds) as one JSON object on stderr
-    #[arg(long, global = true)]
-    timings: bool,
+    #[arg(long)]
+    pub timings: bool,
+}
+
+/// The common options of the subcommands that run on one thread (`synth`,
+/// `eval`, `view`): [`CommonArgs`] without `--threads`.
+#[derive(Debug, Clone, Copy, Args)]
+#[command(next_help_heading = "Common options")]
+pub struct QuietArgs {
+    /// No progress bars or messages (results asked for on stdout, such as
+    /// eval's scores, still print)
+    #[arg(long)]
+    pub quiet: bool,
+    /// Print the wall time of each phase (seconds) as one JSON object on stderr
+    #[arg(long)]
+    pub timings: bool,
+}
+
+/// The input format option of the subcommands that read a point file.
+#[derive(Debug, Clone, Copy, Args)]
+#[command(next_help_heading = "Common options")]
+pub struct FormatArgs {
     /// Input format, overriding the extension: xyz, ply, las, laz, pcd
     /// (an INPUT of `-` is standard input, text unless --format says otherwise)
-    #[arg(long, global = true, value_name = "FMT", value_parser = common::parse_format)]
-    format: Option<aniso_alpha::io::Format>,
+    #[arg(long, value_name = "FMT", value_parser = common::parse_format)]
+    pub format: Option<aniso_alpha::io::Format>,
+}
+
+impl From<QuietArgs> for CommonArgs {
+    fn from(q: QuietArgs) -> Self {
+        CommonArgs {
+            threads: None,
+            quiet: q.quiet,
+            timings: q.timings,
+        }
+    }
 }
 
 #[derive(Debug, Subcommand)]
@@ -69,6 +104,34 @@ enum Command {
     Synth(cmd_synth::SynthArgs),
     /// Score detected labels against ground truth
     Eval(cmd_eval::EvalArgs),
+    /// Write an interactive 3D view (one self-contained HTML file) of a
+    /// point cloud and its structures
+    View(cmd_view::ViewArgs),
+}
+
+impl Command {
+    /// `--format`, for the subcommands that read a point file.
+    fn format(&self) -> Option<aniso_alpha::io::Format> {
+        match self {
+            Command::Delaunay(a) => a.input_format.format,
+            Command::Alpha(a) => a.input_format.format,
+            Command::Detect(a) => a.input_format.format,
+            Command::Eval(a) => a.input_format.format,
+            Command::View(a) => a.input_format.format,
+            Command::Synth(_) => None,
+        }
+    }
+
+    fn common(&self) -> CommonArgs {
+        match self {
+            Command::Delaunay(a) => a.common,
+            Command::Alpha(a) => a.common,
+            Command::Detect(a) => a.common,
+            Command::Synth(a) => a.common.into(),
+            Command::Eval(a) => a.common.into(),
+            Command::View(a) => a.common.into(),
+        }
+    }
 }
 
 /// Last resort: a panic is a bug, reported as one line, exit status 1.
@@ -96,9 +159,11 @@ fn install_panic_hook() {
 fn run(cli: Cli) -> Result<(), CliError> {
     // With --timings, stderr carries exactly one JSON object for scripts:
     // no informational lines around it.
-    common::set_quiet(cli.global.quiet || cli.global.timings);
-    common::set_format(cli.global.format);
-    if let Some(n) = cli.global.threads {
+    let global = cli.command.common();
+    common::set_quiet(global.quiet || global.timings);
+    common::set_silent(global.quiet);
+    common::set_format(cli.command.format());
+    if let Some(n) = global.threads {
         rayon::ThreadPoolBuilder::new()
             .num_threads(n.get())
             .build_global()
@@ -111,8 +176,9 @@ fn run(cli: Cli) -> Result<(), CliError> {
         Command::Detect(a) => cmd_detect::run(a, &mut timings)?,
         Command::Synth(a) => cmd_synth::run(a, &mut timings)?,
         Command::Eval(a) => cmd_eval::run(a, &mut timings)?,
+        Command::View(a) => cmd_view::run(a, &mut timings)?,
     }
-    if cli.global.timings {
+    if global.timings {
         eprintln!("{}", timings.to_json());
     }
     Ok(())
@@ -139,6 +205,42 @@ mod tests {
     #[test]
     fn cli_is_consistent() {
         Cli::command().debug_assert();
+    }
+
+    /// The help cites the method page that is in the repository, groups
+    /// the common options, and says what α is.
+    #[test]
+    fn help_is_grouped_and_cites_what_exists() {
+        let mut cmd = Cli::command();
+        cmd.build();
+        for sub in cmd.get_subcommands_mut() {
+            let name = sub.get_name().to_string();
+            if name == "help" {
+                continue;
+            }
+            let help = sub.render_long_help().to_string();
+            assert!(!help.contains("SPEC"), "{name}");
+            let common = help
+                .find("Common options:")
+                .unwrap_or_else(|| panic!("{name}"));
+            // Every common option is listed under that heading, after the
+            // subcommand's own options.
+            for opt in ["--quiet", "--timings"] {
+                assert!(help[common..].contains(opt), "{name} {opt}");
+                assert!(
+                    !help[..common].contains(&format!("      {opt}")),
+                    "{name} {opt}"
+                );
+            }
+            let threads = matches!(name.as_str(), "delaunay" | "alpha" | "detect");
+            assert_eq!(help.contains("--threads"), threads, "{name}");
+            if matches!(name.as_str(), "alpha" | "detect") {
+                assert!(help.contains("radius") && help.contains("square"), "{name}");
+            }
+        }
+        assert!(std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../docs/method.md")
+            .is_file());
     }
 
     #[test]

@@ -233,6 +233,27 @@ fn bad_usage_exits_2() {
         let o = Command::new(BIN).args(args).output().unwrap();
         assert_eq!(o.status.code(), Some(2), "{args:?}");
     }
+    // `alpha --alpha A` alone asks for an output of the shape, nothing else.
+    let o = Command::new(BIN)
+        .args(["alpha", "in.xyz", "--alpha", "1"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    let missing = err.lines().nth(1).unwrap_or_default();
+    assert!(
+        missing.contains("--output") && missing.contains("--png"),
+        "{err}"
+    );
+    assert!(!missing.contains("--intervals"), "{err}");
+    // No --threads where it would do nothing.
+    for sub in ["synth", "eval", "view"] {
+        let o = Command::new(BIN)
+            .args([sub, "--threads", "2", "--help"])
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{sub} --threads");
+    }
     let o = Command::new(BIN)
         .args(["delaunay", "--help"])
         .output()

@@ -314,13 +314,15 @@ fn synth_detect_eval_chain() {
         serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     assert_eq!(r["orientations"], 162);
     assert!(r["structures"].as_array().unwrap().len() >= 5);
-    assert_eq!(r["structures"][0]["primitive"]["type"], "line");
-    assert!(r["structures"][0]["primitive"]["rms_residual"]
-        .as_f64()
-        .is_some());
+    // The report of SPEC §7 / docs/method.md §7: a line's part is a segment.
+    assert_eq!(r["structures"][0]["kind"], "line");
+    assert!(r["structures"][0]["rms"].as_f64().is_some());
+    let part = &r["structures"][0]["parts"][0];
+    assert_eq!(part["segment"].as_array().map(Vec::len), Some(2));
+    assert!(part["rms"].as_f64().is_some());
     assert!(r["timings"]["read"].as_f64().is_some());
     assert!(r["timings"]["detect"].as_f64().is_some());
-    assert_eq!(r["parameters"]["min_size"], 4);
+    assert_eq!(r["parameters"]["min_size"]["value"], 4.0);
     let o = ok(&[
         "eval",
         "--truth",
@@ -337,7 +339,7 @@ fn synth_detect_eval_chain() {
 #[test]
 fn detect_without_input_runs_the_example() {
     let dir = TempDir::new("example");
-    let o = run_in(Some(&dir.0), &["detect", "--quiet"]);
+    let o = run_in(Some(&dir.0), &["detect"]);
     assert_eq!(
         o.status.code(),
         Some(0),
@@ -353,6 +355,7 @@ fn detect_without_input_runs_the_example() {
         "parts.txt",
         "structures.ply",
         "report.json",
+        "view.html",
     ] {
         assert!(dir.0.join("aniso-alpha-example").join(f).exists(), "{f}");
     }
@@ -400,4 +403,118 @@ fn bad_parameters_are_clean_errors() {
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert_eq!(err.lines().count(), 1, "{err}");
     assert!(err.contains("s.xyz") && err.contains("min-size"), "{err}");
+}
+
+fn ply_count(p: &Path, element: &str) -> Option<usize> {
+    let bytes = std::fs::read(p).unwrap();
+    let header = String::from_utf8_lossy(&bytes[..bytes.len().min(2048)]).to_string();
+    header
+        .lines()
+        .take_while(|l| *l != "end_header")
+        .find_map(|l| l.strip_prefix(&format!("element {element} ")))
+        .map(|n| n.trim().parse().unwrap())
+}
+
+/// `alpha --optimal-alpha` prints the library's optimal alpha; `--surface`
+/// writes exactly the regular triangles, and no edges.
+#[test]
+fn alpha_optimal_and_boundary_surface() {
+    use aniso_alpha::alpha::AlphaComplex;
+    let input = fixture("random_500.xyz");
+    let pts = aniso_alpha::io::read_points(&input, &Default::default())
+        .unwrap()
+        .points;
+    let ac = AlphaComplex::from_points(&pts).unwrap();
+    let want = ac.optimal_alpha().unwrap();
+    let o = ok(&["alpha", input.to_str().unwrap(), "--optimal-alpha"]);
+    assert_eq!(
+        String::from_utf8_lossy(&o.stdout),
+        format!("optimal alpha {want:?}\n")
+    );
+    let dir = TempDir::new("surface");
+    let (all, surf) = (dir.path("all.ply"), dir.path("surf.ply"));
+    ok(&[
+        "alpha",
+        input.to_str().unwrap(),
+        "--optimal-alpha",
+        "--surface",
+        "--output",
+        surf.to_str().unwrap(),
+    ]);
+    ok(&[
+        "alpha",
+        input.to_str().unwrap(),
+        "--alpha",
+        &format!("{want:?}"),
+        "--output",
+        all.to_str().unwrap(),
+    ]);
+    let n_surface = ac.regular_surface(want).len();
+    assert!(n_surface > 0);
+    assert_eq!(ply_count(&surf, "face"), Some(n_surface));
+    assert!(matches!(ply_count(&surf, "edge"), None | Some(0)));
+    // F_alpha holds the boundary and more (interior singular triangles).
+    assert_eq!(ply_count(&all, "face"), Some(ac.triangles_at(want).count()));
+    assert!(ply_count(&all, "face").unwrap() >= n_surface);
+}
+
+/// --quiet means quiet: no messages, no progress, no summary; only what
+/// was asked for as the result (eval's scores) still prints.
+#[test]
+fn quiet_means_quiet() {
+    let dir = TempDir::new("quiet");
+    let silent = |args: &[&str]| {
+        let o = run_in(Some(&dir.0), args);
+        assert_eq!(o.status.code(), Some(0), "{args:?}");
+        assert!(
+            o.stdout.is_empty() && o.stderr.is_empty(),
+            "{args:?}: {o:?}"
+        );
+    };
+    silent(&[
+        "synth", "lines", "--seed", "4", "--output", "l.xyz", "--quiet",
+    ]);
+    silent(&[
+        "detect",
+        "l.xyz",
+        "--structure",
+        "lines",
+        "--alpha",
+        "1",
+        "--lambda3",
+        "10",
+        "--min-size",
+        "4",
+        "--labels",
+        "labels.txt",
+        "--quiet",
+    ]);
+    silent(&["view", "l.xyz", "--output", "v.html", "--quiet"]);
+    silent(&["delaunay", "l.xyz", "--tets", "t.tets", "--quiet"]);
+    let o = ok(&[
+        "eval",
+        "--truth",
+        dir.path("l.xyz").to_str().unwrap(),
+        "--labels",
+        dir.path("labels.txt").to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(String::from_utf8_lossy(&o.stdout).contains("F1"));
+    // Without --quiet, detect prints its summary.
+    let o = run_in(
+        Some(&dir.0),
+        &[
+            "detect",
+            "l.xyz",
+            "--structure",
+            "lines",
+            "--alpha",
+            "1",
+            "--lambda3",
+            "10",
+            "--min-size",
+            "4",
+        ],
+    );
+    assert!(String::from_utf8_lossy(&o.stdout).contains("structure(s)"));
 }

@@ -2,6 +2,9 @@
 //!
 //! `cargo run --release --example triangulate -- uniform 1000000`
 //! `cargo run --release --example triangulate -- grid 50`
+//! `cargo run --release --example triangulate -- line 100000` (also
+//! `decimal_line N`, `dups31 N`: the degenerate series of
+//! `scripts/bench_degenerate.py`)
 //! `cargo run --release --example triangulate -- points.bin` (raw little-endian f64 triples)
 //! Add `--threads N` for the parallel build, `--validate` to check the result.
 mod common;

@@ -1,4 +1,4 @@
-//! Anisotropy: the linear map Q = diag(e) · R of the paper (SPEC §2, §4).
+//! Anisotropy: the linear map Q = diag(e) · R of the paper (docs/method.md §2, §4).
 //!
 //! An [`Anisotropy`] is an orientation R (a proper rotation, rows = the axes of
 //! the ellipsoidal ball) and an elongation E = (e₁, e₂, e₃) with e_i > 0 and
@@ -34,8 +34,11 @@
 
 use std::fmt;
 
-/// A 3×3 matrix stored as rows.
-pub type Mat3 = [[f64; 3]; 3];
+// The linear algebra lives in `geometry`; these names stay importable from
+// here for the modules that used them (`detect`, `synth`).
+pub(crate) use crate::geometry::{cross, dot, norm, normalize};
+pub use crate::geometry::{det3, mat_mul, Mat3};
+use crate::geometry::{q_matrix, transform_point, transform_points};
 
 /// Tolerance on orthonormality and on det(R) − 1 of a user-given rotation.
 pub const ROTATION_TOLERANCE: f64 = 1e-9;
@@ -146,55 +149,6 @@ pub fn rotation_from_euler(theta: f64, psi: f64, phi: f64) -> Mat3 {
         c
     };
     fma_mul(&fma_mul(&rz, &rx), &ry)
-}
-
-/// Matrix product a · b, each entry `(a_i0·b_0j + a_i1·b_1j) + a_i2·b_2j`.
-pub fn mat_mul(a: &Mat3, b: &Mat3) -> Mat3 {
-    let mut c = [[0.0; 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            c[i][j] = a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j];
-        }
-    }
-    c
-}
-
-/// Determinant of a 3×3 matrix.
-pub fn det3(m: &Mat3) -> f64 {
-    m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
-}
-
-pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-pub(crate) fn norm(a: [f64; 3]) -> f64 {
-    dot(a, a).sqrt()
-}
-
-/// `a / |a|`, or `None` if `a` is zero or not finite.
-pub(crate) fn normalize(a: [f64; 3]) -> Option<[f64; 3]> {
-    if !a.iter().all(|x| x.is_finite()) {
-        return None;
-    }
-    // Scale first so that huge/tiny vectors do not overflow/underflow.
-    let m = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-    if m == 0.0 {
-        return None;
-    }
-    let b = [a[0] / m, a[1] / m, a[2] / m];
-    let n = norm(b);
-    Some([b[0] / n, b[1] / n, b[2] / n])
 }
 
 /// A proper rotation whose third row is the unit vector `u`: rows
@@ -381,49 +335,28 @@ impl Anisotropy {
         ]
     }
 
-    /// Q = diag(e) · R: Q_ij = e_i · R_ij (one rounding per entry).
+    /// Q = diag(e) · R: Q_ij = e_i · R_ij (one rounding per entry, see
+    /// [`q_matrix`]).
     pub fn q(&self) -> Mat3 {
-        let mut q = [[0.0; 3]; 3];
-        for (i, row) in q.iter_mut().enumerate() {
-            for (j, x) in row.iter_mut().enumerate() {
-                *x = self.elongation[i] * self.rotation[i][j];
-            }
-        }
-        q
+        q_matrix(&self.rotation, &self.elongation)
     }
 
     /// Q·p for one point: q_i = (Q_i1·x + Q_i2·y) + Q_i3·z, each operation
     /// rounded to f64 in exactly that order, no fused multiply-add (this is
     /// the convention of the CGAL fixtures, reproduced bit for bit).
     pub fn transform_point(&self, p: [f64; 3]) -> [f64; 3] {
-        apply_q(&self.q(), p)
+        transform_point(&self.q(), p)
     }
 
     /// Q·p for every point (see [`Self::transform_point`]).
     pub fn transform(&self, points: &[[f64; 3]]) -> Vec<[f64; 3]> {
-        let q = self.q();
-        points.iter().map(|&p| apply_q(&q, p)).collect()
+        transform_points(&self.q(), points)
     }
 
     /// d_Q(p, q) = |Q(p − q)|.
     pub fn distance(&self, p: [f64; 3], q: [f64; 3]) -> f64 {
         norm(self.transform_point([p[0] - q[0], p[1] - q[1], p[2] - q[2]]))
     }
-}
-
-#[inline]
-fn apply_q(q: &Mat3, p: [f64; 3]) -> [f64; 3] {
-    let mut out = [0.0; 3];
-    for (o, row) in out.iter_mut().zip(q.iter()) {
-        // Separate statements: Rust never contracts a*b + c into an FMA
-        // unless asked (`mul_add`), and we do not ask.
-        let a = row[0] * p[0];
-        let b = row[1] * p[1];
-        let s = a + b;
-        let c = row[2] * p[2];
-        *o = s + c;
-    }
-    out
 }
 
 #[cfg(test)]

@@ -1,4 +1,4 @@
-//! Detection scores (SPEC §6): per-point precision / recall / F1 of
+//! Detection scores (docs/method.md §6): per-point precision / recall / F1 of
 //! "structure vs background", and per-structure (and per-part) matches.
 //!
 //! Labels are `i64` per point: a structure id ≥ 0, or background (−1; any

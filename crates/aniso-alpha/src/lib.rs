@@ -6,8 +6,9 @@
 //!
 //! The crate is layered (see `ARCHITECTURE.md`):
 //!
-//! * [`geometry`]: exact, filtered predicates with the symbolic perturbation
-//!   that CGAL uses, and circumsphere constructions;
+//! * [`geometry`]: exact, filtered predicates (returning a [`Sign`](geometry::Sign))
+//!   with the symbolic perturbation that CGAL uses, circumsphere
+//!   constructions, and the small linear algebra the crate shares;
 //! * [`delaunay`]: the triangulation (flat `u32` arrays, bulk construction,
 //!   queries, `validate()`);
 //! * [`io`]: point file readers (text, PLY, LAS/LAZ, PCD), atomic writers
@@ -21,8 +22,11 @@
 //! * [`alpha`]: alpha-shape intervals of edges and triangles, `F_α`, the
 //!   α-shape surface, and the anisotropic complex of `Q·P`;
 //!
+//! The main types are at the root: [`Triangulation`], [`AlphaComplex`],
+//! [`read_points`].
+//!
 //! ```
-//! use aniso_alpha::delaunay::Triangulation;
+//! use aniso_alpha::Triangulation;
 //! let pts = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0, 1.0]];
 //! let tri = Triangulation::new(&pts).unwrap();
 //! assert_eq!(tri.dimension(), 3);
@@ -30,7 +34,7 @@
 //! tri.validate().unwrap();
 //! ```
 // `unsafe` is denied everywhere but in the Delaunay build: one
-// cache-prefetch hint (`delaunay::build::prefetch`) and the two calls into
+// cache-prefetch hint (`delaunay::cell::prefetch`) and the two calls into
 // the x86-64-v3 copies of the hot loops, made after run-time feature
 // detection (`delaunay::isa`), each documented and tested where it is.
 #![deny(unsafe_code)]
@@ -48,4 +52,9 @@ pub mod geometry;
 pub mod io;
 #[cfg(feature = "json")]
 pub mod report;
+pub mod rng;
 pub mod synth;
+
+pub use alpha::AlphaComplex;
+pub use delaunay::{DelaunayError, Triangulation};
+pub use io::read_points;

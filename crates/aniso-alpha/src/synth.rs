@@ -1,5 +1,5 @@
 //! Deterministic benchmark scenes in the spirit of the paper's figures
-//! (SPEC §5), with ground truth.
+//! (docs/method.md §5), with ground truth.
 //!
 //! A [`Scene`] is a point set with, for every point, the id of its true
 //! structure (or −1 for background) and, for polyhedra, the id of its facet
@@ -27,11 +27,11 @@
 //!
 //! **Background** density: `background_per_ellipsoid` expected points per
 //! α-ellipsoid volume V = (4/3)π·α³·λ₁λ₂λ₃ (41.9 for lines, 134 for planes),
-//! default **0.01**, the density at which SPEC §5 measured lines to be
+//! default **0.01**, the density at which docs/method.md §5 measured lines to be
 //! found. The background box side is S = (N_bg · V / 0.01)^{1/3}: 184.5 for
 //! the lines scene, 126 for planes, 220 for the polyhedron. For lines the
 //! mean background nearest-neighbour distance is then
-//! 0.554·ρ^{−1/3} = 8.9 ≈ 1.28 d (SPEC: ≳ 1.25 d).
+//! 0.554·ρ^{−1/3} = 8.9 ≈ 1.28 d (docs/method.md §5: ≳ 1.25 d).
 //!
 //! **Planes** (Fig. 5: 120 points on 3 planes, 150 background;
 //! Fig. 10: a 190-point polyhedral surface, 800 background; λ₂ = 4,
@@ -62,7 +62,7 @@
 //! # Measured with the method layer
 //!
 //! `tests/lines_pipeline_bruteforce.rs` and
-//! `tests/planes_pipeline_bruteforce.rs` run the SPEC §4 loop on these
+//! `tests/planes_pipeline_bruteforce.rs` run the docs/method.md §4 loop on these
 //! scenes with a brute-force F_{k,α,Q} (no Delaunay), the box sampler, the
 //! path filter per orientation, the union, the component clean-up, the
 //! largest-structure labelling and [`crate::eval`]:
@@ -80,7 +80,7 @@
 //! | polyhedron (2, 3) | 0.03 | 0.94, 0.96 | |
 //! | polyhedron (2, 3) | 0.1 | 0.84, 0.84 | |
 //!
-//! (SPEC §5's reference: lines F1 ≈ 0.9 at 0.01, collapsing at 3×; planes
+//! (docs/method.md §5: lines F1 ≈ 0.9 at 0.01, collapsing at 3×; planes
 //! ≈ 0.83 at 10×.) Background points that touch a structure are what
 //! costs precision; recall is 1.0 (or one point short) in all these runs.
 //!

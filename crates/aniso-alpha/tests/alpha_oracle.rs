@@ -36,7 +36,7 @@ fn point(r: &mut Rng, kind: u64) -> [f64; 3] {
 
 #[test]
 fn edge_predicate_matches_exact_oracle() {
-    let mut r = Rng(11);
+    let mut r = Rng::new(11);
     let mut signs = [0usize; 3];
     for it in 0..20000 {
         let kind = it % 5;
@@ -48,7 +48,7 @@ fn edge_predicate_matches_exact_oracle() {
             p = [a[0], b[1], p[2]];
         }
         let want = oracle_edge(&a, &b, &p);
-        let got = edge_diametral_side(&a, &b, &p);
+        let got = edge_diametral_side(&a, &b, &p).to_i32();
         assert_eq!(got, want, "a={a:?} b={b:?} p={p:?}");
         signs[(want + 1) as usize] += 1;
     }
@@ -58,7 +58,7 @@ fn edge_predicate_matches_exact_oracle() {
 
 #[test]
 fn triangle_predicate_matches_exact_oracle() {
-    let mut r = Rng(12);
+    let mut r = Rng::new(12);
     let mut signs = [0usize; 3];
     let mut tested = 0;
     for it in 0..20000 {
@@ -74,7 +74,7 @@ fn triangle_predicate_matches_exact_oracle() {
         }
         let p = point(&mut r, kind);
         let want = oracle_triangle(&a, &b, &c, &p);
-        let got = triangle_diametral_side(&a, &b, &c, &p);
+        let got = triangle_diametral_side(&a, &b, &c, &p).to_i32();
         assert_eq!(got, want, "a={a:?} b={b:?} c={c:?} p={p:?}");
         signs[(want + 1) as usize] += 1;
         tested += 1;
@@ -118,7 +118,7 @@ fn brute_force_empty_balls() {
         let n = 20 + 4 * seed as usize;
         let pts = random_points(1000 + seed, n);
         let ac = AlphaComplex::from_points(&pts).unwrap();
-        let mut r = Rng(seed);
+        let mut r = Rng::new(seed);
         let alphas = alpha_samples(&ac, &mut r);
         assert!(alphas.len() > 50);
         for &alpha in &alphas {

@@ -4,20 +4,7 @@
 mod alpha_common;
 use alpha_common::*;
 use aniso_alpha::alpha::AlphaComplex;
-
-fn sub(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
+use aniso_alpha::geometry::{cross, dot, sub};
 
 /// The cube's 8 corners and its centre: at a large α the surface is the 12
 /// hull triangles, each with its normal pointing away from the centre.
@@ -35,13 +22,13 @@ fn cube_surface_is_the_hull_oriented_outward() {
     for t in &surf {
         assert!(t.iter().all(|&v| v < 8), "the centre is not on the surface");
         let [a, b, c] = t.map(|v| pts[v as usize]);
-        let n = cross(&sub(&b, &a), &sub(&c, &a));
+        let n = cross(sub(b, a), sub(c, a));
         let g = [
             (a[0] + b[0] + c[0]) / 3.0,
             (a[1] + b[1] + c[1]) / 3.0,
             (a[2] + b[2] + c[2]) / 3.0,
         ];
-        assert!(dot(&n, &sub(&g, &centre)) > 0.0, "{t:?} points inward");
+        assert!(dot(n, sub(g, centre)) > 0.0, "{t:?} points inward");
     }
     // Every tet has the centre and a half face: circumradius of
     // (centre, 3 corners of a face) — below it there is no solid at all.
@@ -71,8 +58,8 @@ fn single_tet_orientation() {
     let g = [0.25, 0.25, 0.25];
     for t in surf {
         let [a, b, c] = t.map(|v| pts[v as usize]);
-        let n = cross(&sub(&b, &a), &sub(&c, &a));
-        assert!(dot(&n, &sub(&a, &g)) > 0.0);
+        let n = cross(sub(b, a), sub(c, a));
+        assert!(dot(n, sub(a, g)) > 0.0);
     }
 }
 

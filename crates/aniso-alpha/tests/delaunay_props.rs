@@ -7,7 +7,7 @@
 
 mod common;
 use aniso_alpha::delaunay::Triangulation;
-use aniso_alpha::geometry::predicates::{insphere_perturbed, orient3d};
+use aniso_alpha::geometry::predicates::{insphere_perturbed, orient3d, Sign};
 use common::{canonical_sorted, Rng};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
@@ -42,7 +42,7 @@ fn affine_dim(pts: &[[f64; 3]]) -> usize {
     else {
         return 1;
     };
-    if pts.iter().any(|p| orient3d(&a, b, c, p) != 0) {
+    if pts.iter().any(|p| orient3d(&a, b, c, p) != Sign::Zero) {
         3
     } else {
         2
@@ -79,7 +79,7 @@ fn shuffled(mut v: Vec<[f64; 3]>, rng: &mut Rng) -> Vec<[f64; 3]> {
 fn uniform_random() {
     runner(40)
         .run(&(any::<u64>(), 4usize..400), |(seed, n)| {
-            let pts = points(&mut Rng(seed), n);
+            let pts = points(&mut Rng::new(seed), n);
             let tri = check_valid(&pts);
             prop_assert_eq!(tri.dimension(), 3);
             prop_assert_eq!(tri.num_vertices(), n);
@@ -94,7 +94,7 @@ fn clustered() {
         .run(
             &(any::<u64>(), 1usize..6, 10usize..120),
             |(seed, k, per)| {
-                let mut rng = Rng(seed);
+                let mut rng = Rng::new(seed);
                 let mut pts = Vec::new();
                 for _ in 0..k {
                     let c = [
@@ -122,7 +122,7 @@ fn clustered() {
 fn integer_grids() {
     // n³ grids in random order: 8 cospherical points per cube, coplanar hull.
     for n in 2..=7 {
-        let pts = shuffled(grid(n), &mut Rng(n as u64));
+        let pts = shuffled(grid(n), &mut Rng::new(n as u64));
         let tri = check_valid(&pts);
         assert_eq!(tri.dimension(), 3);
         // CGAL's perturbed triangulation of a grid has 6 tets per cube
@@ -135,7 +135,7 @@ fn integer_grids() {
 fn grid_under_random_affine_map() {
     runner(25)
         .run(&(any::<u64>(), 2usize..6), |(seed, n)| {
-            let mut rng = Rng(seed);
+            let mut rng = Rng::new(seed);
             let m: Vec<f64> = (0..9).map(|_| rng.uniform() * 2.0 - 1.0).collect();
             let t = [rng.uniform() * 10.0, rng.uniform(), -rng.uniform()];
             let pts: Vec<[f64; 3]> = grid(n)
@@ -167,7 +167,7 @@ fn dyadic_affine_grids_stay_degenerate() {
     .iter()
     .enumerate()
     {
-        let pts: Vec<[f64; 3]> = shuffled(grid(5), &mut Rng(k as u64))
+        let pts: Vec<[f64; 3]> = shuffled(grid(5), &mut Rng::new(k as u64))
             .iter()
             .map(|p| {
                 [
@@ -195,7 +195,7 @@ fn points_on_a_sphere() {
                 }
             }
         }
-        let pts = shuffled(pts, &mut Rng(r as u64));
+        let pts = shuffled(pts, &mut Rng::new(r as u64));
         let tri = check_valid(&pts);
         // Every point is on the hull.
         let mut on_hull = vec![false; tri.num_vertices()];
@@ -209,7 +209,7 @@ fn points_on_a_sphere() {
     // Floating-point points near a sphere (not exactly cospherical).
     runner(20)
         .run(&(any::<u64>(), 5usize..300), |(seed, n)| {
-            let mut rng = Rng(seed);
+            let mut rng = Rng::new(seed);
             let pts: Vec<[f64; 3]> = (0..n)
                 .map(|_| {
                     let z = 2.0 * rng.uniform() - 1.0;
@@ -232,7 +232,7 @@ fn stacked_cocircular_planes() {
         .run(
             &(any::<u64>(), 2usize..6, 3usize..9),
             |(seed, layers, k)| {
-                let mut rng = Rng(seed);
+                let mut rng = Rng::new(seed);
                 let mut pts = Vec::new();
                 for l in 0..layers {
                     // square k x k grid layer (exactly cocircular squares)
@@ -262,7 +262,7 @@ fn duplicates_merge() {
         .run(
             &(any::<u64>(), 1usize..80, 1usize..4),
             |(seed, n, copies)| {
-                let mut rng = Rng(seed);
+                let mut rng = Rng::new(seed);
                 let base = points(&mut rng, n);
                 let mut pts = Vec::new();
                 for _ in 0..copies {
@@ -301,7 +301,7 @@ fn signed_zeros_are_one_point() {
 fn coplanar_and_collinear_have_lower_dimension() {
     runner(40)
         .run(&(any::<u64>(), 1usize..60), |(seed, n)| {
-            let mut rng = Rng(seed);
+            let mut rng = Rng::new(seed);
             // coplanar: integer points in the plane z = x + 2y
             let plane: Vec<[f64; 3]> = (0..n)
                 .map(|_| {
@@ -335,7 +335,7 @@ fn coplanar_and_collinear_have_lower_dimension() {
 fn four_points() {
     runner(60)
         .run(&any::<u64>(), |seed| {
-            let pts = points(&mut Rng(seed), 4);
+            let pts = points(&mut Rng::new(seed), 4);
             let tri = check_valid(&pts);
             prop_assert_eq!(tri.num_finite_tets(), 1);
             prop_assert_eq!(tri.hull_facets().count(), 4);
@@ -354,12 +354,12 @@ fn extreme_scales_and_offsets() {
         (1e-12, 1.0),
     ] {
         // Random points and a grid at that scale and offset.
-        let pts: Vec<[f64; 3]> = points(&mut Rng(5), 300)
+        let pts: Vec<[f64; 3]> = points(&mut Rng::new(5), 300)
             .iter()
             .map(|p| p.map(|c| offset + scale * c))
             .collect();
         check_valid(&pts);
-        let g: Vec<[f64; 3]> = shuffled(grid(5), &mut Rng(6))
+        let g: Vec<[f64; 3]> = shuffled(grid(5), &mut Rng::new(6))
             .iter()
             .map(|p| p.map(|c| offset + scale * c))
             .collect();
@@ -380,11 +380,14 @@ fn result_does_not_depend_on_input_order() {
     // The perturbation depends only on coordinates, so any permutation of
     // the input gives the same tets (this is what makes CGAL's output
     // unique too).
-    for (k, base) in [grid(4), points(&mut Rng(9), 200)].into_iter().enumerate() {
+    for (k, base) in [grid(4), points(&mut Rng::new(9), 200)]
+        .into_iter()
+        .enumerate()
+    {
         let tri = check_valid(&base);
         let reference = canonical_sorted(tri.finite_tets_input());
         for s in 0..3 {
-            let mut rng = Rng(100 * k as u64 + s);
+            let mut rng = Rng::new(100 * k as u64 + s);
             let mut perm: Vec<usize> = (0..base.len()).collect();
             for i in (1..perm.len()).rev() {
                 let j = (rng.next_u64() % (i as u64 + 1)) as usize;
@@ -412,17 +415,17 @@ fn brute_force(pts: &[[f64; 3]]) -> Vec<[u32; 4]> {
                 for d in c + 1..n {
                     let mut t = [a, b, c, d];
                     let o = orient3d(&pts[a], &pts[b], &pts[c], &pts[d]);
-                    if o == 0 {
+                    if o == Sign::Zero {
                         continue;
                     }
-                    if o < 0 {
+                    if o == Sign::Negative {
                         t.swap(0, 1);
                     }
                     let empty = (0..n).all(|e| {
                         t.contains(&e)
                             || insphere_perturbed(
                                 &pts[t[0]], &pts[t[1]], &pts[t[2]], &pts[t[3]], &pts[e],
-                            ) < 0
+                            ) == Sign::Negative
                     });
                     if empty {
                         out.push(t.map(|x| x as u32));
@@ -440,10 +443,10 @@ fn brute_force_oracle_small_sets() {
     // predicates with the engine.
     let mut cases: Vec<Vec<[f64; 3]>> = Vec::new();
     for s in 0..30 {
-        cases.push(points(&mut Rng(s), 6 + (s as usize % 9)));
+        cases.push(points(&mut Rng::new(s), 6 + (s as usize % 9)));
     }
     cases.push(grid(2));
-    cases.push(shuffled(grid(3)[..14].to_vec(), &mut Rng(1)));
+    cases.push(shuffled(grid(3)[..14].to_vec(), &mut Rng::new(1)));
     // cocircular square + apexes
     cases.push(vec![
         [0.0, 0.0, 0.0],
@@ -456,7 +459,7 @@ fn brute_force_oracle_small_sets() {
     ]);
     // small grid subsets with random integer points
     for s in 0..20 {
-        let mut rng = Rng(1000 + s);
+        let mut rng = Rng::new(1000 + s);
         let pts: Vec<[f64; 3]> = (0..10)
             .map(|_| {
                 [
@@ -488,7 +491,7 @@ fn coordinates_outside_the_exact_range_are_refused() {
     use aniso_alpha::delaunay::{DelaunayError, COORD_RANGE};
     // Overflow (1e200) or underflow (1e-300) would make the predicates
     // silently inexact: typed error naming the point.
-    let mut pts = points(&mut Rng(1), 20);
+    let mut pts = points(&mut Rng::new(1), 20);
     pts[7][1] = 1e200;
     assert!(matches!(
         Triangulation::new(&pts),
@@ -498,7 +501,7 @@ fn coordinates_outside_the_exact_range_are_refused() {
             ..
         })
     ));
-    let tiny: Vec<[f64; 3]> = points(&mut Rng(2), 20)
+    let tiny: Vec<[f64; 3]> = points(&mut Rng::new(2), 20)
         .iter()
         .map(|p| p.map(|c| c * 1e-300))
         .collect();
@@ -507,7 +510,7 @@ fn coordinates_outside_the_exact_range_are_refused() {
         Err(DelaunayError::OutOfRange { .. })
     ));
     // The ends of the range, and zero, are fine.
-    let mut edge = points(&mut Rng(3), 20);
+    let mut edge = points(&mut Rng::new(3), 20);
     edge[0] = [COORD_RANGE.1, 0.0, 0.0];
     edge[1] = [COORD_RANGE.0, 0.0, -0.0];
     check_valid(&edge);
@@ -518,7 +521,10 @@ fn coordinates_outside_the_exact_range_are_refused() {
 #[test]
 fn triangle_and_hull_orientations() {
     use aniso_alpha::delaunay::INFINITE;
-    for pts in [points(&mut Rng(11), 200), shuffled(grid(4), &mut Rng(12))] {
+    for pts in [
+        points(&mut Rng::new(11), 200),
+        shuffled(grid(4), &mut Rng::new(12)),
+    ] {
         let tri = check_valid(&pts);
         let mut n = 0;
         for t in tri.triangles() {
@@ -527,7 +533,7 @@ fn triangle_and_hull_orientations() {
             let [a, b, d] = t.vertices.map(|v| *tri.point(v));
             if apex != INFINITE {
                 // The normal points into sides[0]: towards its apex.
-                assert_eq!(orient3d(&a, &b, &d, tri.point(apex)), 1);
+                assert_eq!(orient3d(&a, &b, &d, tri.point(apex)), Sign::Positive);
             }
             n += 1;
         }
@@ -536,7 +542,7 @@ fn triangle_and_hull_orientations() {
         for f in tri.hull_facets() {
             let [a, b, c] = f.map(|v| *tri.point(v));
             for v in 0..tri.num_vertices() as u32 {
-                assert!(orient3d(&a, &b, &c, tri.point(v)) <= 0);
+                assert!(orient3d(&a, &b, &c, tri.point(v)) <= Sign::Zero);
             }
         }
     }

@@ -1,5 +1,5 @@
 //! End-to-end detection on the synthetic scenes with the paper's
-//! parameters (SPEC §5), scored as in SPEC §6.
+//! parameters (docs/method.md §5), scored as in docs/method.md §6.
 
 use aniso_alpha::detect::detector::{Detection, Detector};
 use aniso_alpha::eval::{evaluate, Evaluation};

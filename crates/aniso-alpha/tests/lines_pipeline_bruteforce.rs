@@ -2,7 +2,7 @@
 //! (Fig. 12), without the Delaunay engine: F_{1,α,Q}(P) is computed by brute
 //! force (an edge is exposed when some ball of radius α through its two
 //! transformed endpoints is empty of the other transformed points), then
-//! the SPEC §4 loop runs with the real sampler, path filter, union,
+//! the docs/method.md §4 loop runs with the real sampler, path filter, union,
 //! component clean-up, labelling and scores.
 //!
 //! This validates the scale choices of `synth` (step d = 7, background
@@ -166,11 +166,11 @@ fn arcs() {
     assert!(!arcs_leave_gap(&mut [(6.0, 3.0), (2.0, 4.5)]));
 }
 
-fn run_lines(seed: u64, density: f64) -> (f64, usize, usize) {
+pub(crate) fn run_lines(seed: u64, density: f64) -> (f64, usize, usize) {
     run_lines_with(seed, density, &Sampler::default())
 }
 
-fn run_lines_with(seed: u64, density: f64, sampler: &Sampler) -> (f64, usize, usize) {
+pub(crate) fn run_lines_with(seed: u64, density: f64, sampler: &Sampler) -> (f64, usize, usize) {
     run_scene(
         SceneOptions::lines()
             .seed(seed)
@@ -241,41 +241,6 @@ fn lines_scene_is_detected_at_paper_parameters() {
     let mean = f1s.iter().sum::<f64>() / f1s.len() as f64;
     eprintln!("mean F1 {mean:.3} over {f1s:?}");
     assert!(mean > 0.8, "{f1s:?}");
-}
-
-#[test]
-#[ignore = "slow-ish density sweep; run with --ignored --nocapture"]
-fn lines_density_sweep() {
-    for density in [0.005, 0.01, 0.02, 0.03, 0.05] {
-        let mut f1 = 0.0;
-        for seed in 1..=3 {
-            f1 += run_lines(seed, density).0;
-        }
-        eprintln!("SWEEP density {density}: mean F1 {:.3}", f1 / 3.0);
-    }
-}
-
-#[test]
-#[ignore = "sampler comparison; --ignored --nocapture"]
-fn lines_sampler_comparison() {
-    for (name, sampler) in [
-        ("box m1=0.3", Sampler::default()),
-        ("fibonacci 10deg", Sampler::Fibonacci { step_degrees: 10.0 }),
-        ("fibonacci 14deg", Sampler::Fibonacci { step_degrees: 14.0 }),
-    ] {
-        for density in [0.01, 0.02] {
-            let (mut f1, mut found) = (0.0, 0);
-            for seed in 1..=3 {
-                let r = run_lines_with(seed, density, &sampler);
-                f1 += r.0;
-                found += r.1;
-            }
-            eprintln!(
-                "COMPARE lines {name} density {density}: mean F1 {:.3}, found {found}/15",
-                f1 / 3.0
-            );
-        }
-    }
 }
 
 #[test]

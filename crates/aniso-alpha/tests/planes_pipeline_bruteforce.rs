@@ -3,7 +3,7 @@
 //! F_{2,α,Q}(P) is computed by brute force (a triangle of circumradius
 //! R ≤ α is exposed when one of the two balls of radius α through its
 //! transformed vertices, centred at circumcentre ± √(α² − R²)·normal, is
-//! empty of the other transformed points). Then the SPEC §4 loop runs with
+//! empty of the other transformed points). Then the docs/method.md §4 loop runs with
 //! the box sampler (1,944 orientations), the path filter per orientation,
 //! the union, the component clean-up, labelling and scores.
 
@@ -125,11 +125,11 @@ fn exposed_triangles(q: &[[f64; 3]], alpha: f64) -> Vec<[u32; 3]> {
     tris
 }
 
-fn run(opts: SceneOptions, name: &str) -> Evaluation {
+pub(crate) fn run(opts: SceneOptions, name: &str) -> Evaluation {
     run_with(opts, name, &Sampler::default(), false)
 }
 
-fn run_with(opts: SceneOptions, name: &str, sampler: &Sampler, l23: bool) -> Evaluation {
+pub(crate) fn run_with(opts: SceneOptions, name: &str, sampler: &Sampler, l23: bool) -> Evaluation {
     let opts_crossing = name.contains("crossing");
     let scene = opts.generate().unwrap();
     let p = opts.paper_params();
@@ -206,73 +206,6 @@ fn crossing_planes_are_split_into_two() {
         "planes crossing seed 1",
     );
     assert_eq!(ev.structures_found, 3);
-}
-
-#[test]
-#[ignore = "slow: more seeds and denser backgrounds; --ignored --nocapture"]
-fn planes_sweep() {
-    for density in [0.01, 0.03, 0.1] {
-        for seed in 2..=3 {
-            let ev = run(
-                SceneOptions::planes()
-                    .seed(seed)
-                    .background_per_ellipsoid(density),
-                "planes",
-            );
-            eprintln!(
-                "SWEEP planes density {density} seed {seed}: F1 {:.3}",
-                ev.f1
-            );
-            let ev = run(
-                SceneOptions::polyhedron()
-                    .seed(seed)
-                    .background_per_ellipsoid(density),
-                "polyhedron",
-            );
-            eprintln!(
-                "SWEEP polyhedron density {density} seed {seed}: F1 {:.3}",
-                ev.f1
-            );
-        }
-    }
-}
-
-#[test]
-#[ignore = "sampler comparison; --ignored --nocapture"]
-fn planes_sampler_comparison() {
-    for (name, sampler) in [
-        ("box m1=0.3 m2=12", Sampler::default()),
-        ("fibonacci 10deg", Sampler::Fibonacci { step_degrees: 10.0 }),
-        ("fibonacci 15deg", Sampler::Fibonacci { step_degrees: 15.0 }),
-    ] {
-        for density in [0.01, 0.1] {
-            let mut f1 = 0.0;
-            for seed in 1..=2 {
-                f1 += run_with(
-                    SceneOptions::planes()
-                        .seed(seed)
-                        .background_per_ellipsoid(density),
-                    "planes",
-                    &sampler,
-                    false,
-                )
-                .f1;
-                f1 += run_with(
-                    SceneOptions::polyhedron()
-                        .seed(seed)
-                        .background_per_ellipsoid(density),
-                    "polyhedron",
-                    &sampler,
-                    false,
-                )
-                .f1;
-            }
-            eprintln!(
-                "COMPARE planes+polyhedron {name} density {density}: mean F1 {:.3}",
-                f1 / 4.0
-            );
-        }
-    }
 }
 
 /// The engine's anisotropic α-shape (Delaunay of Q·P, exact intervals,

@@ -21,20 +21,21 @@
 //!   a polynomial of degree 6 in the coordinate differences, with
 //!   `|u × v|² = |u|²|v|² − (u·v)²` (Lagrange).
 
-use crate::geometry::Point3;
+use crate::geometry::{Point3, Sign};
 
-/// Sign of `(p − a)·(p − b)`: `-1` when `p` is strictly inside the ball
-/// with diameter `ab`, `0` on its sphere, `1` outside.
+/// Sign of `(p − a)·(p − b)`: negative when `p` is strictly inside the
+/// ball with diameter `ab`, zero on its sphere, positive outside.
 ///
 /// ```
 /// use aniso_alpha::alpha::exact::edge_diametral_side;
+/// use aniso_alpha::geometry::Sign;
 /// let (a, b) = ([0.0, 0.0, 0.0], [2.0, 0.0, 0.0]);
-/// assert_eq!(edge_diametral_side(&a, &b, &[1.0, 0.5, 0.0]), -1);
-/// assert_eq!(edge_diametral_side(&a, &b, &[1.0, 1.0, 0.0]), 0);
-/// assert_eq!(edge_diametral_side(&a, &b, &[1.0, 1.5, 0.0]), 1);
+/// assert_eq!(edge_diametral_side(&a, &b, &[1.0, 0.5, 0.0]), Sign::Negative);
+/// assert_eq!(edge_diametral_side(&a, &b, &[1.0, 1.0, 0.0]), Sign::Zero);
+/// assert_eq!(edge_diametral_side(&a, &b, &[1.0, 1.5, 0.0]), Sign::Positive);
 /// ```
 #[inline]
-pub fn edge_diametral_side(a: &Point3, b: &Point3, p: &Point3) -> i32 {
+pub fn edge_diametral_side(a: &Point3, b: &Point3, p: &Point3) -> Sign {
     let mut d = 0.0;
     let mut m = 0.0;
     for k in 0..3 {
@@ -47,28 +48,29 @@ pub fn edge_diametral_side(a: &Point3, b: &Point3, p: &Point3) -> i32 {
     // 2e-15 ≈ 9ε leaves margin for the rounding of m itself.
     let eps = 2e-15 * m;
     if d > eps {
-        return 1;
+        return Sign::Positive;
     }
     if -d > eps {
-        return -1;
+        return Sign::Negative;
     }
-    edge_exact(a, b, p)
+    Sign::of_i32(edge_exact(a, b, p))
 }
 
-/// Sign of `D` (see the module docs): `-1` when `p` is strictly inside the
-/// smallest circumsphere (diametral sphere) of the non-degenerate triangle
-/// `abc`, `0` on it, `1` outside.
+/// Sign of `D` (see the module docs): negative when `p` is strictly inside
+/// the smallest circumsphere (diametral sphere) of the non-degenerate
+/// triangle `abc`, zero on it, positive outside.
 ///
 /// ```
 /// use aniso_alpha::alpha::exact::triangle_diametral_side;
+/// use aniso_alpha::geometry::Sign;
 /// let (a, b, c) = ([0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]);
 /// // Circumcentre (1, 1, 0), radius √2.
-/// assert_eq!(triangle_diametral_side(&a, &b, &c, &[1.0, 1.0, 1.0]), -1);
-/// assert_eq!(triangle_diametral_side(&a, &b, &c, &[2.0, 2.0, 0.0]), 0);
-/// assert_eq!(triangle_diametral_side(&a, &b, &c, &[1.0, 1.0, 2.0]), 1);
+/// assert_eq!(triangle_diametral_side(&a, &b, &c, &[1.0, 1.0, 1.0]), Sign::Negative);
+/// assert_eq!(triangle_diametral_side(&a, &b, &c, &[2.0, 2.0, 0.0]), Sign::Zero);
+/// assert_eq!(triangle_diametral_side(&a, &b, &c, &[1.0, 1.0, 2.0]), Sign::Positive);
 /// ```
 #[inline]
-pub fn triangle_diametral_side(a: &Point3, b: &Point3, c: &Point3, p: &Point3) -> i32 {
+pub fn triangle_diametral_side(a: &Point3, b: &Point3, c: &Point3, p: &Point3) -> Sign {
     let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
     let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
     let w = [p[0] - a[0], p[1] - a[1], p[2] - a[2]];
@@ -99,13 +101,15 @@ pub fn triangle_diametral_side(a: &Point3, b: &Point3, c: &Point3, p: &Point3) -
     let eps = 5.8e-13 * (m2 * m2 * m2);
     if (f64::MIN_POSITIVE..f64::MAX).contains(&eps) {
         if d > eps {
-            return 1;
+            return Sign::Positive;
         }
         if -d > eps {
-            return -1;
+            return Sign::Negative;
         }
     }
-    triangle_filter(&u, &v, &w, uu, vv, ww, d).unwrap_or_else(|| triangle_exact(a, b, c, p))
+    Sign::of_i32(
+        triangle_filter(&u, &v, &w, uu, vv, ww, d).unwrap_or_else(|| triangle_exact(a, b, c, p)),
+    )
 }
 
 /// The filter of [`triangle_diametral_side`]: `Some(sign)` when the f64
@@ -232,17 +236,17 @@ pub(crate) fn cell_radius2_and_mask(p: [&Point3; 4]) -> (f64, u8) {
         (3, d3, [a, b, c, d]),
     ] {
         let s = if ok && dv > eps {
-            1
+            Sign::Positive
         } else if ok && -dv > eps {
-            -1
+            Sign::Negative
         } else {
             triangle_diametral_side(f[0], f[1], f[2], f[3])
         };
-        if s < 0 {
+        if s.is_negative() {
             mask |= 1 << i;
         }
     }
-    if triangle_diametral_side(b, d, c, a) < 0 {
+    if triangle_diametral_side(b, d, c, a).is_negative() {
         mask |= 1;
     }
     let r2 = radius2_from(p, &f);
@@ -573,15 +577,9 @@ mod tests {
     /// tets.
     #[test]
     fn cell_mask_matches_per_face_tests() {
-        const FACE: [[usize; 3]; 4] = [[1, 3, 2], [0, 2, 3], [0, 3, 1], [0, 1, 2]];
-        let mut s = 7u64;
-        let mut rnd = || {
-            s = s.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = s;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-        };
+        use crate::delaunay::FACE;
+        let mut rng = crate::rng::SplitMix64::new(7);
+        let mut rnd = || rng.uniform();
         let mut set = 0;
         for it in 0..20000 {
             let p: [Point3; 4] = std::array::from_fn(|_| {
@@ -596,12 +594,13 @@ mod tests {
                 }
             });
             // positively oriented, non-flat tets only
-            if crate::geometry::predicates::orient3d(&p[0], &p[1], &p[2], &p[3]) <= 0 {
+            if crate::geometry::predicates::orient3d(&p[0], &p[1], &p[2], &p[3]) <= Sign::Zero {
                 continue;
             }
             let (_, m) = cell_radius2_and_mask([&p[0], &p[1], &p[2], &p[3]]);
             for (i, f) in FACE.iter().enumerate() {
-                let want = triangle_diametral_side(&p[f[0]], &p[f[1]], &p[f[2]], &p[i]) < 0;
+                let want =
+                    triangle_diametral_side(&p[f[0]], &p[f[1]], &p[f[2]], &p[i]).is_negative();
                 assert_eq!((m >> i) & 1 == 1, want, "{p:?} face {i}");
                 set += want as usize;
             }
@@ -616,9 +615,9 @@ mod tests {
         let a = [0.1, 0.2, 0.3];
         let b = [0.1 + 4.0, 0.2, 0.3];
         assert_eq!(edge_exact(&a, &b, &a), 0);
-        assert_eq!(edge_diametral_side(&a, &b, &b), 0);
+        assert_eq!(edge_diametral_side(&a, &b, &b), Sign::Zero);
         let c = [0.1, 0.2 + 3.0, 0.3];
         assert_eq!(triangle_exact(&a, &b, &c, &a), 0);
-        assert_eq!(triangle_diametral_side(&a, &b, &c, &c), 0);
+        assert_eq!(triangle_diametral_side(&a, &b, &c, &c), Sign::Zero);
     }
 }

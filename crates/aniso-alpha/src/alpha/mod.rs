@@ -1,5 +1,5 @@
 //! Alpha-shape intervals, Euclidean and anisotropic alpha-shapes
-//! (SPEC §1–§2).
+//! (docs/method.md §1–§2).
 //!
 //! [`AlphaComplex`] takes a Delaunay [`Triangulation`] and computes, for
 //! every finite edge and triangle σ, the interval `[α_min(σ), α_max(σ)]` of
@@ -88,18 +88,15 @@
 
 pub mod exact;
 
-use crate::delaunay::{DelaunayError, Triangulation, INFINITE};
-use crate::geometry::Point3;
+use crate::delaunay::{DelaunayError, Triangulation, VertexId, EDGES as PAIRS, FACE, INFINITE};
+use crate::geometry::{transform_points, Point3};
 
-/// Faces: for local vertex `i`, the other three local indices in an order
-/// that makes `(f[0], f[1], f[2], i)` an even permutation of `(0, 1, 2, 3)`,
-/// so that face `i` of a positively oriented tet has its normal (right-hand
-/// rule) pointing towards vertex `i`, i.e. into the tet.
-const FACE: [[usize; 3]; 4] = [[1, 3, 2], [0, 2, 3], [0, 3, 1], [0, 1, 2]];
+/// `Q = diag(e)·R` from a rotation and an elongation (the one definition
+/// is [`crate::geometry::q_matrix`]).
+pub use crate::geometry::q_matrix;
+
 /// A cell's vertices and `(neighbour, mirror index)` per face.
 type GatheredCell = ([u32; 4], [(u32, usize); 4]);
-/// The 6 edges of a tet as local index pairs.
-const PAIRS: [[usize; 2]; 6] = [[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]];
 
 /// An edge of the triangulation with its alpha interval, vertices given as
 /// input indices (ascending).
@@ -225,7 +222,7 @@ impl AlphaComplex {
         Ok(Self::new(Triangulation::new(points)?))
     }
 
-    /// The anisotropic complex of SPEC §2: transforms every point by the
+    /// The anisotropic complex of docs/method.md §2: transforms every point by the
     /// matrix `Q` given by its rows `q_rows` (`Q = diag(e)·R`, see
     /// [`q_matrix`]), triangulates `Q·P` and computes its intervals. Since
     /// `d_Q(p, q) = |Qp − Qq|`, the result's `F_α` is the anisotropic
@@ -256,7 +253,7 @@ impl AlphaComplex {
     /// As [`Triangulation::new`] (a non-finite coordinate after the
     /// transform is reported at its input index).
     pub fn anisotropic(points: &[[f64; 3]], q_rows: &[[f64; 3]; 3]) -> Result<Self, DelaunayError> {
-        Self::from_points(&transform_points(points, q_rows))
+        Self::from_points(&transform_points(q_rows, points))
     }
 
     /// The triangulation the intervals refer to.
@@ -279,10 +276,18 @@ impl AlphaComplex {
         self.tri_face.len()
     }
 
-    /// Vertex ids `(a, b)`, `a < b`, of edge `e`.
+    /// Vertex ids `(a, b)`, `a < b`, of edge `e` (ids of the
+    /// triangulation's vertices, not input indices: see
+    /// [`Self::input_index`]).
     #[inline]
-    pub fn edge_vertices(&self, e: usize) -> [u32; 2] {
-        self.edge_v[e]
+    pub fn edge_vertices(&self, e: usize) -> [VertexId; 2] {
+        self.edge_v[e].map(VertexId)
+    }
+
+    /// The smallest input index of vertex `v`.
+    #[inline]
+    pub fn input_index(&self, v: VertexId) -> u32 {
+        self.tri.input_index(v.0)
     }
 
     /// `(α_min, α_max)` of edge `e`.
@@ -292,8 +297,8 @@ impl AlphaComplex {
     }
 
     /// The id of the edge between vertex ids `a` and `b`, if it exists.
-    pub fn find_edge(&self, a: u32, b: u32) -> Option<usize> {
-        let (a, b) = if a < b { (a, b) } else { (b, a) };
+    pub fn find_edge(&self, a: VertexId, b: VertexId) -> Option<usize> {
+        let (a, b) = (a.0.min(b.0), a.0.max(b.0));
         let s = *self.edge_start.get(a as usize)? as usize;
         let e = *self.edge_start.get(a as usize + 1)? as usize;
         self.edge_v[s..e]
@@ -305,7 +310,13 @@ impl AlphaComplex {
     /// Vertex ids of triangle `f`, ordered so that its normal (right-hand
     /// rule) points into the first of its two cells ([`Self::triangle_cells`]).
     #[inline]
-    pub fn triangle_vertices(&self, f: usize) -> [u32; 3] {
+    pub fn triangle_vertices(&self, f: usize) -> [VertexId; 3] {
+        self.triangle_vertex_ids(f).map(VertexId)
+    }
+
+    /// [`Self::triangle_vertices`] as plain ids.
+    #[inline]
+    fn triangle_vertex_ids(&self, f: usize) -> [u32; 3] {
         let p = self.tri_face[f];
         let (t, i) = (p >> 2, (p & 3) as usize);
         let v = self.tri.tet(t);
@@ -367,7 +378,7 @@ impl AlphaComplex {
     /// indices.
     pub fn triangles(&self) -> impl Iterator<Item = TriangleInterval> + '_ {
         (0..self.num_triangles()).map(move |f| TriangleInterval {
-            vertices: self.input3(self.triangle_vertices(f)),
+            vertices: self.input3(self.triangle_vertex_ids(f)),
             alpha_min: self.tri_iv[f][0],
             alpha_max: self.tri_iv[f][1],
         })
@@ -400,7 +411,7 @@ impl AlphaComplex {
     /// `F_{2,α}` as ascending input-index triples.
     pub fn triangles_at(&self, alpha: f64) -> impl Iterator<Item = [u32; 3]> + '_ {
         self.triangle_ids_at(alpha)
-            .map(move |f| self.input3(self.triangle_vertices(f)))
+            .map(move |f| self.input3(self.triangle_vertex_ids(f)))
     }
 
     /// The α spectrum: every distinct finite critical value, ascending —
@@ -443,7 +454,7 @@ impl AlphaComplex {
             if in_t == in_n {
                 continue;
             }
-            let [a, b, c] = self.triangle_vertices(f).map(|x| self.tri.input_index(x));
+            let [a, b, c] = self.triangle_vertex_ids(f).map(|x| self.tri.input_index(x));
             // The normal of (a, b, c) points into t.
             out.push(if in_t { [a, c, b] } else { [a, b, c] });
         }
@@ -700,7 +711,8 @@ impl TriangleCtx<'_> {
                         &pts[x as usize],
                         &pts[y as usize],
                         &pts[z as usize],
-                    ) < 0;
+                    )
+                    .is_negative();
                     refuted |= (inside as u8) << e;
                 }
                 out.push(TriangleOut {
@@ -906,25 +918,4 @@ pub(crate) fn triangle_rho_sorted(pts: &[Point3], mut f: [u32; 3]) -> f64 {
     f.sort_unstable();
     let [a, b, c] = f.map(|v| &pts[v as usize]);
     triangle_rho(a, b, c)
-}
-
-/// `Q = diag(e)·R`: row `i` of the rotation `r` scaled by `e[i]`
-/// (`Q_ij = e_i·R_ij`, one rounding each).
-///
-/// ```
-/// use aniso_alpha::alpha::q_matrix;
-/// let r = [[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]];
-/// assert_eq!(q_matrix(&r, &[2.0, 1.0, 0.5]), [[0.0, 2.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 0.5]]);
-/// ```
-pub fn q_matrix(rotation: &[[f64; 3]; 3], elongation: &[f64; 3]) -> [[f64; 3]; 3] {
-    std::array::from_fn(|i| rotation[i].map(|x| elongation[i] * x))
-}
-
-/// `q_i = (Q_i1·x + Q_i2·y) + Q_i3·z` for every point, each operation
-/// rounded in that order (no fused multiply-add).
-fn transform_points(points: &[[f64; 3]], q: &[[f64; 3]; 3]) -> Vec<[f64; 3]> {
-    points
-        .iter()
-        .map(|p| std::array::from_fn(|i| (q[i][0] * p[0] + q[i][1] * p[1]) + q[i][2] * p[2]))
-        .collect()
 }

@@ -26,21 +26,66 @@
 //! [`Triangulation::input_index`] and [`Triangulation::vertex_of_input`]
 //! translate to and from indices into the caller's slice.
 
+//! # Layout
+//!
+//! The tetrahedron structure is `cell` (cells, the face table [`FACE`],
+//! packed neighbours, flags, compaction); the build keeps its cells in a `store`
+//! (plain, or shared by threads); one insertion core (`insert`, with the
+//! cavity's scratch and linking in `cavity`) is used by the sequential and
+//! the parallel build alike (`sequential`, `parallel`); `build` checks the
+//! input, orders it (`order`), runs one of them and finishes the
+//! [`Triangulation`]. `queries` and `validate` only read it.
+
 mod build;
+mod cavity;
+mod cell;
+mod insert;
 mod isa;
 mod order;
 mod parallel;
 mod queries;
+mod sequential;
 mod store;
+#[cfg(test)]
+mod test_points;
 mod validate;
 
-pub use queries::{Edge, Triangle};
+pub(crate) use cell::EDGES;
+pub use cell::FACE;
+pub use queries::{Edge, EdgeRing, Triangle};
 pub use validate::ValidationError;
 
 use crate::geometry::Point3;
 
 /// The id of the infinite vertex.
 pub const INFINITE: u32 = u32::MAX;
+
+/// A vertex of a triangulation: an index into [`Triangulation::points`],
+/// in insertion order, as opposed to an index into the caller's input
+/// (duplicates share one vertex; [`Triangulation::input_index`] and
+/// [`Triangulation::vertex_of_input`] translate). The
+/// [`AlphaComplex`](crate::alpha::AlphaComplex) reports both kinds, and
+/// gives its vertex ids this type so that the two cannot be mixed up.
+///
+/// ```
+/// use aniso_alpha::AlphaComplex;
+/// // The first input point is a duplicate of the third.
+/// let pts = [[1.0, 1.0, 1.0], [0.0, 0.0, 0.0], [1.0, 1.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+/// let ac = AlphaComplex::from_points(&pts)?;
+/// let [a, b] = ac.edge_vertices(0);
+/// assert!(a < b);
+/// let tri = ac.triangulation();
+/// assert_eq!(tri.point(a.0), &pts[ac.input_index(a) as usize]);
+/// # Ok::<(), aniso_alpha::delaunay::DelaunayError>(())
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct VertexId(pub u32);
+
+impl From<VertexId> for u32 {
+    fn from(v: VertexId) -> u32 {
+        v.0
+    }
+}
 
 /// Error building a triangulation.
 #[derive(Debug, Clone, PartialEq)]
@@ -66,13 +111,25 @@ pub enum DelaunayError {
         /// The value found.
         value: f64,
     },
-    /// More points than the `u32` indices can address.
+    /// More points than the build accepts ([`MAX_POINTS`]).
     TooManyPoints(usize),
     /// The triangulation of this many points needs more than 2^30
     /// tetrahedra, the most the packed `u32` adjacency can address (uniform
     /// data reaches it near 150 million points).
     TooManyTets(usize),
 }
+
+/// The most points a triangulation accepts (duplicates included):
+/// 536,870,910 = 2^29 − 2, about 5.4e8.
+///
+/// Vertex ids are `u32`s that must stay below 2^31: the top bit of a cell's
+/// vertex word carries an insertion's flags, and the two largest values
+/// stand for the infinite vertex and for an unwritten cell. The build keeps
+/// a margin of a factor of 4 below that (`(2^32 − 3) / 8` points are
+/// refused). Points in general position reach the 2^30-tetrahedron limit
+/// ([`DelaunayError::TooManyTets`]) first, near 150 million points; the
+/// point limit matters for inputs with many duplicates or of low dimension.
+pub const MAX_POINTS: usize = (u32::MAX as usize - 2) / 8 - 1;
 
 /// The magnitudes a nonzero coordinate may have: `[COORD_RANGE.0,
 /// COORD_RANGE.1]` (zero is always fine). Within it, the products of the
@@ -110,7 +167,8 @@ impl std::fmt::Display for DelaunayError {
             DelaunayError::TooManyPoints(n) => {
                 write!(
                     f,
-                    "{n} points is more than this library can index (2^32 - 2)"
+                    "{n} points is more than this library can triangulate at once \
+                     (at most {MAX_POINTS}): split the data"
                 )
             }
             DelaunayError::TooManyTets(n) => write!(
@@ -152,7 +210,7 @@ pub struct Triangulation {
     /// Input index -> vertex id.
     input_vert: Vec<u32>,
     /// Tetrahedra: vertex ids and packed neighbours (`4 * tet + mirror`).
-    cells: Vec<build::Cell>,
+    cells: Vec<cell::Cell>,
     /// Number of finite tetrahedra.
     num_finite: usize,
     /// Vertex id -> one incident tetrahedron.

@@ -1,7 +1,7 @@
 //! Read-only queries: triangles, edges with their rings, hull facets,
 //! vertex stars, circumspheres.
 
-use super::build::FACE;
+use super::cell::{EDGES, FACE};
 use super::{Triangulation, INFINITE};
 use crate::geometry::circum;
 use crate::geometry::Point3;
@@ -80,8 +80,7 @@ impl Triangulation {
     pub fn edges(&self) -> impl Iterator<Item = Edge> + '_ {
         (0..self.cells.len() as u32).flat_map(move |t| {
             let v = self.cells[t as usize].v;
-            const PAIRS: [[usize; 2]; 6] = [[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]];
-            PAIRS.iter().filter_map(move |&[i, j]| {
+            EDGES.iter().filter_map(move |&[i, j]| {
                 if v[i] == INFINITE || v[j] == INFINITE {
                     return None;
                 }

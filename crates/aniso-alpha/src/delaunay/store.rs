@@ -2,14 +2,13 @@
 //! single-threaded build ([`Owned`]), or one array of atomic words shared by
 //! the threads of a parallel build ([`Shared`], see [`super::parallel`]).
 //!
-//! The insertion code ([`super::build`]) is generic over [`Store`], so the
+//! The insertion code ([`super::insert`]) is generic over [`Store`], so the
 //! single-threaded build compiles to plain loads and stores as before, and
 //! a parallel build runs the same code with two more checks: a tet is
 //! changed only by the thread that owns it, and an insertion that needs a
 //! tet this thread does not own is undone and done later.
 
-use super::build::Cell;
-use super::build::{CLEAR, IN_CONFLICT};
+use super::cell::{prefetch, Cell, CLEAR, FRESH, IN_CONFLICT};
 use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 
 /// Why an insertion stopped before it was complete.
@@ -61,12 +60,6 @@ pub(crate) trait Store {
     }
 }
 
-/// A new cell's contents: vertices not yet written, neighbours not linked.
-pub(crate) const FRESH: Cell = Cell {
-    v: [super::build::DEAD; 4],
-    n: [super::build::UNSET; 4],
-};
-
 /// The cells of a single-threaded build.
 pub(crate) struct Owned {
     pub(crate) cells: Vec<Cell>,
@@ -99,7 +92,7 @@ impl Store for Owned {
     }
     #[inline(always)]
     fn prefetch(&self, t: u32) {
-        super::build::prefetch(&self.cells, t as usize);
+        prefetch(&self.cells, t as usize);
     }
     #[inline(always)]
     fn owns(&self, _v: &[u32; 4]) -> bool {
@@ -204,6 +197,9 @@ pub(crate) struct Shared<'a> {
     pub(crate) me: u8,
     /// This thread's own cells.
     pub(crate) own: ThreadCells,
+    /// The cell this thread took last (with debug assertions only; the
+    /// one cell it may write before the cell holds its own vertices).
+    pub(crate) fresh: u32,
 }
 
 /// The cells a thread of a parallel build may take for new tets; it keeps
@@ -217,6 +213,13 @@ pub(crate) struct ThreadCells {
 }
 
 impl Shared<'_> {
+    /// Whether this thread may change tet `t` under the ownership rule: it
+    /// owns the tet, or just took its cell and has not written its
+    /// vertices yet (checked with debug assertions only).
+    fn may_write(&self, t: u32) -> bool {
+        t == self.fresh || self.owns(&self.cells[t as usize].load().v)
+    }
+
     /// The pieces of the vertices `v` (flags masked), or-ed.
     #[inline(always)]
     fn pieces(&self, v: &[u32; 4]) -> u8 {
@@ -241,10 +244,12 @@ impl Store for Shared<'_> {
     }
     #[inline(always)]
     fn set_n(&mut self, t: u32, i: usize, x: u32) {
+        debug_assert!(self.may_write(t), "tet {t} is not this thread's");
         self.cells[t as usize].0[4 + i].store(x, Relaxed);
     }
     #[inline(always)]
     fn update<R>(&mut self, t: u32, f: impl FnOnce(&mut Cell) -> R) -> R {
+        debug_assert!(self.may_write(t), "tet {t} is not this thread's");
         let cell = &self.cells[t as usize];
         let old = cell.load();
         let mut c = old;
@@ -261,7 +266,7 @@ impl Store for Shared<'_> {
     }
     #[inline(always)]
     fn prefetch(&self, t: u32) {
-        super::build::prefetch(self.cells, t as usize);
+        prefetch(self.cells, t as usize);
     }
     #[inline(always)]
     fn owns(&self, v: &[u32; 4]) -> bool {
@@ -275,14 +280,18 @@ impl Store for Shared<'_> {
     #[inline]
     fn alloc(&mut self) -> Result<u32, Stop> {
         let own = &mut self.own;
-        if let Some(t) = own.free.pop() {
-            Ok(t)
+        let t = if let Some(t) = own.free.pop() {
+            t
         } else if own.chunk.0 < own.chunk.1 {
             own.chunk.0 += 1;
-            Ok(own.chunk.0 as u32 - 1)
+            own.chunk.0 as u32 - 1
         } else {
-            Err(Stop::Busy)
+            return Err(Stop::Busy);
+        };
+        if cfg!(debug_assertions) {
+            self.fresh = t;
         }
+        Ok(t)
     }
     #[inline(always)]
     fn free_cells(&mut self) -> &mut Vec<u32> {

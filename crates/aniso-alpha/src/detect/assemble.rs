@@ -369,7 +369,11 @@ fn same_primitive(a: &Cand, b: &Cand, angle_deg: f64, points: &[[f64; 3]]) -> bo
     if a.fit.distance(&centroid(&b.fit)) <= a.tau && b.fit.distance(&centroid(&a.fit)) <= b.tau {
         return true;
     }
-    let (big, small) = if a.seeds.len() >= b.seeds.len() { (a, b) } else { (b, a) };
+    let (big, small) = if a.seeds.len() >= b.seeds.len() {
+        (a, b)
+    } else {
+        (b, a)
+    };
     let near = small
         .seeds
         .iter()

@@ -1,7 +1,7 @@
 //! The structure detector (paper §4.3, method doc §4): its parameters, and
-//! the run that chains the steps: the orientation scan ([`super::scan`]),
+//! the run that chains the steps: the orientation scan (`detect::scan`),
 //! the union and its clean-up, and the assembly of structures and parts
-//! ([`super::assemble`]).
+//! (`detect::assemble`).
 //!
 //! Parameters come from the user ([`Detector::lines`],
 //! [`Detector::planes`]) or from the data ([`Detector::auto`], method doc
@@ -336,7 +336,7 @@ impl<'a> Detector<'a> {
     }
 
     /// Cuts each orientation's points into tiles of this side (input
-    /// units) with halos (see [`super::scan`]): bounded memory, the same
+    /// units) with halos (see `detect::scan`): bounded memory, the same
     /// result.
     pub fn tile(mut self, side: Option<f64>) -> Self {
         self.tile = side;

@@ -105,10 +105,10 @@ fn triangle_gabriel(tri: &Triangulation, f: [u32; 3], apexes: [u32; 2]) -> bool 
     apexes
         .iter()
         .filter(|&&w| w != INFINITE)
-        .all(|&w| triangle_diametral_side(a, b, c, tri.point(w)) >= 0)
+        .all(|&w| !triangle_diametral_side(a, b, c, tri.point(w)).is_negative())
 }
 
-const FACE: [[usize; 3]; 4] = [[1, 3, 2], [0, 2, 3], [0, 3, 1], [0, 1, 2]];
+use crate::delaunay::FACE;
 
 /// Whether a triangle with these sides (tet, face) is in F_α. `r` are
 /// the tets' circumradii. Radii and the Gabriel test are computed exactly as
@@ -175,7 +175,7 @@ pub fn edges_at(tri: &Triangulation, alpha: f64) -> Vec<[u32; 2]> {
             tri.tet(t)
                 .iter()
                 .filter(|&&w| w != a && w != b && w != INFINITE)
-                .all(|&w| edge_diametral_side(pa, pb, tri.point(w)) >= 0)
+                .all(|&w| !edge_diametral_side(pa, pb, tri.point(w)).is_negative())
         });
         let inside = gabriel || {
             // α_min = min over incident triangles of their α_min: the

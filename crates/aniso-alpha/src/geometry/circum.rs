@@ -3,46 +3,29 @@
 //! These are floating-point constructions (not exact), computed relative to
 //! the first vertex for accuracy.
 
-use super::Point3;
-
-#[inline]
-fn sub(a: &Point3, b: &Point3) -> Point3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-#[inline]
-fn dot(a: &Point3, b: &Point3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-#[inline]
-fn cross(a: &Point3, b: &Point3) -> Point3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
+use super::{cross, dot, sub, Point3};
 
 /// Squared circumradius of the tetrahedron `abcd` and the circumcentre's
 /// offset from `a`. Returns infinite values for a flat tetrahedron.
 #[inline]
 pub fn tet_circum_offset(a: &Point3, b: &Point3, c: &Point3, d: &Point3) -> (Point3, f64) {
-    let u = sub(b, a);
-    let v = sub(c, a);
-    let w = sub(d, a);
-    let uu = dot(&u, &u);
-    let vv = dot(&v, &v);
-    let ww = dot(&w, &w);
-    let vw = cross(&v, &w);
-    let wu = cross(&w, &u);
-    let uv = cross(&u, &v);
-    let det = dot(&u, &vw);
+    let u = sub(*b, *a);
+    let v = sub(*c, *a);
+    let w = sub(*d, *a);
+    let uu = dot(u, u);
+    let vv = dot(v, v);
+    let ww = dot(w, w);
+    let vw = cross(v, w);
+    let wu = cross(w, u);
+    let uv = cross(u, v);
+    let det = dot(u, vw);
     let s = 0.5 / det;
     let o = [
         (uu * vw[0] + vv * wu[0] + ww * uv[0]) * s,
         (uu * vw[1] + vv * wu[1] + ww * uv[1]) * s,
         (uu * vw[2] + vv * wu[2] + ww * uv[2]) * s,
     ];
-    (o, dot(&o, &o))
+    (o, dot(o, o))
 }
 
 /// Circumcentre and circumradius of a tetrahedron.
@@ -61,22 +44,22 @@ pub fn tet_circumsphere(a: &Point3, b: &Point3, c: &Point3, d: &Point3) -> (Poin
 /// circumsphere) and the circumcentre's offset from `a`.
 #[inline]
 pub fn tri_circum_offset(a: &Point3, b: &Point3, c: &Point3) -> (Point3, f64) {
-    let u = sub(b, a);
-    let v = sub(c, a);
-    let n = cross(&u, &v);
-    let nn = dot(&n, &n);
-    let uu = dot(&u, &u);
-    let vv = dot(&v, &v);
+    let u = sub(*b, *a);
+    let v = sub(*c, *a);
+    let n = cross(u, v);
+    let nn = dot(n, n);
+    let uu = dot(u, u);
+    let vv = dot(v, v);
     // o = (|u|² (v × n) + |v|² (n × u)) / (2 |n|²)
-    let vn = cross(&v, &n);
-    let nu = cross(&n, &u);
+    let vn = cross(v, n);
+    let nu = cross(n, u);
     let s = 0.5 / nn;
     let o = [
         (uu * vn[0] + vv * nu[0]) * s,
         (uu * vn[1] + vv * nu[1]) * s,
         (uu * vn[2] + vv * nu[2]) * s,
     ];
-    (o, dot(&o, &o))
+    (o, dot(o, o))
 }
 
 /// Circumcentre and circumradius of a triangle (its smallest circumsphere).
@@ -99,9 +82,9 @@ pub fn tri_circumsphere(a: &Point3, b: &Point3, c: &Point3) -> (Point3, f64) {
 /// assert_eq!(edge_circumsphere(&[0.0, 0.0, 0.0], &[0.0, 0.0, 2.0]), ([0.0, 0.0, 1.0], 1.0));
 /// ```
 pub fn edge_circumsphere(a: &Point3, b: &Point3) -> (Point3, f64) {
-    let d = sub(b, a);
+    let d = sub(*b, *a);
     (
         [a[0] + 0.5 * d[0], a[1] + 0.5 * d[1], a[2] + 0.5 * d[2]],
-        0.5 * dot(&d, &d).sqrt(),
+        0.5 * dot(d, d).sqrt(),
     )
 }

@@ -1,13 +1,21 @@
 //! Geometry: exact predicates (with the symbolic perturbation that settles
-//! ties) and floating-point constructions (circumspheres).
+//! ties), floating-point constructions (circumspheres), and the small
+//! linear algebra the crate shares (vector helpers, [`Mat3`], the exact
+//! transform `Q·p`).
 //!
 //! Nothing here knows about triangulation topology.
 
 pub mod circum;
 pub mod kdtree;
+mod linear;
 pub mod predicates;
+mod wide;
 
-pub use predicates::Point3;
+pub use linear::{
+    add, cross, det3, dot, mat_mul, norm, normalize, q_matrix, scale, sub, transform_point,
+    transform_points, Mat3,
+};
+pub use predicates::{Point3, Sign};
 
 /// The axis-aligned bounding box `(lo, hi)` of `points`; for an empty slice
 /// `lo` is `+∞` and `hi` is `−∞` on every axis.

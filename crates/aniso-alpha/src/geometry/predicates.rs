@@ -17,10 +17,105 @@
 //! * [`insphere`]`(a, b, c, d, e)` is positive when `e` lies strictly inside
 //!   the circumsphere of the *positively oriented* tetrahedron `abcd`.
 
+use super::wide::{insphere_narrow_f, insphere_wide, orient3d_narrow_f, orient3d_wide};
 use robust::{Coord, Coord3D};
 
 /// A point in 3D.
 pub type Point3 = [f64; 3];
+
+/// The sign of a predicate's determinant, which every exact predicate of
+/// this module returns. Ordered `Negative < Zero < Positive`.
+///
+/// ```
+/// use aniso_alpha::geometry::Sign;
+/// assert_eq!(Sign::of(-0.5), Sign::Negative);
+/// assert_eq!(-Sign::Negative * Sign::Positive, Sign::Positive);
+/// assert!(Sign::Zero >= Sign::Negative);
+/// assert_eq!(Sign::Positive.to_i32(), 1);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[repr(i8)]
+pub enum Sign {
+    /// Negative.
+    Negative = -1,
+    /// Zero: the points are degenerate for this predicate (coplanar,
+    /// cospherical, on the circle, ...).
+    Zero = 0,
+    /// Positive.
+    Positive = 1,
+}
+
+impl Sign {
+    /// The sign of `x` (`Zero` for `±0`; `x` must not be NaN).
+    #[inline]
+    pub fn of(x: f64) -> Sign {
+        if x > 0.0 {
+            Sign::Positive
+        } else if x < 0.0 {
+            Sign::Negative
+        } else {
+            Sign::Zero
+        }
+    }
+
+    /// The sign of the integer `s`.
+    #[inline]
+    pub const fn of_i32(s: i32) -> Sign {
+        if s > 0 {
+            Sign::Positive
+        } else if s < 0 {
+            Sign::Negative
+        } else {
+            Sign::Zero
+        }
+    }
+
+    /// `1`, `0` or `-1`.
+    #[inline]
+    pub const fn to_i32(self) -> i32 {
+        self as i32
+    }
+
+    /// Whether the sign is [`Sign::Positive`].
+    #[inline]
+    pub const fn is_positive(self) -> bool {
+        matches!(self, Sign::Positive)
+    }
+
+    /// Whether the sign is [`Sign::Negative`].
+    #[inline]
+    pub const fn is_negative(self) -> bool {
+        matches!(self, Sign::Negative)
+    }
+
+    /// Whether the sign is [`Sign::Zero`].
+    #[inline]
+    pub const fn is_zero(self) -> bool {
+        matches!(self, Sign::Zero)
+    }
+}
+
+impl std::ops::Neg for Sign {
+    type Output = Sign;
+    #[inline]
+    fn neg(self) -> Sign {
+        Sign::of_i32(-self.to_i32())
+    }
+}
+
+impl std::ops::Mul for Sign {
+    type Output = Sign;
+    #[inline]
+    fn mul(self, other: Sign) -> Sign {
+        Sign::of_i32(self.to_i32() * other.to_i32())
+    }
+}
+
+impl From<Sign> for i32 {
+    fn from(s: Sign) -> i32 {
+        s.to_i32()
+    }
+}
 
 /// Exact difference `a − b` if it is representable, else `None`
 /// (Knuth's two-diff: the rounding error of the subtraction is zero).
@@ -243,15 +338,15 @@ fn insphere_det(d: &[f64; 12]) -> f64 {
 /// coplanar.
 ///
 /// ```
-/// use aniso_alpha::geometry::predicates::orient3d;
+/// use aniso_alpha::geometry::predicates::{orient3d, Sign};
 /// let o = [0.0, 0.0, 0.0];
-/// assert_eq!(orient3d(&o, &[1.0, 0.0, 0.0], &[0.0, 1.0, 0.0], &[0.0, 0.0, 1.0]), 1);
-/// assert_eq!(orient3d(&o, &[0.0, 1.0, 0.0], &[1.0, 0.0, 0.0], &[0.0, 0.0, 1.0]), -1);
-/// assert_eq!(orient3d(&o, &[1.0, 0.0, 0.0], &[0.0, 1.0, 0.0], &[1.0, 1.0, 0.0]), 0);
+/// assert_eq!(orient3d(&o, &[1.0, 0.0, 0.0], &[0.0, 1.0, 0.0], &[0.0, 0.0, 1.0]), Sign::Positive);
+/// assert_eq!(orient3d(&o, &[0.0, 1.0, 0.0], &[1.0, 0.0, 0.0], &[0.0, 0.0, 1.0]), Sign::Negative);
+/// assert_eq!(orient3d(&o, &[1.0, 0.0, 0.0], &[0.0, 1.0, 0.0], &[1.0, 1.0, 0.0]), Sign::Zero);
 /// ```
 #[inline(always)]
-pub fn orient3d(a: &Point3, b: &Point3, c: &Point3, d: &Point3) -> i32 {
-    orient3d_with(a, b, c, d, f64::INFINITY)
+pub fn orient3d(a: &Point3, b: &Point3, c: &Point3, d: &Point3) -> Sign {
+    Sign::of_i32(orient3d_with(a, b, c, d, f64::INFINITY))
 }
 
 /// [`orient3d`], first trying a static bound on the error of the plain
@@ -320,15 +415,15 @@ fn orient3d_stages<const FULL: bool>(
 /// negatively oriented the sign is reversed.
 ///
 /// ```
-/// use aniso_alpha::geometry::predicates::insphere;
+/// use aniso_alpha::geometry::predicates::{insphere, Sign};
 /// let t = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-/// assert_eq!(insphere(&t[0], &t[1], &t[2], &t[3], &[0.2, 0.2, 0.2]), 1);
-/// assert_eq!(insphere(&t[0], &t[1], &t[2], &t[3], &[1.0, 1.0, 1.0]), 0);
-/// assert_eq!(insphere(&t[0], &t[1], &t[2], &t[3], &[2.0, 2.0, 2.0]), -1);
+/// assert_eq!(insphere(&t[0], &t[1], &t[2], &t[3], &[0.2, 0.2, 0.2]), Sign::Positive);
+/// assert_eq!(insphere(&t[0], &t[1], &t[2], &t[3], &[1.0, 1.0, 1.0]), Sign::Zero);
+/// assert_eq!(insphere(&t[0], &t[1], &t[2], &t[3], &[2.0, 2.0, 2.0]), Sign::Negative);
 /// ```
 #[inline(always)]
-pub fn insphere(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> i32 {
-    insphere_with(a, b, c, d, e, f64::INFINITY)
+pub fn insphere(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> Sign {
+    Sign::of_i32(insphere_with(a, b, c, d, e, f64::INFINITY))
 }
 
 /// [`insphere`], first trying a static bound on the error of the plain
@@ -448,7 +543,17 @@ fn orient3d_slow(a: &Point3, b: &Point3, c: &Point3, d: &Point3) -> i32 {
     if small_ints(&r, 65536.0) && [a, b, c, d].iter().all(|p| small_ints(&p[..], 4.5e15)) {
         return -sign(orient_det(&r));
     }
+    // Then exact integers: coordinates within 60 bits of each other (most
+    // data), differences within 23 bits (coordinates far from the origin),
+    // coordinates within 100 bits, and only beyond that `robust`'s
+    // expansions.
+    if let Some(s) = orient3d_narrow_f(a, b, c, d) {
+        return -s;
+    }
     if let Some(s) = orient3d_int(a, b, c, d) {
+        return -s;
+    }
+    if let Some(s) = orient3d_wide(a, b, c, d) {
         return -s;
     }
     -sign(robust::orient3d(c3(a), c3(b), c3(c), c3(d)))
@@ -464,7 +569,14 @@ fn insphere_slow(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> 
     if small_ints(&r, 512.0) && [a, b, c, d, e].iter().all(|p| small_ints(&p[..], 4.5e15)) {
         return -sign(insphere_det(&r));
     }
+    // Then exact integers, as in `orient3d_slow`.
+    if let Some(s) = insphere_narrow_f(a, b, c, d, e) {
+        return -s;
+    }
     if let Some(s) = insphere_int(a, b, c, d, e) {
+        return -s;
+    }
+    if let Some(s) = insphere_wide(a, b, c, d, e) {
         return -s;
     }
     -sign(robust::insphere(c3(a), c3(b), c3(c), c3(d), c3(e)))
@@ -473,7 +585,7 @@ fn insphere_slow(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> 
 /// A choice of implementation for the two hot predicates. Both kernels
 /// return exact signs; [`SmallGrid`] is only valid for inputs that
 /// [`SmallGrid::applies`] accepts.
-pub trait Kernel: Copy + Send + Sync {
+pub(crate) trait Kernel: Copy + Send + Sync {
     /// Exact sign of `det[b − a, c − a, d − a]`, as [`orient3d`].
     fn orient3d(a: &Point3, b: &Point3, c: &Point3, d: &Point3) -> i32;
     /// Exact in-sphere sign, as [`insphere`].
@@ -546,14 +658,15 @@ pub trait Kernel: Copy + Send + Sync {
 /// static bound has a certain sign with a single comparison, skipping the
 /// per-call bound; anything else goes through the full filtered predicate.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct StaticFilter {
+pub(crate) struct StaticFilter {
     orient: f64,
     insphere: f64,
 }
 
 impl StaticFilter {
     /// A filter that never decides, so every call takes the full path.
-    pub const NONE: StaticFilter = StaticFilter {
+    #[cfg(test)]
+    pub(crate) const NONE: StaticFilter = StaticFilter {
         orient: f64::INFINITY,
         insphere: f64::INFINITY,
     };
@@ -565,7 +678,7 @@ impl StaticFilter {
     /// matter (a computed determinant whose true magnitude bound is below
     /// the smallest normal number is itself far below 1e-200, so it never
     /// passes), which is what the semi-static filter checks per call.
-    pub fn for_box(lo: &Point3, hi: &Point3) -> StaticFilter {
+    pub(crate) fn for_box(lo: &Point3, hi: &Point3) -> StaticFilter {
         let x = hi[0] - lo[0];
         let y = hi[1] - lo[1];
         let z = hi[2] - lo[2];
@@ -584,7 +697,8 @@ impl StaticFilter {
     }
 
     /// The static bounds for a set of finite points.
-    pub fn for_points(points: &[Point3]) -> StaticFilter {
+    #[cfg(test)]
+    pub(crate) fn for_points(points: &[Point3]) -> StaticFilter {
         let (lo, hi) = super::bounding_box(points);
         if points.is_empty() || !lo.iter().chain(&hi).all(|v| v.is_finite()) {
             return StaticFilter::NONE;
@@ -595,16 +709,16 @@ impl StaticFilter {
 
 /// The general kernel: floating-point filter, then exact stages.
 #[derive(Clone, Copy, Debug, Default)]
-pub struct Filtered;
+pub(crate) struct Filtered;
 
 impl Kernel for Filtered {
     #[inline(always)]
     fn orient3d(a: &Point3, b: &Point3, c: &Point3, d: &Point3) -> i32 {
-        orient3d(a, b, c, d)
+        orient3d_with(a, b, c, d, f64::INFINITY)
     }
     #[inline(always)]
     fn insphere(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> i32 {
-        insphere(a, b, c, d, e)
+        insphere_with(a, b, c, d, e, f64::INFINITY)
     }
     #[inline(always)]
     fn orient3d_static(
@@ -658,11 +772,12 @@ impl Kernel for Filtered {
 /// `insphere_slow`), so no filter is needed. Degenerate grids are exactly
 /// where the filtered kernel is slowest (most tests are exact ties).
 #[derive(Clone, Copy, Debug, Default)]
-pub struct SmallGrid;
+pub(crate) struct SmallGrid;
 
 impl SmallGrid {
     /// Whether the points satisfy the condition of [`SmallGrid`].
-    pub fn applies(points: &[Point3]) -> bool {
+    #[cfg(test)]
+    pub(crate) fn applies(points: &[Point3]) -> bool {
         Self::frame(points).is_some()
     }
 
@@ -762,12 +877,12 @@ impl Kernel for SmallGrid {
 /// Exact 2D orientation of the projections of `a, b, c` onto coordinates
 /// `(i, j)`: sign of `det[b − a, c − a]` in that plane.
 #[inline]
-pub fn orient2d_proj(a: &Point3, b: &Point3, c: &Point3, i: usize, j: usize) -> i32 {
+pub fn orient2d_proj(a: &Point3, b: &Point3, c: &Point3, i: usize, j: usize) -> Sign {
     let pa = Coord { x: a[i], y: a[j] };
     let pb = Coord { x: b[i], y: b[j] };
     let pc = Coord { x: c[i], y: c[j] };
     // robust::orient2d is positive when a, b, c are counter-clockwise.
-    sign(robust::orient2d(pa, pb, pc))
+    Sign::of(robust::orient2d(pa, pb, pc))
 }
 
 /// CGAL's `coplanar_orientation(p, q, r)` for three points: the 2D
@@ -777,13 +892,13 @@ pub fn orient2d_proj(a: &Point3, b: &Point3, c: &Point3, i: usize, j: usize) -> 
 /// For points in a common plane the same projection is chosen for every
 /// non-collinear triple, so the signs are coherent within the plane.
 #[inline]
-pub fn coplanar_orientation(p: &Point3, q: &Point3, r: &Point3) -> i32 {
+pub fn coplanar_orientation(p: &Point3, q: &Point3, r: &Point3) -> Sign {
     let o = orient2d_proj(p, q, r, 0, 1);
-    if o != 0 {
+    if o != Sign::Zero {
         return o;
     }
     let o = orient2d_proj(p, q, r, 1, 2);
-    if o != 0 {
+    if o != Sign::Zero {
         return o;
     }
     orient2d_proj(p, q, r, 0, 2)
@@ -792,7 +907,7 @@ pub fn coplanar_orientation(p: &Point3, q: &Point3, r: &Point3) -> i32 {
 /// Whether three points are collinear (exactly).
 #[inline]
 pub fn collinear(p: &Point3, q: &Point3, r: &Point3) -> bool {
-    coplanar_orientation(p, q, r) == 0
+    coplanar_orientation(p, q, r) == Sign::Zero
 }
 
 /// Exact side of the coplanar point `p` with respect to the circle through
@@ -802,13 +917,13 @@ pub fn collinear(p: &Point3, q: &Point3, r: &Point3) -> bool {
 /// Computed as an in-sphere test against any sphere through the circle: the
 /// sphere through `p0, p1, p2` and a point `x` off their plane cuts the plane
 /// exactly in their circumcircle, so for the coplanar `p` the two tests agree.
-pub fn coplanar_side_of_bounded_circle(p0: &Point3, p1: &Point3, p2: &Point3, p: &Point3) -> i32 {
+pub fn coplanar_side_of_bounded_circle(p0: &Point3, p1: &Point3, p2: &Point3, p: &Point3) -> Sign {
     // Move p0 along an axis that is not parallel to the plane. The xy
     // projection of the triangle is non-degenerate iff the plane's normal
     // has a non-zero z component, and so on.
-    let k = if orient2d_proj(p0, p1, p2, 0, 1) != 0 {
+    let k = if orient2d_proj(p0, p1, p2, 0, 1) != Sign::Zero {
         2
-    } else if orient2d_proj(p0, p1, p2, 1, 2) != 0 {
+    } else if orient2d_proj(p0, p1, p2, 1, 2) != Sign::Zero {
         0
     } else {
         1
@@ -816,7 +931,7 @@ pub fn coplanar_side_of_bounded_circle(p0: &Point3, p1: &Point3, p2: &Point3, p:
     let mut x = *p0;
     x[k] = p0[k] + p0[k].abs().max(1.0);
     let o = orient3d(p0, p1, p2, &x);
-    debug_assert!(o != 0);
+    debug_assert!(o != Sign::Zero);
     insphere(p0, p1, p2, &x, p) * o
 }
 
@@ -849,14 +964,19 @@ fn lex_less_branchless(a: &Point3, b: &Point3) -> bool {
 /// `e` decides, unless it is zero, in which case the next point is looked
 /// at. This reproduces CGAL 5.5's `side_of_oriented_sphere(..., perturb = true)`.
 #[inline(always)]
-pub fn insphere_perturbed(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> i32 {
-    insphere_perturbed_k::<Filtered>(a, b, c, d, e, &StaticFilter::NONE)
+pub fn insphere_perturbed(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> Sign {
+    let s = insphere_with(a, b, c, d, e, f64::INFINITY);
+    Sign::of_i32(if s != 0 {
+        s
+    } else {
+        insphere_tie::<Filtered>(a, b, c, d, e)
+    })
 }
 
 /// [`insphere_perturbed`] with the predicates of kernel `K` and a static
-/// filter for the point set (or [`StaticFilter::NONE`]).
+/// filter for the point set, as an integer sign.
 #[inline(always)]
-pub fn insphere_perturbed_k<K: Kernel>(
+pub(crate) fn insphere_perturbed_k<K: Kernel>(
     a: &Point3,
     b: &Point3,
     c: &Point3,
@@ -950,9 +1070,9 @@ fn tie_by<K: Kernel>(pts: [&Point3; 5], less: impl Fn(usize, usize) -> bool) -> 
 /// (`coplanar_side_of_bounded_circle(..., perturb = true)`): `1` if `p` is
 /// (perturbed-)inside the circle through `p0, p1, p2`, else `-1`. The four
 /// points must be coplanar and distinct, and `p0, p1, p2` not collinear.
-pub fn coplanar_incircle_perturbed(p0: &Point3, p1: &Point3, p2: &Point3, p: &Point3) -> i32 {
+pub fn coplanar_incircle_perturbed(p0: &Point3, p1: &Point3, p2: &Point3, p: &Point3) -> Sign {
     let s = coplanar_side_of_bounded_circle(p0, p1, p2, p);
-    if s != 0 {
+    if s != Sign::Zero {
         return s;
     }
     let pts: [&Point3; 4] = [p0, p1, p2, p];
@@ -967,29 +1087,35 @@ pub fn coplanar_incircle_perturbed(p0: &Point3, p1: &Point3, p2: &Point3, p: &Po
     let local = coplanar_orientation(p0, p1, p2);
     for &i in &idx[..3] {
         if i == 3 {
-            return -1;
+            return Sign::Negative;
         }
         let mut q = [p0, p1, p2];
         q[i] = p;
         let o = coplanar_orientation(q[0], q[1], q[2]);
-        if o != 0 {
+        if o != Sign::Zero {
             return o * local;
         }
     }
-    -1
+    Sign::Negative
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::rng::SplitMix64;
 
-    /// One step of Knuth's MMIX linear congruential generator (the tests'
-    /// deterministic source of coordinates).
-    fn lcg(s: &mut u64) -> u64 {
-        *s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        *s
+    // The tests compare signs as integers (and with `robust`'s).
+    fn orient3d(a: &Point3, b: &Point3, c: &Point3, d: &Point3) -> i32 {
+        super::orient3d(a, b, c, d).to_i32()
+    }
+    fn insphere(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> i32 {
+        super::insphere(a, b, c, d, e).to_i32()
+    }
+    fn insphere_perturbed(a: &Point3, b: &Point3, c: &Point3, d: &Point3, e: &Point3) -> i32 {
+        super::insphere_perturbed(a, b, c, d, e).to_i32()
+    }
+    fn coplanar_side_of_bounded_circle(p0: &Point3, p1: &Point3, p2: &Point3, p: &Point3) -> i32 {
+        super::coplanar_side_of_bounded_circle(p0, p1, p2, p).to_i32()
     }
 
     fn det3(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
@@ -1000,8 +1126,8 @@ mod tests {
     #[test]
     fn orient_matches_naive_on_small_integers() {
         // Small integers: the naive determinant is exact.
-        let mut s = 12345u64;
-        let mut next = || ((lcg(&mut s) >> 33) % 7) as f64 - 3.0;
+        let mut rng = SplitMix64::new(12345u64);
+        let mut next = || ((rng.next_u64() >> 33) % 7) as f64 - 3.0;
         for _ in 0..5000 {
             let p: Vec<[f64; 3]> = (0..5).map(|_| [next(), next(), next()]).collect();
             let sub = |u: [f64; 3], v: [f64; 3]| [u[0] - v[0], u[1] - v[1], u[2] - v[2]];
@@ -1040,8 +1166,8 @@ mod tests {
 
     #[test]
     fn integer_stage_agrees_with_robust() {
-        let mut s = 99u64;
-        let mut next = |range: u64| (lcg(&mut s) >> 33) % range;
+        let mut rng = SplitMix64::new(99u64);
+        let mut next = |range: u64| (rng.next_u64() >> 33) % range;
         let mut used = 0;
         for round in 0..20000 {
             // Dyadic grids of various scales and offsets, some near the
@@ -1143,8 +1269,8 @@ mod tests {
 
     #[test]
     fn small_grid_kernel_agrees_with_filtered() {
-        let mut s = 5u64;
-        let mut next = |m: u64| (lcg(&mut s) >> 33) % m;
+        let mut rng = SplitMix64::new(5u64);
+        let mut next = |m: u64| (rng.next_u64() >> 33) % m;
         for round in 0..20000 {
             let step = [1.0, 0.25, 8.0][round % 3];
             let offset = [0.0, 1024.0, -3.0 * 1024.0 * 1024.0][round % 3];
@@ -1195,8 +1321,8 @@ mod tests {
         // offsets, judged with the static bound of the whole set: the
         // answer must be the exact one. The plain determinant gets many of
         // these wrong (counted), so a bound that is too small fails here.
-        let mut s = 77u64;
-        let mut unif = || (lcg(&mut s) >> 11) as f64 / (1u64 << 53) as f64;
+        let mut rng = SplitMix64::new(77u64);
+        let mut unif = || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
         let mut plain_wrong = 0;
         for (scale, offset) in [
             (1.0, 0.0),
@@ -1376,8 +1502,8 @@ mod tests {
                 }
             }
         }
-        let mut s = 0x1234_5678u64;
-        let mut next = |n: usize| ((lcg(&mut s) >> 33) % n as u64) as usize;
+        let mut rng = SplitMix64::new(0x1234_5678u64);
+        let mut next = |n: usize| ((rng.next_u64() >> 33) % n as u64) as usize;
         let (mut ties, mut decided_late) = (0, 0);
         while ties < 3000 {
             let mut t = [0usize; 5];
@@ -1414,8 +1540,8 @@ mod tests {
     #[test]
     fn keyed_tie_matches_lex_tie() {
         // A dyadic grid (step 1/4) shifted to negative and large offsets.
-        let mut s = 0x9e37_79b9u64;
-        let mut next = |n: u64| (lcg(&mut s) >> 33) % n;
+        let mut rng = SplitMix64::new(0x9e37_79b9u64);
+        let mut next = |n: u64| (rng.next_u64() >> 33) % n;
         for offset in [0.0, -3.25, 1e6] {
             let grid: Vec<Point3> = (0..200)
                 .map(|_| {
@@ -1454,8 +1580,8 @@ mod tests {
         // Random points, and points near a common sphere and plane, where
         // the static stage must often abstain. Whenever a quick stage
         // answers, it equals the full predicate.
-        let mut s = 0x9e37_79b9u64;
-        let mut unif = || (lcg(&mut s) >> 11) as f64 / (1u64 << 53) as f64;
+        let mut rng = SplitMix64::new(0x9e37_79b9u64);
+        let mut unif = || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
         let filter = StaticFilter::for_box(&[-2.0; 3], &[2.0; 3]);
         let (mut decided, mut abstained) = (0, 0);
         for round in 0..20_000 {
@@ -1504,6 +1630,105 @@ mod tests {
                 SmallGrid::orient3d_quick(&a, &b, &c, &d, &filter),
                 orient3d(&a, &b, &c, &d)
             );
+        }
+    }
+
+    /// The cases of a corpus file: coordinates, then Shewchuk's sign.
+    fn corpus(text: &str) -> Vec<(Vec<f64>, i32)> {
+        text.lines()
+            .filter(|l| !l.trim().is_empty())
+            .map(|l| {
+                let v: Vec<f64> = l
+                    .split_whitespace()
+                    .skip(1)
+                    .map(|t| t.parse().unwrap())
+                    .collect();
+                let (sign, coords) = v.split_last().unwrap();
+                (coords.to_vec(), *sign as i32)
+            })
+            .collect()
+    }
+
+    fn points(c: &[f64], dim: usize) -> Vec<Point3> {
+        c.chunks(dim)
+            .map(|p| [p[0], p[1], if dim == 3 { p[2] } else { 0.0 }])
+            .collect()
+    }
+
+    /// Nanevski et al.'s hard cases (coordinates from 1e-4 to 1e33, see
+    /// `tests/fixtures/predicates/README.md`): `orient3d` through every
+    /// path of the crate (the public predicate, the filtered kernel with
+    /// and without the static bound of the case's own box, and its quick
+    /// stage whenever it answers) gives the corpus's sign.
+    #[test]
+    fn robust_corpus_orient3d() {
+        let cases = corpus(include_str!("../../tests/fixtures/predicates/orient3d.txt"));
+        assert_eq!(cases.len(), 1000);
+        let mut quick = 0;
+        for (k, (c, want)) in cases.iter().enumerate() {
+            let p = points(c, 3);
+            let (a, b, cc, d) = (&p[0], &p[1], &p[2], &p[3]);
+            // Shewchuk's orient3d is this crate's negated.
+            let want = -want;
+            assert_eq!(orient3d(a, b, cc, d), want, "case {}", k + 1);
+            let filter = StaticFilter::for_points(&p);
+            assert_eq!(Filtered::orient3d(a, b, cc, d), want, "case {}", k + 1);
+            assert_eq!(Filtered::orient3d_static(a, b, cc, d, &filter), want);
+            let q = Filtered::orient3d_quick(a, b, cc, d, &filter);
+            if q != 0 {
+                quick += 1;
+                assert_eq!(q, want, "case {}", k + 1);
+            }
+            // Swapping two points reverses the sign.
+            assert_eq!(orient3d(b, a, cc, d), -want, "case {}", k + 1);
+        }
+        assert!(quick > 0);
+    }
+
+    /// As [`robust_corpus_orient3d`], for `insphere` and its perturbed
+    /// form (which only differs on ties, and there are none).
+    #[test]
+    fn robust_corpus_insphere() {
+        let cases = corpus(include_str!("../../tests/fixtures/predicates/insphere.txt"));
+        assert_eq!(cases.len(), 1000);
+        for (k, (c, want)) in cases.iter().enumerate() {
+            let p = points(c, 3);
+            let (a, b, cc, d, e) = (&p[0], &p[1], &p[2], &p[3], &p[4]);
+            let want = -want;
+            assert_eq!(insphere(a, b, cc, d, e), want, "case {}", k + 1);
+            assert_eq!(insphere_perturbed(a, b, cc, d, e), want, "case {}", k + 1);
+            let filter = StaticFilter::for_points(&p);
+            assert_eq!(Filtered::insphere(a, b, cc, d, e), want);
+            assert_eq!(Filtered::insphere_static(a, b, cc, d, e, &filter), want);
+            let q = Filtered::insphere_quick(a, b, cc, d, e, &filter);
+            assert!(q == 0 || q == want, "case {}", k + 1);
+            assert_eq!(insphere(b, a, cc, d, e), -want, "case {}", k + 1);
+        }
+    }
+
+    /// The 2D cases through the crate's projections: `orient2d` as the xy
+    /// orientation of points at z = 0, and `incircle` as the coplanar
+    /// circle test (inside means the corpus's sign times the orientation
+    /// of the first three points).
+    #[test]
+    fn robust_corpus_orient2d_and_incircle() {
+        let cases = corpus(include_str!("../../tests/fixtures/predicates/orient2d.txt"));
+        assert_eq!(cases.len(), 1000);
+        for (k, (c, want)) in cases.iter().enumerate() {
+            let p = points(c, 2);
+            let got = orient2d_proj(&p[0], &p[1], &p[2], 0, 1).to_i32();
+            assert_eq!(got, *want, "case {}", k + 1);
+            assert_eq!(coplanar_orientation(&p[0], &p[1], &p[2]).to_i32(), *want);
+        }
+        let cases = corpus(include_str!("../../tests/fixtures/predicates/incircle.txt"));
+        assert_eq!(cases.len(), 1000);
+        for (k, (c, want)) in cases.iter().enumerate() {
+            let p = points(c, 2);
+            let o = orient2d_proj(&p[0], &p[1], &p[2], 0, 1).to_i32();
+            let got = coplanar_side_of_bounded_circle(&p[0], &p[1], &p[2], &p[3]);
+            assert_eq!(got, want * o, "case {}", k + 1);
+            let perturbed = super::coplanar_incircle_perturbed(&p[0], &p[1], &p[2], &p[3]);
+            assert_eq!(perturbed.to_i32(), want * o, "case {}", k + 1);
         }
     }
 }

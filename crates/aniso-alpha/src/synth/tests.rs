@@ -107,7 +107,7 @@ fn lines_scene() {
             }
         }
     }
-    // SPEC §5: background nearest-neighbour distance ≳ 1.25 d.
+    // docs/method.md §5: background nearest-neighbour distance ≳ 1.25 d.
     let nn = nearest_neighbour_mean(&members(&s, -1));
     assert!(nn > 1.15 * 7.0 && nn < 1.45 * 7.0, "{nn}");
 }

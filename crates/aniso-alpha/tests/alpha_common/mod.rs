@@ -234,27 +234,16 @@ mod common;
 pub use common::Rng;
 
 pub fn random_points(seed: u64, n: usize) -> Vec<[f64; 3]> {
-    let mut r = Rng(seed);
+    let mut r = Rng::new(seed);
     (0..n)
         .map(|_| [r.uniform(), r.uniform(), r.uniform()])
         .collect()
 }
 
-fn sub(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn dotf(a: &[f64; 3], b: &[f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
+use aniso_alpha::geometry::{cross, dot as dotf, sub};
+
 fn unit(a: [f64; 3]) -> [f64; 3] {
-    let l = dotf(&a, &a).sqrt();
+    let l = dotf(a, a).sqrt();
     [a[0] / l, a[1] / l, a[2] / l]
 }
 
@@ -266,8 +255,8 @@ fn ball_empty(pts: &[[f64; 3]], skip: &[usize], c: &[f64; 3], alpha: f64) -> boo
         if skip.contains(&k) {
             return true;
         }
-        let d = sub(p, c);
-        dotf(&d, &d) >= a2
+        let d = sub(*p, *c);
+        dotf(d, d) >= a2
     })
 }
 
@@ -282,8 +271,8 @@ pub fn edge_exposed(pts: &[[f64; 3]], i: usize, j: usize, alpha: f64) -> bool {
         (a[1] + b[1]) / 2.0,
         (a[2] + b[2]) / 2.0,
     ];
-    let d = sub(b, a);
-    let h2 = dotf(&d, &d) / 4.0;
+    let d = sub(*b, *a);
+    let h2 = dotf(d, d) / 4.0;
     if alpha * alpha < h2 {
         return false;
     }
@@ -294,8 +283,8 @@ pub fn edge_exposed(pts: &[[f64; 3]], i: usize, j: usize, alpha: f64) -> bool {
     } else {
         [0.0, 1.0, 0.0]
     };
-    let e1 = unit(cross(&dn, &helper));
-    let e2 = cross(&dn, &e1);
+    let e1 = unit(cross(dn, helper));
+    let e2 = cross(dn, e1);
     let centre = |th: f64| {
         let (c, sn) = (th.cos(), th.sin());
         [
@@ -310,10 +299,10 @@ pub fn edge_exposed(pts: &[[f64; 3]], i: usize, j: usize, alpha: f64) -> bool {
             continue;
         }
         // |c(θ) − p|² − α² = C + A cos θ + B sin θ
-        let mp = sub(&m, p);
-        let cc = dotf(&mp, &mp) + s * s - alpha * alpha;
-        let aa = 2.0 * s * dotf(&mp, &e1);
-        let bb = 2.0 * s * dotf(&mp, &e2);
+        let mp = sub(m, *p);
+        let cc = dotf(mp, mp) + s * s - alpha * alpha;
+        let aa = 2.0 * s * dotf(mp, e1);
+        let bb = 2.0 * s * dotf(mp, e2);
         let r = (aa * aa + bb * bb).sqrt();
         if r > 0.0 && cc.abs() <= r {
             let phi = bb.atan2(aa);
@@ -342,16 +331,16 @@ pub fn edge_exposed(pts: &[[f64; 3]], i: usize, j: usize, alpha: f64) -> bool {
 /// at distance α from them on the line through the circumcentre.
 pub fn triangle_exposed(pts: &[[f64; 3]], i: usize, j: usize, k: usize, alpha: f64) -> bool {
     let a = &pts[i];
-    let u = sub(&pts[j], a);
-    let v = sub(&pts[k], a);
-    let n = cross(&u, &v);
-    let nn = dotf(&n, &n);
-    let (uu, vv) = (dotf(&u, &u), dotf(&v, &v));
-    let vn = cross(&v, &n);
-    let nu = cross(&n, &u);
+    let u = sub(pts[j], *a);
+    let v = sub(pts[k], *a);
+    let n = cross(u, v);
+    let nn = dotf(n, n);
+    let (uu, vv) = (dotf(u, u), dotf(v, v));
+    let vn = cross(v, n);
+    let nu = cross(n, u);
     let o: [f64; 3] = std::array::from_fn(|q| (uu * vn[q] + vv * nu[q]) / (2.0 * nn));
     let c0 = [a[0] + o[0], a[1] + o[1], a[2] + o[2]];
-    let r2 = dotf(&o, &o);
+    let r2 = dotf(o, o);
     if alpha * alpha < r2 {
         return false;
     }

@@ -61,20 +61,6 @@ pub fn canonical_sorted(tets: impl IntoIterator<Item = [u32; 4]>) -> Vec<[u32; 4
     v
 }
 
-/// Deterministic PRNG for tests (SplitMix64).
-pub struct Rng(pub u64);
-impl Rng {
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    pub fn uniform(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-    pub fn below(&mut self, n: u64) -> u64 {
-        self.next_u64() % n
-    }
-}
+/// The tests' deterministic PRNG: the crate's own (SplitMix64).
+#[allow(unused_imports)]
+pub use aniso_alpha::rng::SplitMix64 as Rng;

@@ -303,28 +303,3 @@ fn grid_patches_match_oracle() {
         })
         .unwrap();
 }
-
-#[test]
-#[ignore = "timing; --ignored --nocapture"]
-fn timing_large_patch() {
-    // 200 × 100 squares = 40,000 triangles, plus 2,000 fins; nb_c = 20.
-    let mut s = patch(200, 100, 0);
-    for i in 0..2000u32 {
-        let v = 1 + (i * 7919) % 199 + 201 * (1 + (i * 104_729) % 99);
-        s.push([v, v + 202, 1_000_000 + i]);
-    }
-    let t = std::time::Instant::now();
-    let reps = 20;
-    let mut kept = 0;
-    for _ in 0..reps {
-        kept = filter_mask(&s, 20).unwrap().iter().filter(|&&k| k).count();
-    }
-    let dt = t.elapsed().as_secs_f64() / reps as f64;
-    eprintln!(
-        "filter_mask: {} triangles in {:.2} ms ({:.0} ns/triangle), kept {kept}",
-        s.len(),
-        dt * 1e3,
-        dt * 1e9 / s.len() as f64
-    );
-    assert_eq!(kept, 40_000);
-}

@@ -1,0 +1,240 @@
+#!/usr/bin/env python3
+"""Simulated laser scans of labelled scenes, for developing and testing
+detection on scan-like data (occlusion, range noise, density falling with
+range, outliers), with per-point ground truth.
+
+    python3 scripts/simulate_scan.py room   --seed 1 --output room.xyz
+    python3 scripts/simulate_scan.py house  --seed 1 --output house.xyz
+    python3 scripts/simulate_scan.py street --seed 1 --output street.xyz
+
+Writes `x y z label` per line (label -1 = clutter/outlier, otherwise the
+id of the planar surface, or of the pole/cable for `street`), and prints a
+one-line JSON summary. Needs numpy and open3d (ray casting).
+
+Scenes (dimensions in metres):
+  room    a 6 x 5 x 2.8 m room scanned from its middle: floor, ceiling, four
+          walls, a table and a cupboard (boxes: each face a plane), a door
+          recess; range noise 3 mm, 2,000 uniform outliers in the room.
+  house   a 10 x 7 m house with a gable roof (two slopes), a chimney,
+          window recesses in its walls, on a ground plane, scanned from
+          three stations outside; trees (random blobs of points) as
+          clutter; range noise 1 cm.
+  street  a street with 5 poles (cylinders, radius 8-15 cm, 6-8 m tall,
+          each with a crossbar), cables sagging between their tops, a
+          facade and the ground, scanned from two stations; labels are the
+          line structures (pole, crossbar, cable); planes are -1.
+
+Scanner: rays on an azimuth x elevation grid (0.1 to 0.2 degree steps,
+jittered), first hit, Gaussian noise along the ray; points beyond 60 m
+dropped.
+"""
+
+import argparse
+import json
+import sys
+
+import numpy as np
+
+
+class Scene:
+    """Triangles with a label each."""
+
+    def __init__(self):
+        self.v = []
+        self.t = []
+        self.lab = []
+        self.n = 0
+
+    def quad(self, p0, u, w, label, holes=()):
+        """The parallelogram p0 + s*u + r*w, s, r in [0, 1], minus
+        rectangular holes given as (s0, s1, r0, r1)."""
+        p0, u, w = (np.asarray(x, float) for x in (p0, u, w))
+        ss = sorted({0.0, 1.0, *[h[0] for h in holes], *[h[1] for h in holes]})
+        rs = sorted({0.0, 1.0, *[h[2] for h in holes], *[h[3] for h in holes]})
+        for i in range(len(ss) - 1):
+            for j in range(len(rs) - 1):
+                sm, rm = 0.5 * (ss[i] + ss[i + 1]), 0.5 * (rs[j] + rs[j + 1])
+                if any(h[0] <= sm <= h[1] and h[2] <= rm <= h[3] for h in holes):
+                    continue
+                a = p0 + ss[i] * u + rs[j] * w
+                b = p0 + ss[i + 1] * u + rs[j] * w
+                c = p0 + ss[i + 1] * u + rs[j + 1] * w
+                d = p0 + ss[i] * u + rs[j + 1] * w
+                self.tri(a, b, c, label)
+                self.tri(a, c, d, label)
+
+    def tri(self, a, b, c, label):
+        self.v.extend([a, b, c])
+        self.t.append([self.n, self.n + 1, self.n + 2])
+        self.lab.append(label)
+        self.n += 3
+
+    def box(self, lo, hi, first_label):
+        """An axis-aligned box; each face its own label. Returns the next
+        free label."""
+        lo, hi = np.asarray(lo, float), np.asarray(hi, float)
+        d = hi - lo
+        ex, ey, ez = np.array([d[0], 0, 0]), np.array([0, d[1], 0]), np.array([0, 0, d[2]])
+        faces = [
+            (lo, ey, ez), (lo + ex, ey, ez),
+            (lo, ex, ez), (lo + ey, ex, ez),
+            (lo, ex, ey), (lo + ez, ex, ey),
+        ]
+        for k, (p, u, w) in enumerate(faces):
+            self.quad(p, u, w, first_label + k)
+        return first_label + 6
+
+    def cylinder(self, a, b, r, label, segments=24):
+        a, b = np.asarray(a, float), np.asarray(b, float)
+        axis = b - a
+        axis /= np.linalg.norm(axis)
+        t = np.array([1.0, 0, 0]) if abs(axis[0]) < 0.9 else np.array([0, 1.0, 0])
+        e1 = np.cross(axis, t)
+        e1 /= np.linalg.norm(e1)
+        e2 = np.cross(axis, e1)
+        ring = lambda c, k: c + r * (np.cos(2 * np.pi * k / segments) * e1 + np.sin(2 * np.pi * k / segments) * e2)
+        for k in range(segments):
+            p, q = ring(a, k), ring(a, k + 1)
+            p2, q2 = ring(b, k), ring(b, k + 1)
+            self.tri(p, q, q2, label)
+            self.tri(p, q2, p2, label)
+
+    def arrays(self):
+        return np.array(self.v, float), np.array(self.t, np.int64), np.array(self.lab, np.int64)
+
+
+def scan(scene, stations, rng, step_deg, noise, max_range=60.0, elev=(-80, 85)):
+    import open3d as o3d
+
+    v, t, lab = scene.arrays()
+    rs = o3d.t.geometry.RaycastingScene()
+    rs.add_triangles(o3d.core.Tensor(v.astype(np.float32)), o3d.core.Tensor(t.astype(np.uint32)))
+    pts, labels = [], []
+    for s in stations:
+        az = np.arange(0, 360, step_deg)
+        el = np.arange(elev[0], elev[1], step_deg)
+        A, E = np.meshgrid(np.radians(az), np.radians(el))
+        A = A + rng.normal(0, np.radians(step_deg) * 0.05, A.shape)
+        E = E + rng.normal(0, np.radians(step_deg) * 0.05, E.shape)
+        d = np.stack([np.cos(E) * np.cos(A), np.cos(E) * np.sin(A), np.sin(E)], -1).reshape(-1, 3)
+        o = np.broadcast_to(np.asarray(s, float), d.shape)
+        rays = o3d.core.Tensor(np.hstack([o, d]).astype(np.float32))
+        ans = rs.cast_rays(rays)
+        th = ans["t_hit"].numpy().astype(float)
+        pid = ans["primitive_ids"].numpy()
+        ok = np.isfinite(th) & (th < max_range)
+        r = th[ok] + rng.normal(0, noise, ok.sum())
+        pts.append(o[ok] + r[:, None] * d[ok])
+        labels.append(lab[pid[ok]])
+    return np.vstack(pts), np.concatenate(labels)
+
+
+def room(rng):
+    s = Scene()
+    L, W, H = 6.0, 5.0, 2.8
+    lab = 0
+    s.quad([0, 0, 0], [L, 0, 0], [0, W, 0], lab); lab += 1          # floor
+    s.quad([0, 0, H], [L, 0, 0], [0, W, 0], lab); lab += 1          # ceiling
+    s.quad([0, 0, 0], [L, 0, 0], [0, 0, H], lab, holes=[(0.4, 0.55, 0.0, 0.75)]); lab += 1
+    s.quad([0, W, 0], [L, 0, 0], [0, 0, H], lab); lab += 1
+    s.quad([0, 0, 0], [0, W, 0], [0, 0, H], lab); lab += 1
+    s.quad([L, 0, 0], [0, W, 0], [0, 0, H], lab); lab += 1
+    # Door recess behind the hole in the first wall.
+    s.quad([0.4 * L, -0.25, 0], [0.15 * L, 0, 0], [0, 0, 0.75 * H], lab); lab += 1
+    lab = s.box([1.0, 3.2, 0.0], [2.6, 4.0, 0.75], lab)               # table
+    lab = s.box([4.9, 0.5, 0.0], [5.6, 2.0, 2.0], lab)                # cupboard
+    pts, labels = scan(s, [[3.2, 2.3, 1.5]], rng, 0.12, 0.003)
+    # Uniform outliers in the room.
+    out = rng.uniform([0, 0, 0], [L, W, H], (2000, 3))
+    return np.vstack([pts, out]), np.concatenate([labels, -np.ones(2000, np.int64)])
+
+
+def house(rng):
+    s = Scene()
+    lab = 0
+    Lx, Ly, Hw, Hr = 10.0, 7.0, 5.0, 3.0
+    s.quad([-25, -25, 0], [50, 0, 0], [0, 50, 0], lab); lab += 1       # ground
+    win = [(0.15, 0.3, 0.35, 0.7), (0.45, 0.6, 0.35, 0.7), (0.75, 0.9, 0.35, 0.7)]
+    # Walls with windows; recessed panes 0.2 m behind.
+    for p0, u in [([0, 0, 0], [Lx, 0, 0]), ([Lx, Ly, 0], [-Lx, 0, 0])]:
+        p0, u = np.array(p0, float), np.array(u, float)
+        n = np.cross(u, [0, 0, 1.0]); n /= np.linalg.norm(n)
+        s.quad(p0, u, [0, 0, Hw], lab, holes=win); lab += 1
+        for h in win:
+            s.quad(p0 - 0.2 * n + h[0] * u + [0, 0, h[2] * Hw], (h[1] - h[0]) * u, [0, 0, (h[3] - h[2]) * Hw], lab)
+        lab += 1
+    for p0, u in [([Lx, 0, 0], [0, Ly, 0]), ([0, Ly, 0], [0, -Ly, 0])]:
+        s.quad(p0, u, [0, 0, Hw], lab); lab += 1
+        # Gable triangle above.
+        p0, u = np.array(p0, float), np.array(u, float)
+        a, b, c = p0 + [0, 0, Hw], p0 + u + [0, 0, Hw], p0 + 0.5 * u + [0, 0, Hw + Hr]
+        s.tri(a, b, c, lab - 1)
+    # Roof slopes (with 0.5 m overhang).
+    o = 0.5
+    ridge = [[-o, Ly / 2, Hw + Hr], [Lx + o, Ly / 2, Hw + Hr]]
+    s.quad([-o, -o, Hw - o * Hr / (Ly / 2)], [Lx + 2 * o, 0, 0], [0, Ly / 2 + o, Hr + o * Hr / (Ly / 2)], lab); lab += 1
+    s.quad([-o, Ly + o, Hw - o * Hr / (Ly / 2)], [Lx + 2 * o, 0, 0], [0, -(Ly / 2 + o), Hr + o * Hr / (Ly / 2)], lab); lab += 1
+    del ridge
+    lab = s.box([6.5, 1.5, Hw + 0.5], [7.3, 2.3, Hw + Hr + 1.2], lab)   # chimney
+    pts, labels = scan(s, [[-12, -9, 1.7], [22, -6, 1.7], [5, 20, 1.7]], rng, 0.09, 0.01)
+    # Trees: blobs of points (foliage) near the house.
+    trees = []
+    for c in [[-5, 3, 4], [15, 10, 5], [12, -6, 3.5]]:
+        k = 4000
+        d = rng.normal(0, 1.0, (k, 3)) * [1.6, 1.6, 2.0]
+        trees.append(np.asarray(c) + d)
+    trees = np.vstack(trees)
+    keep = np.hypot(pts[:, 0] - 5, pts[:, 1] - 3.5) < 30
+    return np.vstack([pts[keep], trees]), np.concatenate([labels[keep], -np.ones(len(trees), np.int64)])
+
+
+def street(rng):
+    s = Scene()
+    lab = 0
+    s.quad([-40, -8, 0], [80, 0, 0], [0, 30, 0], 1000)                 # ground (plane: -1)
+    s.quad([-40, 12, 0], [80, 0, 0], [0, 0, 9], 1001)                  # facade (plane: -1)
+    xs = np.linspace(-24, 24, 5) + rng.uniform(-2, 2, 5)
+    tops = []
+    for x in xs:
+        r = rng.uniform(0.08, 0.15)
+        h = rng.uniform(6, 8)
+        s.cylinder([x, 0, 0], [x, 0, h], r, lab); lab += 1            # pole
+        s.cylinder([x, -0.8, h - 0.5], [x, 0.8, h - 0.5], 0.05, lab); lab += 1  # crossbar
+        tops.append([x, 0.7, h - 0.45])
+    for a, b in zip(tops[:-1], tops[1:]):
+        a, b = np.array(a), np.array(b)
+        # A cable sagging 0.6 m, as 12 straight cylinders (one label).
+        k = 12
+        for i in range(k):
+            t0, t1 = i / k, (i + 1) / k
+            p = a + t0 * (b - a) - [0, 0, 2.4 * t0 * (1 - t0)]
+            q = a + t1 * (b - a) - [0, 0, 2.4 * t1 * (1 - t1)]
+            s.cylinder(p, q, 0.015, lab, segments=8)
+        lab += 1
+    pts, labels = scan(s, [[-10, -5, 1.8], [12, -5, 1.8]], rng, 0.06, 0.005, elev=(-60, 70))
+    labels = np.where(labels >= 1000, -1, labels)
+    return pts, labels
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("scene", choices=["room", "house", "street"])
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--output", required=True)
+    a = ap.parse_args()
+    rng = np.random.default_rng(a.seed)
+    pts, labels = {"room": room, "house": house, "street": street}[a.scene](rng)
+    # Shuffle (scanner order would make every neighbour query trivial).
+    perm = rng.permutation(len(pts))
+    pts, labels = pts[perm], labels[perm]
+    with open(a.output, "w") as f:
+        for p, l in zip(pts, labels):
+            f.write(f"{p[0]:.5f} {p[1]:.5f} {p[2]:.5f} {int(l)}\n")
+    u, c = np.unique(labels[labels >= 0], return_counts=True)
+    print(json.dumps({"scene": a.scene, "seed": a.seed, "points": int(len(pts)),
+                      "labelled": int((labels >= 0).sum()), "structures": int(len(u)),
+                      "structures_1000": int((c >= 1000).sum())}))
+
+
+if __name__ == "__main__":
+    sys.exit(main())
