@@ -67,7 +67,7 @@ pub fn set_format(format: Option<aio::Format>) {
 /// clap parser for `--format`.
 pub fn parse_format(s: &str) -> Result<aio::Format, String> {
     aio::Format::from_name(s).ok_or_else(|| {
-        format!("unknown format '{s}' (expected xyz, txt, csv, pts, ply, las, laz or pcd)")
+        format!("unknown format '{s}' (expected xyz, txt, csv, pts, ply, las, laz, pcd or e57)")
     })
 }
 

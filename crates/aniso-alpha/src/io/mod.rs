@@ -8,6 +8,7 @@
 //! | `.ply` | PLY ascii, binary little- or big-endian; x/y/z of any scalar type |
 //! | `.las` `.laz` | LAS/LAZ with scale and offset applied (cargo feature `las`) |
 //! | `.pcd` | PCD ascii, binary and binary_compressed |
+//! | `.e57` | E57, every scan, each moved by its pose (cargo feature `e57`) |
 //!
 //! Point `i` of a [`PointCloud`] is the `i`-th point of the file. Every
 //! error is an [`IoError`] that names the file (and, for text, the line);
@@ -27,6 +28,8 @@
 
 mod atomic;
 mod attributes;
+#[cfg(feature = "e57")]
+mod e57;
 mod error;
 mod labelled;
 mod labels;
@@ -91,6 +94,14 @@ pub enum ReadWarning {
         /// The line (shortened).
         text: String,
     },
+    /// Points of the file were not read (E57 points whose coordinates
+    /// are flagged invalid).
+    SkippedPoints {
+        /// How many.
+        count: u64,
+        /// Why.
+        reason: &'static str,
+    },
 }
 
 impl std::fmt::Display for ReadWarning {
@@ -98,6 +109,9 @@ impl std::fmt::Display for ReadWarning {
         match self {
             ReadWarning::HeaderLine { line, text } => {
                 write!(f, "line {line} taken as a header: '{text}'")
+            }
+            ReadWarning::SkippedPoints { count, reason } => {
+                write!(f, "{count} points skipped: {reason}")
             }
         }
     }
@@ -200,9 +214,11 @@ pub enum Format {
     Las,
     /// `.pcd`.
     Pcd,
+    /// `.e57`.
+    E57,
 }
 
-const EXPECTED_POINTS: &str = ".xyz, .txt, .csv, .pts, .ply, .las, .laz or .pcd";
+const EXPECTED_POINTS: &str = ".xyz, .txt, .csv, .pts, .ply, .las, .laz, .pcd or .e57";
 
 impl Format {
     /// The format of a point file, from its extension (case-insensitive).
@@ -226,7 +242,7 @@ impl Format {
 
     /// The format named by an extension or a `--format` value
     /// (case-insensitive, without the dot): `xyz` `txt` `csv` `pts` `ply`
-    /// `las` `laz` `pcd`.
+    /// `las` `laz` `pcd` `e57`.
     ///
     /// ```
     /// use aniso_alpha::io::Format;
@@ -239,6 +255,7 @@ impl Format {
             "ply" => Format::Ply,
             "las" | "laz" => Format::Las,
             "pcd" => Format::Pcd,
+            "e57" => Format::E57,
             _ => return None,
         })
     }
@@ -375,6 +392,7 @@ fn parse_format(
         Format::Ply => read_ply_bytes(path, bytes, options),
         Format::Las => read_las_bytes(path, bytes, options),
         Format::Pcd => read_pcd_bytes(path, bytes, options),
+        Format::E57 => read_e57_bytes(path, bytes, options),
     }
 }
 
@@ -455,6 +473,32 @@ pub fn read_las_bytes(
         Err(IoError::Unsupported {
             path: name.to_path_buf(),
             message: "LAS/LAZ support is not compiled in (cargo feature `las`)",
+        })
+    }
+}
+
+/// Parses an E57 file held in memory: the points of every scan, each
+/// moved by its pose into the file's coordinate system (points flagged
+/// invalid are skipped, with a [`ReadWarning::SkippedPoints`]); with
+/// `options.attributes`, every other field (intensity, colours, row and
+/// column, time stamps, extension fields) in its own type. E57 has no
+/// classification: `labels` stay `None`. Needs the cargo feature `e57`;
+/// without it this returns [`IoError::Unsupported`].
+pub fn read_e57_bytes(
+    name: &Path,
+    bytes: &[u8],
+    options: &ReadOptions,
+) -> Result<PointCloud, IoError> {
+    #[cfg(feature = "e57")]
+    {
+        e57::read_e57(name, bytes, options.attributes)
+    }
+    #[cfg(not(feature = "e57"))]
+    {
+        let _ = (bytes, options);
+        Err(IoError::Unsupported {
+            path: name.to_path_buf(),
+            message: "E57 support is not compiled in (cargo feature `e57`)",
         })
     }
 }
