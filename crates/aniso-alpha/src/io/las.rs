@@ -628,6 +628,31 @@ mod tests {
     }
 
     #[test]
+    fn fuzz_regression_many_extra_byte_names() {
+        // libFuzzer (timeout, 39 s): a record of 16,474 bytes, 16,454 of
+        // them extra bytes, each a column; their names were made unique
+        // by scanning a list (quadratic, cubic for repeated names), before
+        // the reader found the file has no point. Now a set (see
+        // unique_names_stay_unique_and_linear): milliseconds.
+        let bytes = include_bytes!("../../tests/fuzz_regressions/las-extra-bytes-names-timeout.las");
+        let e = read_las(Path::new("names.las"), bytes, None, true).unwrap_err();
+        assert!(matches!(e, IoError::NoPoints { .. }), "{e}");
+    }
+
+    #[test]
+    fn unique_names_stay_unique_and_linear() {
+        let mut n = super::super::las_attrs::Names::new(&["x", "y", "z"]);
+        assert_eq!(n.unique("x", "f"), "x_2");
+        assert_eq!(n.unique("a b", "f"), "a_b");
+        assert_eq!(n.unique("  ", "f"), "f");
+        assert_eq!(n.unique("a_b_2", "f"), "a_b_2");
+        assert_eq!(n.unique("a b", "f"), "a_b_3");
+        let all: std::collections::HashSet<String> =
+            (0..65_536).map(|_| n.unique("same", "f")).collect();
+        assert_eq!(all.len(), 65_536);
+    }
+
+    #[test]
     fn fuzz_regression_huge_record_length() {
         // libFuzzer found a header with a huge record length and point
         // count: the reader allocated 2.7 GB at once.

@@ -2,6 +2,8 @@
 //! file, and the Extra Bytes VLR (LAS 1.4 R15 §2.5.3: record id 4 of user
 //! `LASF_Spec`, 192 bytes per described field).
 
+use std::collections::{HashMap, HashSet};
+
 use super::attributes::{Attribute, AttributeType, LasSource, Values, Vlr};
 
 /// Size of the fixed part of a record of point format `format` (0–10).
@@ -282,25 +284,46 @@ pub(crate) fn parse_vlrs(
     Ok((vlrs, padding))
 }
 
-/// A name fit for a PLY property: whitespace replaced by `_`, never
-/// empty, and unique among `taken` (`_2`, `_3`… appended).
-fn unique_name(name: &str, fallback: &str, taken: &mut Vec<String>) -> String {
-    let mut base: String = name
-        .trim()
-        .chars()
-        .map(|c| if c.is_whitespace() { '_' } else { c })
-        .collect();
-    if base.is_empty() {
-        base = fallback.to_string();
+/// The column names given so far, and for each base name the next
+/// suffix to try: a file of 65,000 fields of one name costs linear time
+/// (a list and a scan from `_2` each time was cubic: the fuzzer's
+/// timeout).
+pub(crate) struct Names {
+    taken: HashSet<String>,
+    next: HashMap<String, usize>,
+}
+
+impl Names {
+    pub(crate) fn new(taken: &[&str]) -> Names {
+        Names {
+            taken: taken.iter().map(|s| s.to_string()).collect(),
+            next: HashMap::new(),
+        }
     }
-    let mut out = base.clone();
-    let mut k = 2;
-    while taken.contains(&out) {
-        out = format!("{base}_{k}");
-        k += 1;
+
+    /// A name fit for a PLY property: whitespace replaced by `_`, never
+    /// empty, and unique among the names given (`_2`, `_3`… appended).
+    pub(crate) fn unique(&mut self, name: &str, fallback: &str) -> String {
+        let mut base: String = name
+            .trim()
+            .chars()
+            .map(|c| if c.is_whitespace() { '_' } else { c })
+            .collect();
+        if base.is_empty() {
+            base = fallback.to_string();
+        }
+        if self.taken.insert(base.clone()) {
+            return base;
+        }
+        let k = self.next.entry(base.clone()).or_insert(2);
+        loop {
+            let out = format!("{base}_{k}");
+            *k += 1;
+            if self.taken.insert(out.clone()) {
+                return out;
+            }
+        }
     }
-    taken.push(out.clone());
-    out
 }
 
 /// The typed attributes of every record of `src`: the point format's
@@ -313,10 +336,10 @@ pub(crate) fn record_attributes(src: &LasSource) -> Vec<Attribute> {
     let len = src.record_len;
     let n = if len == 0 { 0 } else { src.records.len() / len };
     let recs = || src.records.chunks_exact(len);
-    let mut taken: Vec<String> = ["x", "y", "z"].map(String::from).to_vec();
+    let mut taken = Names::new(&["x", "y", "z"]);
     let mut out = Vec::new();
     for (name, o, field) in record_fields(src.point_format) {
-        let name = unique_name(name, name, &mut taken);
+        let name = taken.unique(name, name);
         let values = match field {
             Whole(ty) => {
                 let mut v = Values::with_capacity(ty, n);
@@ -337,9 +360,9 @@ pub(crate) fn record_attributes(src: &LasSource) -> Vec<Attribute> {
         .map(|v| parse_extra_fields(&v.data))
         .unwrap_or_default();
     let mut at = 0usize;
-    let undocumented = |from: usize, to: usize, taken: &mut Vec<String>, out: &mut Vec<_>| {
+    let undocumented = |from: usize, to: usize, taken: &mut Names, out: &mut Vec<_>| {
         for k in from..to {
-            let name = unique_name(&format!("extra_byte_{k}"), "extra_byte", taken);
+            let name = taken.unique(&format!("extra_byte_{k}"), "extra_byte");
             out.push(Attribute::new(
                 name,
                 Values::U8(recs().map(|r| r[base + k]).collect()),
@@ -359,7 +382,7 @@ pub(crate) fn record_attributes(src: &LasSource) -> Vec<Attribute> {
                 // Named undocumented bytes: `name_0`, `name_1`…
                 for k in 0..size {
                     let name = format!("{}_{k}", f.name_str());
-                    let name = unique_name(&name, "extra_byte", &mut taken);
+                    let name = taken.unique(&name, "extra_byte");
                     out.push(Attribute::new(
                         name,
                         Values::U8(recs().map(|r| r[base + at + k]).collect()),
@@ -375,7 +398,7 @@ pub(crate) fn record_attributes(src: &LasSource) -> Vec<Attribute> {
                     } else {
                         format!("{raw}_{c}")
                     };
-                    let name = unique_name(&name, &format!("extra_{at}"), &mut taken);
+                    let name = taken.unique(&name, &format!("extra_{at}"));
                     let o = base + at + c * ty.size();
                     let mut v = Values::with_capacity(ty, n);
                     for r in recs() {
