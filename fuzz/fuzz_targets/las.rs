@@ -9,9 +9,10 @@
 //!
 //! Speed: a LAZ input may declare up to 1000 bytes of records per byte
 //! (the reader's bound); decompressing those dominates a run, so inputs
-//! declaring more than [`MAX_POINTS`] points are skipped here (the header
-//! checks that refuse huge counts are unit-tested in `io::las`). Half the
-//! inputs are read with every attribute kept.
+//! declaring more than [`MAX_POINTS`] points, or more than
+//! [`MAX_RECORD_BYTES`] of records, are skipped here (the header checks
+//! that refuse huge counts are unit-tested in `io::las`). Half the inputs
+//! are read with every attribute kept.
 //!
 //! Seeds: `fuzz/corpus_seeds/las/` (LAS and LAZ files of every point
 //! format, written by `cargo test -p aniso-alpha --features las --test
@@ -25,6 +26,9 @@ use libfuzzer_sys::fuzz_target;
 
 /// Inputs declaring more points are skipped (see the module docs).
 const MAX_POINTS: u64 = 2048;
+
+/// Inputs declaring more bytes of point records are skipped.
+const MAX_RECORD_BYTES: u64 = 256 << 10;
 
 /// The point count the header declares (legacy field, or LAS 1.4's).
 fn declared_points(b: &[u8]) -> u64 {
@@ -75,7 +79,11 @@ fuzz_target!(
         }));
     },
     |data: &[u8]| {
-        if declared_points(data) > MAX_POINTS {
+        let points = declared_points(data);
+        let record_len = data
+            .get(105..107)
+            .map_or(0, |s| u64::from(u16::from_le_bytes([s[0], s[1]])));
+        if points > MAX_POINTS || points * record_len > MAX_RECORD_BYTES {
             return;
         }
         let name = if data.get(104).is_some_and(|f| f & 0xC0 != 0) {

@@ -37,12 +37,19 @@ alpha is a radius (the short semi-axis of the ellipsoid), not CGAL's squared alp
 Without INPUT, runs on a built-in example scene (a Fig. 10-like polyhedron in uniform background, \
 planes, alpha 1, lambda2 4, lambda3 8, min-size 20) and says where it wrote its results.\n\
 --labels writes one integer per input point: its structure id, or -1; --part-labels its part \
-(plane or segment) id, or -1. Parts are disjoint.\n\n\
+(plane or segment) id, or -1. Parts are disjoint.\n\
+--output OUT.las|.laz|.ply writes the input cloud back with every attribute it had (a LAS/LAZ \
+input's records byte for byte; another input to LAS becomes point format 0 with its attributes \
+as extra bytes) and two int32 fields, structure and part (-1 off the structures); .obj writes \
+the parts' meshes only. --classify planes=6 also gives the structures' points that LAS class; \
+--background-classes 7,18 leaves the points of those classes out of the detection (labelled -1).\n\n\
 Examples:\n  aniso-alpha detect\n  \
 aniso-alpha detect scan.ply --structure planes --labels labels.txt --part-labels parts.txt --report report.json\n  \
 aniso-alpha detect scene.xyz --structure lines --alpha 1 --lambda3 10 --min-size 4 --labels labels.txt\n  \
 aniso-alpha detect scan.ply --structure planes --alpha 1 --lambda2 4 --lambda3 8 --min-size 20 \
---output planes.ply --report report.json --threads 2"
+--output planes.ply --report report.json --threads 2\n  \
+aniso-alpha detect scan.laz --structure planes --output scan_labelled.laz --classify planes=6 \
+--background-classes 7,18"
 )]
 pub struct DetectArgs {
     /// Input point file; omit it to run the built-in example

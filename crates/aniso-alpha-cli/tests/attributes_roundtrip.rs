@@ -58,7 +58,14 @@ fn read_ids(p: &Path) -> Vec<i64> {
 fn detect(dir: &TempDir, input: &Path, out: &Path, args: &[&str]) -> (Vec<i64>, Vec<i64>) {
     let (labels, parts) = (dir.path("labels.txt"), dir.path("parts.txt"));
     let o = Command::new(BIN)
-        .args(["detect", s(input), "--output", s(out), "--labels", s(&labels)])
+        .args([
+            "detect",
+            s(input),
+            "--output",
+            s(out),
+            "--labels",
+            s(&labels),
+        ])
         .args(["--part-labels", s(&parts), "--quiet", "--threads", "2"])
         .args(args)
         .output()
@@ -295,5 +302,24 @@ fn e57_to_las_keeps_colours_as_fields() {
         for k in 0..3 {
             assert!((p[k] - q[k]).abs() <= 1e-6, "{p:?} {q:?}");
         }
+    }
+}
+
+#[test]
+fn detect_help_documents_the_labelled_outputs() {
+    let o = Command::new(BIN)
+        .args(["detect", "--help"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0));
+    let help = String::from_utf8_lossy(&o.stdout);
+    for want in [
+        "--output OUT.las|.laz|.ply writes the input cloud back with every attribute",
+        "--classify planes=6",
+        "--background-classes 7,18",
+        "scan_labelled.laz",
+        "e57",
+    ] {
+        assert!(help.contains(want), "detect --help lacks '{want}':\n{help}");
     }
 }

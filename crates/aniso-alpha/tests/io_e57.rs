@@ -135,7 +135,10 @@ fn intensity_keeps_its_type() {
     let Values::F64(v) = attr(&c, "intensity") else {
         panic!("scaled intensity not f64")
     };
-    assert!((v[0] + 66.6).abs() < 1e-9 && (v[1] - 66.6).abs() < 1e-9, "{v:?}");
+    assert!(
+        (v[0] + 66.6).abs() < 1e-9 && (v[1] - 66.6).abs() < 1e-9,
+        "{v:?}"
+    );
 }
 
 #[test]
@@ -153,7 +156,11 @@ fn extension_fields_are_kept_by_name() {
         let col = attr(&c, name);
         assert_eq!(col.len(), c.points.len());
         let first = r.pointcloud_raw(pc).unwrap().next().unwrap().unwrap();
-        assert_eq!(col.get_f64(0), first[i].to_f64(&rec.data_type).unwrap(), "{name}");
+        assert_eq!(
+            col.get_f64(0),
+            first[i].to_f64(&rec.data_type).unwrap(),
+            "{name}"
+        );
     }
     assert!(matches!(attr(&c, "pointSourceId"), Values::U16(v) if v[0] == 1));
 }
@@ -274,7 +281,10 @@ fn a_lying_point_count_is_refused_before_allocating() {
         x.replace("recordCount=\"3\"", "recordCount=\"1000000000000000\"")
     });
     let e = read_points(&path, &ReadOptions::default()).unwrap_err();
-    assert!(e.to_string().contains("points declared in a file of"), "{e}");
+    assert!(
+        e.to_string().contains("points declared in a file of"),
+        "{e}"
+    );
     // The oracle can fail: the same file, unchanged, reads.
     let path = tmp("true_count.e57");
     let pts = vec![[1.0, 0.0, 0.0]; 3];
@@ -282,7 +292,13 @@ fn a_lying_point_count_is_refused_before_allocating() {
         assert!(x.contains("recordCount=\"3\""), "{x}");
         x
     });
-    assert_eq!(read_points(&path, &ReadOptions::default()).unwrap().points.len(), 2);
+    assert_eq!(
+        read_points(&path, &ReadOptions::default())
+            .unwrap()
+            .points
+            .len(),
+        2
+    );
 }
 
 fn read_hostile(bytes: &[u8]) -> Result<PointCloud, IoError> {
@@ -318,7 +334,10 @@ fn truncated_and_corrupt_files_are_errors_not_panics() {
                 Ok(c) => assert!(c.points.iter().flatten().all(|v| v.is_finite())),
             }
         }
-        assert!(errors * 10 >= flips * 9, "{name}: {errors} errors of {flips} flips");
+        assert!(
+            errors * 10 >= flips * 9,
+            "{name}: {errors} errors of {flips} flips"
+        );
     }
     // Not E57 at all.
     let e = read_hostile(b"ply\nformat ascii 1.0\n").unwrap_err();

@@ -58,8 +58,8 @@ struct Column {
 pub(crate) fn read_e57(path: &Path, bytes: &[u8], attributes: bool) -> Result<PointCloud, IoError> {
     let bad = |m: String| IoError::format(path, format!("invalid E57 file: {m}"));
     precheck(bytes).map_err(bad)?;
-    let mut reader = contain(path, || E57Reader::new(Cursor::new(bytes)))?
-        .map_err(|e| bad(e.to_string()))?;
+    let mut reader =
+        contain(path, || E57Reader::new(Cursor::new(bytes)))?.map_err(|e| bad(e.to_string()))?;
     let scans = reader.pointclouds();
     if scans.is_empty() {
         return Err(bad("no point cloud (data3D) in the file".into()));
@@ -80,8 +80,11 @@ pub(crate) fn read_e57(path: &Path, bytes: &[u8], attributes: bool) -> Result<Po
     let mut columns: Option<Vec<Attribute>> = None;
     let mut skipped = 0u64;
     for (s, pc) in scans.iter().enumerate() {
-        let coords = coordinates(&pc.prototype)
-            .ok_or_else(|| bad(format!("scan {s} has neither Cartesian nor spherical coordinates")))?;
+        let coords = coordinates(&pc.prototype).ok_or_else(|| {
+            bad(format!(
+                "scan {s} has neither Cartesian nor spherical coordinates"
+            ))
+        })?;
         let mut kept: Vec<Column> = if attributes {
             scan_columns(&pc.prototype, &coords, cap)
         } else {
@@ -144,7 +147,12 @@ pub(crate) fn read_e57(path: &Path, bytes: &[u8], attributes: bool) -> Result<Po
             cloud.points.push(p);
             for c in &mut kept {
                 push_value(&mut c.attribute.values, &values[c.index], &c.data_type).map_err(
-                    |m| bad(format!("scan {s}, point {read}, field '{}': {m}", c.attribute.name)),
+                    |m| {
+                        bad(format!(
+                            "scan {s}, point {read}, field '{}': {m}",
+                            c.attribute.name
+                        ))
+                    },
                 )?;
             }
         }
@@ -354,10 +362,9 @@ fn to_f64(v: &RecordValue, t: &RecordDataType) -> Option<f64> {
         (RecordValue::Single(x), RecordDataType::Single { .. }) => Some(f64::from(*x)),
         (RecordValue::Double(x), RecordDataType::Double { .. }) => Some(*x),
         (RecordValue::Integer(i), RecordDataType::Integer { .. }) => Some(*i as f64),
-        (
-            RecordValue::ScaledInteger(i),
-            RecordDataType::ScaledInteger { scale, offset, .. },
-        ) => Some(*i as f64 * scale + offset),
+        (RecordValue::ScaledInteger(i), RecordDataType::ScaledInteger { scale, offset, .. }) => {
+            Some(*i as f64 * scale + offset)
+        }
         _ => None,
     }
 }
@@ -372,7 +379,9 @@ fn push_value(col: &mut Values, v: &RecordValue, t: &RecordDataType) -> Result<(
         }
         (c, RecordValue::Integer(i), RecordDataType::Integer { min, max }) => {
             if i < min || i > max {
-                return Err(format!("value {i} outside its declared range {min}..={max}"));
+                return Err(format!(
+                    "value {i} outside its declared range {min}..={max}"
+                ));
             }
             // In range, so it fits the column's type (column_type);
             // push_f64 would round an i64 beyond 2^53.
@@ -439,7 +448,10 @@ mod tests {
         let h = std::f64::consts::FRAC_1_SQRT_2;
         let pose = Pose::new([h, 0.0, 0.0, h], [10.0, 0.0, 0.0]);
         let p = pose.apply([1.0, 0.0, 0.0]);
-        assert!((p[0] - 10.0).abs() < 1e-12 && (p[1] - 1.0).abs() < 1e-12, "{p:?}");
+        assert!(
+            (p[0] - 10.0).abs() < 1e-12 && (p[1] - 1.0).abs() < 1e-12,
+            "{p:?}"
+        );
         // Not normalised: the same rotation.
         let p2 = Pose::new([2.0, 0.0, 0.0, 2.0], [10.0, 0.0, 0.0]).apply([1.0, 0.0, 0.0]);
         assert!((p2[0] - p[0]).abs() < 1e-12 && (p2[1] - p[1]).abs() < 1e-12);

@@ -614,7 +614,12 @@ mod tests {
             let e = std::thread::Builder::new()
                 .stack_size(1 << 20)
                 .spawn(move || {
-                    read_las(Path::new("gps.laz"), bytes, Some(ClassSet::EMPTY), attributes)
+                    read_las(
+                        Path::new("gps.laz"),
+                        bytes,
+                        Some(ClassSet::EMPTY),
+                        attributes,
+                    )
                 })
                 .unwrap()
                 .join()
@@ -634,7 +639,8 @@ mod tests {
         // by scanning a list (quadratic, cubic for repeated names), before
         // the reader found the file has no point. Now a set (see
         // unique_names_stay_unique_and_linear): milliseconds.
-        let bytes = include_bytes!("../../tests/fuzz_regressions/las-extra-bytes-names-timeout.las");
+        let bytes =
+            include_bytes!("../../tests/fuzz_regressions/las-extra-bytes-names-timeout.las");
         let e = read_las(Path::new("names.las"), bytes, None, true).unwrap_err();
         assert!(matches!(e, IoError::NoPoints { .. }), "{e}");
     }
