@@ -37,6 +37,15 @@
 //!      and λ = clamp(C_REACH·d/α, 1, λ_max). Very noisy structures
 //!      (σ above about d/2) get λ = 1: the Euclidean α-shape, as measured
 //!      on the noisy walls of the CGAL building scan.
+//!    4b. **Thick lines** (k = 1, when C_NOISE·σ ≥ C_REACH·d, so λ would
+//!    be 1): the line is a tube (a pole, a trunk, a cable's point
+//!    swarm) many points across, whose α-shape is a surface, not a path.
+//!    It is a line at a coarser scale: the mode's members are thinned to
+//!    one point per voxel of side [`TUBE_VOXEL`]·α (the member nearest to
+//!    its voxel's centroid), so consecutive kept points lie about a voxel
+//!    apart along the tube and one across; the spacing becomes the voxel
+//!    side and λ = C_REACH·voxel/α = 4. The assembly's claims give the
+//!    parts back every input point within α of their segment.
 //! 5. **nb_c** = [`NB_C_AUTO`]: the path filter then only cuts spurs and
 //!    fins of a few simplices; what is chance is decided by the
 //!    significance test ([`super::significance`]).
@@ -82,6 +91,11 @@ pub const C_REACH: f64 = 2.0;
 
 /// Largest elongation chosen.
 pub const LAMBDA_MAX: f64 = 8.0;
+
+/// Thinning of a thick line (module doc, step 4b): the side of the voxels
+/// in units of α, so that a voxel holds the whole cross-section of the
+/// tube (its diameter is about 2·C_NOISE·σ = 2α).
+pub const TUBE_VOXEL: f64 = 2.0;
 
 /// The path filter's nb_c in the automatic mode.
 pub const NB_C_AUTO: u32 = 4;
@@ -188,6 +202,48 @@ fn scales(kind: StructureKind, d: f64, sigma: f64, given: &Given) -> (f64, f64, 
         StructureKind::Lines => 1.0,
     };
     (alpha, l2, l3)
+}
+
+/// One member per voxel of side `side`: the one nearest to the centroid of
+/// its voxel's members (the lowest index on a tie); ascending indices.
+fn thin(points: &[[f64; 3]], members: &[u32], side: f64) -> Vec<u32> {
+    let key = |i: u32| {
+        let p = points[i as usize];
+        [
+            (p[0] / side).floor() as i64,
+            (p[1] / side).floor() as i64,
+            (p[2] / side).floor() as i64,
+        ]
+    };
+    let mut order: Vec<([i64; 3], u32)> = members.iter().map(|&i| (key(i), i)).collect();
+    order.sort_unstable();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < order.len() {
+        let j = i + order[i..].iter().take_while(|e| e.0 == order[i].0).count();
+        let mut c = [0.0f64; 3];
+        for e in &order[i..j] {
+            let p = points[e.1 as usize];
+            for k in 0..3 {
+                c[k] += p[k];
+            }
+        }
+        let m = (j - i) as f64;
+        let c = [c[0] / m, c[1] / m, c[2] / m];
+        let d2 = |v: u32| {
+            let p = points[v as usize];
+            (p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2) + (p[2] - c[2]).powi(2)
+        };
+        let best = order[i..j]
+            .iter()
+            .map(|e| e.1)
+            .min_by(|&u, &v| d2(u).total_cmp(&d2(v)).then(u.cmp(&v)))
+            .expect("a voxel has a member");
+        out.push(best);
+        i = j;
+    }
+    out.sort_unstable();
+    out
 }
 
 fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -395,7 +451,18 @@ pub fn estimate_from(
         } else {
             quantile(&mut nv, 0.5)
         };
-        let (a, l2, l3) = scales(kind, d, sigma, given);
+        let (mut a, mut l2, mut l3) = scales(kind, d, sigma, given);
+        let (mut members, mut d) = (members, d);
+        if kind == StructureKind::Lines
+            && given.alpha.is_none()
+            && given.lambda3.is_none()
+            && C_NOISE * sigma >= C_REACH * d
+        {
+            let side = TUBE_VOXEL * a;
+            members = thin(points, &members, side);
+            d = side;
+            (a, l2, l3) = scales(kind, d, sigma, given);
+        }
         mode_scans.push(ModeScan {
             axis: m.axis,
             support: m.support,

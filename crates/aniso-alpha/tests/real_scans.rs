@@ -1,0 +1,254 @@
+//! Detection with every parameter from the data on real scans (the
+//! fixtures in `tests/fixtures/real/`, see their README): what a person
+//! holding a scan gets from `detect SCAN --structure planes` with no other
+//! flag. Also the two guarantees of the scan that the real-scan path leans
+//! on: tiles give the same result as one triangulation, and the thread
+//! count changes nothing.
+//!
+//! The scores are per point (structure vs background, as `eval`) and per
+//! labelled plane of at least 1,000 points: a plane is found when one part
+//! holds at least half of its points and at least half of that part's
+//! points are the plane's (the same rule as `scripts/bench_real.py`).
+
+use std::path::Path;
+
+use aniso_alpha::detect::detector::{Detection, Detector, Given, StructureKind};
+use aniso_alpha::io::{read_points, ReadOptions};
+
+fn fixture(name: &str) -> (Vec<[f64; 3]>, Option<Vec<i64>>) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/real").join(name);
+    let cloud = read_points(
+        &path,
+        &ReadOptions {
+            read_labels: true,
+            ..ReadOptions::default()
+        },
+    )
+    .unwrap();
+    (cloud.points, cloud.labels)
+}
+
+#[derive(Debug)]
+struct Score {
+    f1: f64,
+    found: usize,
+    big: usize,
+    parts: usize,
+}
+
+fn score(truth: &[i64], parts: &[i64], min_true: usize) -> Score {
+    let (mut tp, mut fp, mut fneg) = (0usize, 0usize, 0usize);
+    for (&t, &p) in truth.iter().zip(parts) {
+        match (t >= 0, p >= 0) {
+            (true, true) => tp += 1,
+            (false, true) => fp += 1,
+            (true, false) => fneg += 1,
+            _ => {}
+        }
+    }
+    let prec = tp as f64 / (tp + fp).max(1) as f64;
+    let rec = tp as f64 / (tp + fneg).max(1) as f64;
+    let f1 = 2.0 * prec * rec / (prec + rec).max(1e-12);
+    let nt = truth.iter().copied().max().unwrap_or(-1) + 1;
+    let np = parts.iter().copied().max().unwrap_or(-1) + 1;
+    let mut part_size = vec![0usize; np as usize];
+    for &p in parts.iter().filter(|&&p| p >= 0) {
+        part_size[p as usize] += 1;
+    }
+    let (mut found, mut big) = (0, 0);
+    for t in 0..nt {
+        let members: Vec<usize> = (0..truth.len()).filter(|&i| truth[i] == t).collect();
+        if members.len() < min_true {
+            continue;
+        }
+        big += 1;
+        let mut count = vec![0usize; np as usize];
+        for &i in &members {
+            if parts[i] >= 0 {
+                count[parts[i] as usize] += 1;
+            }
+        }
+        if let Some((p, &c)) = count.iter().enumerate().max_by_key(|&(_, c)| *c) {
+            if 2 * c >= members.len() && 2 * c > part_size[p] {
+                found += 1;
+            }
+        }
+    }
+    Score {
+        f1,
+        found,
+        big,
+        parts: part_size.len(),
+    }
+}
+
+/// What every planar part must carry: a unit plane through its points, a
+/// closed outline on that plane, a mesh over its own points.
+fn check_parts(det: &Detection, points: &[[f64; 3]]) {
+    for st in &det.structures {
+        for p in &st.parts {
+            let [a, b, c, d] = p.plane().expect("a planar part has a plane");
+            assert!(((a * a + b * b + c * c).sqrt() - 1.0).abs() < 1e-9);
+            let rms = p.primitive.rms();
+            assert!(rms.is_finite());
+            assert!(p.outline.len() >= 3, "outline of {} points", p.outline.len());
+            for q in &p.outline {
+                assert!((a * q[0] + b * q[1] + c * q[2] + d).abs() < 1e-6 * (1.0 + d.abs()));
+            }
+            let mut own = p.vertices.clone();
+            own.sort_unstable();
+            for t in &p.mesh {
+                for v in t {
+                    assert!(own.binary_search(v).is_ok(), "mesh vertex outside its part");
+                }
+            }
+            // The part's points lie near its plane (loosely: the claim
+            // distance is a few alphas at most).
+            let far = p
+                .vertices
+                .iter()
+                .map(|&v| {
+                    let q = points[v as usize];
+                    (a * q[0] + b * q[1] + c * q[2] + d).abs()
+                })
+                .fold(0.0, f64::max);
+            assert!(far <= 10.0 * rms.max(1e-9) + 1.0, "a point {far} off its plane");
+        }
+    }
+}
+
+#[test]
+fn ball_every_plane_from_the_data() {
+    let (points, truth) = fixture("ball.ply");
+    let truth = truth.unwrap();
+    let det = Detector::auto(StructureKind::Planes, &points, &Given::default())
+        .unwrap()
+        .run(&points)
+        .unwrap();
+    let s = score(&truth, &det.part_labels(), 1000);
+    eprintln!("ball: {s:?}, {} orientations", det.stats.orientations);
+    assert_eq!(s.big, 20);
+    assert!(s.found >= 19, "{s:?}");
+    assert!(s.f1 >= 0.95, "{s:?}");
+    assert!(s.parts <= 24, "{s:?}");
+    check_parts(&det, &points);
+}
+
+#[test]
+fn building_planes_from_the_data() {
+    // A regression guard at the level measured (BENCHMARKS.md, real
+    // scans): 8 of the 11 labelled planes of >= 1,000 points, F1 0.815.
+    // The misses are stepped facades that the labels count as one plane.
+    let (points, truth) = fixture("building.ply");
+    let truth = truth.unwrap();
+    let det = Detector::auto(StructureKind::Planes, &points, &Given::default())
+        .unwrap()
+        .run(&points)
+        .unwrap();
+    let s = score(&truth, &det.part_labels(), 1000);
+    eprintln!("building: {s:?}, {} orientations", det.stats.orientations);
+    assert_eq!(s.big, 11);
+    assert!(s.found >= 8, "{s:?}");
+    assert!(s.f1 >= 0.78, "{s:?}");
+    check_parts(&det, &points);
+}
+
+#[test]
+fn mixed_density_keeps_every_plane() {
+    // The ball thinned as a static scanner sees it: the density falls with
+    // the squared distance from a station beside the object, from every
+    // point kept near it to about a tenth at the far side (fixed seed).
+    let (points, truth) = fixture("ball.ply");
+    let truth = truth.unwrap();
+    let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
+    for p in &points {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let size = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
+    let station = [lo[0] - 0.15 * size, 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])];
+    let dist = |p: &[f64; 3]| ((0..3).map(|k| (p[k] - station[k]).powi(2)).sum::<f64>()).sqrt();
+    let near = points.iter().map(dist).fold(f64::MAX, f64::min);
+    let mut state = 0x5eed_u64;
+    let mut uniform = || {
+        // SplitMix64.
+        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let (mut kept, mut kept_truth) = (Vec::new(), Vec::new());
+    for (p, &t) in points.iter().zip(&truth) {
+        if uniform() < (near / dist(p)).powi(2) {
+            kept.push(*p);
+            kept_truth.push(t);
+        }
+    }
+    let det = Detector::auto(StructureKind::Planes, &kept, &Given::default())
+        .unwrap()
+        .run(&kept)
+        .unwrap();
+    // Planes that kept at least 300 points (a third of the 1,000 rule).
+    let s = score(&kept_truth, &det.part_labels(), 300);
+    eprintln!("ball thinned to {} points: {s:?}", kept.len());
+    assert!(kept.len() < points.len() / 2);
+    assert!(s.big >= 15, "{s:?}");
+    assert!(s.found + 2 >= s.big, "{s:?}");
+    assert!(s.f1 >= 0.9, "{s:?}");
+}
+
+#[test]
+fn tiles_give_the_untiled_result() {
+    // Tiles smaller than the planes (a quarter of the object's size), so
+    // that parts cross tile borders; the halos make every tile's kept
+    // simplices exactly the whole cloud's (docs/method.md §8).
+    let (points, _) = fixture("ball.ply");
+    let auto = Detector::auto(StructureKind::Planes, &points, &Given::default()).unwrap();
+    let whole = auto.clone().run(&points).unwrap();
+    let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
+    for p in &points {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let size = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
+    let tiled = auto.tile(Some(size / 4.0)).run(&points).unwrap();
+    assert!(!whole.simplices.is_empty());
+    assert_eq!(whole.simplices, tiled.simplices);
+    assert_eq!(whole.labels, tiled.labels);
+    assert_eq!(whole.part_labels(), tiled.part_labels());
+    assert_eq!(whole.structures, tiled.structures);
+}
+
+#[test]
+fn thread_count_changes_nothing() {
+    let (points, _) = fixture("building.ply");
+    // A third of the building keeps the test short.
+    let points: Vec<[f64; 3]> = points.into_iter().step_by(3).collect();
+    let auto = Detector::auto(StructureKind::Planes, &points, &Given::default()).unwrap();
+    let one = auto.clone().threads(1).run(&points).unwrap();
+    let two = auto.threads(2).run(&points).unwrap();
+    assert!(!one.structures.is_empty());
+    assert_eq!(one, two);
+}
+
+#[test]
+fn the_score_can_fail() {
+    // The scorer's oracle check: a labelling that splits every plane in
+    // two finds none of them, and the empty labelling scores zero.
+    let truth: Vec<i64> = (0..4000).map(|i| i / 2000).collect();
+    let halves: Vec<i64> = (0..4000).map(|i| i / 1000).collect();
+    let s = score(&truth, &halves, 1000);
+    assert_eq!((s.found, s.big), (0, 2));
+    assert!((s.f1 - 1.0).abs() < 1e-12);
+    let none = vec![-1i64; 4000];
+    let s = score(&truth, &none, 1000);
+    assert_eq!(s.found, 0);
+    assert_eq!(s.f1, 0.0);
+    let same = score(&truth, &truth, 1000);
+    assert_eq!(same.found, 2);
+}

@@ -1,0 +1,175 @@
+#!/usr/bin/env python3
+"""Plane detection on real scans: aniso-alpha's automatic mode against
+CGAL's Efficient RANSAC, CGAL's region growing and an Open3D
+`segment_plane` loop, in one run, on the same files (issue: real scans).
+
+    python3 scripts/bench_real.py [--repeat 3] [--bin target/release/aniso-alpha]
+        [--peer /work/peers-bin/cgal_shapes] [--scans building,ball]
+
+Needs: numpy; open3d for the Open3D peer (skipped without it); the CGAL
+peer built from scripts/peers/cgal_shapes.cpp (skipped without it; see the
+build line in BENCHMARKS.md). Scans: the labelled fixtures in
+crates/aniso-alpha/tests/fixtures/real/ (binary PLY, x y z label).
+
+Scores, as tests/real_scans.rs: per-point precision / recall / F1 of
+"in a plane" against the labels, and the labelled planes of >= 1,000
+points found (one part holds at least half of the plane's points, and at
+least half of that part's points are the plane's). Times: the wall time of
+each process (reading included), median of the repeats, and the ratio to
+Efficient RANSAC's wall time in the same run.
+
+aniso-alpha runs with no parameter at all. The peers get parameters: the
+CGAL defaults where they do well, and where they do not, values tuned by
+hand on that scan (listed in PEER_PARAMS; an advantage to the peers).
+"""
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+FIXTURES = os.path.join(ROOT, "crates/aniso-alpha/tests/fixtures/real")
+
+# Hand-tuned on each scan (a sweep of epsilon 0.05-0.5 and cluster epsilon
+# 0.2-2 for the building); the ball keeps CGAL's defaults.
+PEER_PARAMS = {
+    "building": {"ransac": {"epsilon": 0.3, "cluster-epsilon": 1.0, "min-points": 200},
+                 "region": {"epsilon": 0.3, "min-points": 200},
+                 "open3d": {"distance": 0.3, "min_points": 200}},
+    "ball": {"ransac": {}, "region": {},
+             "open3d": {"distance": 0.05, "min_points": 200}},
+}
+
+
+def read_ply(path):
+    with open(path, "rb") as f:
+        data = f.read()
+    end = data.index(b"end_header\n") + len(b"end_header\n")
+    header = data[:end].decode()
+    n = int(header.split("element vertex ")[1].split()[0])
+    rec = np.frombuffer(data[end:], dtype=[("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("label", "<i4")], count=n)
+    xyz = np.stack([rec["x"], rec["y"], rec["z"]], axis=1).astype(np.float64)
+    return xyz, rec["label"].astype(np.int64)
+
+
+def score(truth, pred, min_true=1000):
+    tp = np.sum((truth >= 0) & (pred >= 0))
+    fp = np.sum((truth < 0) & (pred >= 0))
+    fn = np.sum((truth >= 0) & (pred < 0))
+    p = tp / max(tp + fp, 1)
+    r = tp / max(tp + fn, 1)
+    f1 = 2 * p * r / max(p + r, 1e-12)
+    found = big = 0
+    for t, c in zip(*np.unique(truth[truth >= 0], return_counts=True)):
+        if c < min_true:
+            continue
+        big += 1
+        m = truth == t
+        ps, cs = np.unique(pred[m & (pred >= 0)], return_counts=True)
+        if len(ps):
+            j = np.argmax(cs)
+            if 2 * cs[j] >= c and 2 * cs[j] > np.sum(pred == ps[j]):
+                found += 1
+    parts = len(np.unique(pred[pred >= 0]))
+    return dict(precision=round(float(p), 3), recall=round(float(r), 3), f1=round(float(f1), 3),
+                found=found, big=big, parts=parts)
+
+
+def run_ours(binary, ply, out):
+    t = time.perf_counter()
+    subprocess.run([binary, "detect", ply, "--structure", "planes", "--part-labels", out, "--quiet"],
+                   check=True, capture_output=True)
+    return time.perf_counter() - t, np.loadtxt(out, dtype=np.int64)
+
+
+def run_cgal(peer, mode, xyz, out, params):
+    args = [peer, mode, xyz, out]
+    for k, v in params.items():
+        args += ["--" + k, str(v)]
+    t = time.perf_counter()
+    r = subprocess.run(args, check=True, capture_output=True, text=True)
+    wall = time.perf_counter() - t
+    info = json.loads(r.stdout.strip().splitlines()[-1])
+    return wall, np.loadtxt(out, dtype=np.int64), info
+
+
+def run_open3d(pts, distance, min_points, max_planes=60):
+    import open3d as o3d
+    t = time.perf_counter()
+    rest = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(pts))
+    idx = np.arange(len(pts))
+    lab = -np.ones(len(pts), np.int64)
+    k = 0
+    while k < max_planes and len(idx) >= min_points:
+        _, inl = rest.segment_plane(distance_threshold=distance, ransac_n=3, num_iterations=1000)
+        if len(inl) < min_points:
+            break
+        lab[idx[inl]] = k
+        k += 1
+        keep = np.ones(len(idx), bool)
+        keep[inl] = False
+        idx = idx[keep]
+        rest = rest.select_by_index(inl, invert=True)
+    return time.perf_counter() - t, lab
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--bin", default=os.path.join(ROOT, "target/release/aniso-alpha"))
+    ap.add_argument("--peer", default="/work/peers-bin/cgal_shapes")
+    ap.add_argument("--scans", default="building,ball")
+    a = ap.parse_args()
+    try:
+        import open3d  # noqa: F401
+        have_o3d = True
+    except ImportError:
+        have_o3d = False
+        print("(open3d not importable: its peer is skipped)", file=sys.stderr)
+    have_cgal = os.access(a.peer, os.X_OK)
+    if not have_cgal:
+        print(f"({a.peer} not found: the CGAL peers are skipped)", file=sys.stderr)
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for name in a.scans.split(","):
+            ply = os.path.join(FIXTURES, name + ".ply")
+            pts, truth = read_ply(ply)
+            xyz = os.path.join(tmp, name + ".xyz")
+            np.savetxt(xyz, pts, fmt="%.6f")
+            out = os.path.join(tmp, name + ".labels")
+            runs = {}
+            for _ in range(a.repeat):
+                w, lab = run_ours(a.bin, ply, out)
+                runs.setdefault("aniso-alpha (auto)", []).append((w, lab, None))
+                if have_cgal:
+                    for mode in ("ransac", "region"):
+                        w, lab, info = run_cgal(a.peer, mode, xyz, out, PEER_PARAMS[name][mode])
+                        runs.setdefault("CGAL " + ("Efficient RANSAC" if mode == "ransac" else "region growing"),
+                                        []).append((w, lab, info))
+                if have_o3d:
+                    p = PEER_PARAMS[name]["open3d"]
+                    w, lab = run_open3d(pts, p["distance"], p["min_points"])
+                    runs.setdefault("Open3D segment_plane loop", []).append((w, lab, None))
+            base = statistics.median(w for w, _, _ in runs.get("CGAL Efficient RANSAC", [(float("nan"), 0, 0)]))
+            for peer, rs in runs.items():
+                wall = statistics.median(w for w, _, _ in rs)
+                s = score(truth, rs[-1][1])
+                inproc = ""
+                if rs[-1][2]:
+                    inproc = "%.2f" % statistics.median(r[2]["normals_seconds"] + r[2]["detect_seconds"] for r in rs)
+                rows.append((name, len(pts), peer, wall, wall / base, inproc, s))
+    print("| scan | points | method | wall s (median of %d) | / RANSAC wall | in-process s | planes found (>= 1k) | parts | P | R | F1 |" % a.repeat)
+    print("|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+    for name, n, peer, wall, ratio, inproc, s in rows:
+        print(f"| {name} | {n} | {peer} | {wall:.2f} | {ratio:.1f}x | {inproc} | {s['found']}/{s['big']} | {s['parts']} "
+              f"| {s['precision']} | {s['recall']} | {s['f1']} |")
+
+
+if __name__ == "__main__":
+    main()
