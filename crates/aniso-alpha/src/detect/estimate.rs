@@ -37,15 +37,15 @@
 //!      and λ = clamp(C_REACH·d/α, 1, λ_max). Very noisy structures
 //!      (σ above about d/2) get λ = 1: the Euclidean α-shape, as measured
 //!      on the noisy walls of the CGAL building scan.
-//!    4b. **Thick lines** (k = 1, when C_NOISE·σ ≥ C_REACH·d, so λ would
-//!    be 1): the line is a tube (a pole, a trunk, a cable's point
-//!    swarm) many points across, whose α-shape is a surface, not a path.
-//!    It is a line at a coarser scale: the mode's members are thinned to
-//!    one point per voxel of side [`TUBE_VOXEL`]·α (the member nearest to
-//!    its voxel's centroid), so consecutive kept points lie about a voxel
-//!    apart along the tube and one across; the spacing becomes the voxel
-//!    side and λ = C_REACH·voxel/α = 4. The assembly's claims give the
-//!    parts back every input point within α of their segment.
+//!    * **thick lines** (k = 1, when C_NOISE·σ ≥ C_REACH·d, so λ would be 1):
+//!      the line is a tube (a pole, a trunk, a cable's point swarm) many points
+//!      across, whose α-shape is a surface, not a path. It is a line at a
+//!      coarser scale: the mode's members are thinned along the mode's direction
+//!      (a kept point excludes the others within [`TUBE_STEP`]·α along it and
+//!      [`TUBE_WIDTH`]·α across), so the kept points of a tube form one chain,
+//!      TUBE_STEP·α to twice that apart; the spacing becomes that step and λ =
+//!      C_REACH·step/α = 4. The assembly's claims give the parts back every
+//!      input point within α of their segment.
 //! 5. **nb_c** = [`NB_C_AUTO`]: the path filter then only cuts spurs and
 //!    fins of a few simplices; what is chance is decided by the
 //!    significance test ([`super::significance`]).
@@ -56,6 +56,7 @@ use super::local::{local_shapes, LocalShape};
 use super::modes::{modes, Mode};
 use super::StructureKind;
 use crate::aniso::{completion_first_row, completion_third_row, Mat3};
+use crate::geometry::kdtree::KdTree;
 
 /// Score (planarity or linearity) from which a point is structure-like: the
 /// midpoint of the features' range [0, 1].
@@ -92,10 +93,16 @@ pub const C_REACH: f64 = 2.0;
 /// Largest elongation chosen.
 pub const LAMBDA_MAX: f64 = 8.0;
 
-/// Thinning of a thick line (module doc, step 4b): the side of the voxels
-/// in units of α, so that a voxel holds the whole cross-section of the
-/// tube (its diameter is about 2·C_NOISE·σ = 2α).
-pub const TUBE_VOXEL: f64 = 2.0;
+/// Thinning of a thick line (module doc, step 4b): the step between kept
+/// points along the tube in units of α: the tube's diameter, about
+/// 2·C_NOISE·σ = 2α, so that consecutive kept points are farther apart
+/// along the tube than across it.
+pub const TUBE_STEP: f64 = 2.0;
+
+/// Thinning of a thick line: the width within which kept points exclude
+/// one another, in units of α: twice the tube's diameter (2α), so that a
+/// cross-section keeps one point wherever it is cut.
+pub const TUBE_WIDTH: f64 = 4.0;
 
 /// The path filter's nb_c in the automatic mode.
 pub const NB_C_AUTO: u32 = 4;
@@ -204,45 +211,43 @@ fn scales(kind: StructureKind, d: f64, sigma: f64, given: &Given) -> (f64, f64, 
     (alpha, l2, l3)
 }
 
-/// One member per voxel of side `side`: the one nearest to the centroid of
-/// its voxel's members (the lowest index on a tie); ascending indices.
-fn thin(points: &[[f64; 3]], members: &[u32], side: f64) -> Vec<u32> {
-    let key = |i: u32| {
-        let p = points[i as usize];
-        [
-            (p[0] / side).floor() as i64,
-            (p[1] / side).floor() as i64,
-            (p[2] / side).floor() as i64,
-        ]
-    };
-    let mut order: Vec<([i64; 3], u32)> = members.iter().map(|&i| (key(i), i)).collect();
-    order.sort_unstable();
+/// A thinning of a tube's members along `axis` (module doc, step 4b):
+/// members taken in index order, each kept unless a kept one lies within
+/// `step` of it along the axis and within `width` across; ascending
+/// indices. Within a tube narrower than `width` the kept points follow one
+/// another at `step` to `2·step` along it, one chain; tubes farther apart
+/// than `width` keep their own chains.
+fn thin_along(
+    points: &[[f64; 3]],
+    members: &[u32],
+    axis: [f64; 3],
+    step: f64,
+    width: f64,
+) -> Vec<u32> {
+    let tree = KdTree::new(points, Some(members.to_vec()));
+    let mut kept_flag = vec![false; points.len()];
     let mut out = Vec::new();
-    let mut i = 0;
-    while i < order.len() {
-        let j = i + order[i..].iter().take_while(|e| e.0 == order[i].0).count();
-        let mut c = [0.0f64; 3];
-        for e in &order[i..j] {
-            let p = points[e.1 as usize];
-            for k in 0..3 {
-                c[k] += p[k];
+    let reach = (step * step + width * width).sqrt();
+    for &i in members {
+        let p = points[i as usize];
+        let mut blocked = false;
+        tree.within(&p, reach, |j| {
+            if blocked || !kept_flag[j as usize] {
+                return;
             }
+            let q = points[j as usize];
+            let w = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
+            let along = dot(w, axis);
+            let across2 = (dot(w, w) - along * along).max(0.0);
+            if along.abs() < step && across2 < width * width {
+                blocked = true;
+            }
+        });
+        if !blocked {
+            kept_flag[i as usize] = true;
+            out.push(i);
         }
-        let m = (j - i) as f64;
-        let c = [c[0] / m, c[1] / m, c[2] / m];
-        let d2 = |v: u32| {
-            let p = points[v as usize];
-            (p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2) + (p[2] - c[2]).powi(2)
-        };
-        let best = order[i..j]
-            .iter()
-            .map(|e| e.1)
-            .min_by(|&u, &v| d2(u).total_cmp(&d2(v)).then(u.cmp(&v)))
-            .expect("a voxel has a member");
-        out.push(best);
-        i = j;
     }
-    out.sort_unstable();
     out
 }
 
@@ -458,9 +463,9 @@ pub fn estimate_from(
             && given.lambda3.is_none()
             && C_NOISE * sigma >= C_REACH * d
         {
-            let side = TUBE_VOXEL * a;
-            members = thin(points, &members, side);
-            d = side;
+            let step = TUBE_STEP * a;
+            members = thin_along(points, &members, m.axis, step, TUBE_WIDTH * a);
+            d = step;
             (a, l2, l3) = scales(kind, d, sigma, given);
         }
         mode_scans.push(ModeScan {
@@ -487,5 +492,51 @@ pub fn estimate_from(
         lambda3: lambda3_p,
         min_size: min_size_p,
         modes: mode_scans,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn thin_along_keeps_one_chain_per_tube() {
+        // Two vertical tubes of radius 0.1, 2 apart, 10 long, sampled
+        // densely (rings of 12 points every 0.02).
+        let mut pts = Vec::new();
+        for x0 in [0.0, 2.0] {
+            for k in 0..500 {
+                for j in 0..12 {
+                    let t = j as f64 * std::f64::consts::TAU / 12.0 + k as f64 * 0.1;
+                    pts.push([x0 + 0.1 * t.cos(), 0.1 * t.sin(), k as f64 * 0.02]);
+                }
+            }
+        }
+        let ids: Vec<u32> = (0..pts.len() as u32).collect();
+        let (step, width) = (0.2, 0.4);
+        let kept = thin_along(&pts, &ids, [0.0, 0.0, 1.0], step, width);
+        for x0 in [0.0, 2.0] {
+            let mut z: Vec<f64> = kept
+                .iter()
+                .map(|&i| pts[i as usize])
+                .filter(|p| (p[0] - x0).abs() < 0.5)
+                .map(|p| p[2])
+                .collect();
+            z.sort_by(f64::total_cmp);
+            // One chain: consecutive kept points at least a step apart
+            // along the tube and at most two steps (a point is only
+            // excluded by a kept one within a step).
+            assert!(z.len() >= 25 && z.len() <= 51, "{} kept", z.len());
+            for w in z.windows(2) {
+                assert!(w[1] - w[0] >= step - 1e-12, "{w:?}");
+                assert!(w[1] - w[0] <= 2.0 * step + 0.02, "{w:?}");
+            }
+        }
+        // Ascending, a subset.
+        assert!(kept.windows(2).all(|w| w[0] < w[1]));
+        // A width over the gap between the tubes makes their points
+        // exclude each other: fewer are kept.
+        let wide = thin_along(&pts, &ids, [0.0, 0.0, 1.0], step, 2.5);
+        assert!(wide.len() < kept.len());
     }
 }

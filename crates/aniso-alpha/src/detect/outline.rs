@@ -42,6 +42,10 @@ pub struct Outline {
     pub polygon: Vec<[f64; 3]>,
 }
 
+/// Doublings of the radius tried before the convex hull, for a part with no
+/// triangle at its own radius (`outline`).
+const OUTLINE_DOUBLINGS: usize = 6;
+
 fn circumradius2(a: Point2<f64>, b: Point2<f64>, c: Point2<f64>) -> f64 {
     let (bx, by) = (b.x - a.x, b.y - a.y);
     let (cx, cy) = (c.x - a.x, c.y - a.y);
@@ -90,22 +94,34 @@ pub fn outline(points: &[[f64; 3]], ids: &[u32], plane: &PlaneFit, r: f64) -> Ou
     let Ok(tri) = DelaunayTriangulation::<V>::bulk_load(verts) else {
         return Outline::default();
     };
-    let r2 = r * r;
     // Kept triangles (spade's faces are counter-clockwise in (u, v), and
     // (a0, a1, normal) is right-handed, so they are counter-clockwise seen
-    // from the normal).
+    // from the normal). A part too sparse for radius r (a strip one or two
+    // points wide, claimed along a fitted plane) has no triangle at r: the
+    // radius doubles until one is kept, up to the convex hull (r = ∞), so
+    // every planar part of three non-collinear points has an outline.
     let mut triangles: Vec<[u32; 3]> = Vec::new();
     let mut edges: Vec<(u32, u32)> = Vec::new(); // directed, of kept triangles
     let mut pos: Vec<(u32, Point2<f64>)> = Vec::new();
-    for f in tri.inner_faces() {
-        let [a, b, cc] = f.vertices();
-        let (pa, pb, pc) = (a.data().p, b.data().p, cc.data().p);
-        if circumradius2(pa, pb, pc) <= r2 {
-            let t = [a.data().id, b.data().id, cc.data().id];
-            triangles.push(t);
-            edges.extend([(t[0], t[1]), (t[1], t[2]), (t[2], t[0])]);
-            pos.extend([(t[0], pa), (t[1], pb), (t[2], pc)]);
+    let mut r2 = r * r;
+    for attempt in 0..=OUTLINE_DOUBLINGS {
+        if attempt == OUTLINE_DOUBLINGS {
+            r2 = f64::INFINITY;
         }
+        for f in tri.inner_faces() {
+            let [a, b, cc] = f.vertices();
+            let (pa, pb, pc) = (a.data().p, b.data().p, cc.data().p);
+            if circumradius2(pa, pb, pc) <= r2 {
+                let t = [a.data().id, b.data().id, cc.data().id];
+                triangles.push(t);
+                edges.extend([(t[0], t[1]), (t[1], t[2]), (t[2], t[0])]);
+                pos.extend([(t[0], pa), (t[1], pb), (t[2], pc)]);
+            }
+        }
+        if !triangles.is_empty() {
+            break;
+        }
+        r2 *= 4.0;
     }
     triangles.sort_unstable();
     pos.sort_by_key(|x| x.0);
@@ -210,9 +226,30 @@ mod tests {
         assert!((a - 300.5).abs() < 1e-6, "area {a}");
         // The convex hull would have area 400: the notch is there.
         assert!(o.polygon.iter().all(|p| (p[2] - 3.0).abs() < 1e-9));
-        // A larger radius does not change a grid's α-shape much, a tiny one
-        // keeps nothing.
-        assert!(outline(&pts, &ids, &plane, 0.5).triangles.is_empty());
+        // A radius too small for any triangle (0.5 < 0.71) is doubled
+        // until triangles are kept: here at 1, the same shape.
+        assert_eq!(outline(&pts, &ids, &plane, 0.5), o);
+    }
+
+    #[test]
+    fn sparse_strip_still_has_an_outline() {
+        // Two rows 10 apart, points 1 apart along them: no triangle has a
+        // circumradius under 5, so at radius 1 the α-shape is empty and the
+        // doubling (2, 4, 8) gives the strip between the rows.
+        let mut pts = Vec::new();
+        for i in 0..=20 {
+            pts.push([i as f64, 0.0, 1.0]);
+            pts.push([i as f64 + 0.5, 10.0, 1.0]);
+        }
+        let ids: Vec<u32> = (0..pts.len() as u32).collect();
+        let plane = fit_plane_indices(&pts, &ids).unwrap();
+        let o = outline(&pts, &ids, &plane, 1.0);
+        assert!(!o.triangles.is_empty());
+        assert!(o.polygon.len() >= 4);
+        let a = area(&o.polygon).abs();
+        assert!(a > 150.0 && a <= 20.5 * 10.0 + 1e-9, "area {a}");
+        // Fewer than three points have no outline.
+        assert_eq!(outline(&pts, &ids[..2], &plane, 1.0), Outline::default());
     }
 
     #[test]
