@@ -46,5 +46,8 @@ fn laz_rgb_symbol_index() {
     let bytes = std::fs::read(&path).unwrap();
     let e = read_points_bytes(&path, &bytes, &ReadOptions::default()).unwrap_err();
     assert!(matches!(e, IoError::Format { .. }), "{e}");
-    assert!(e.to_string().contains("decoder failed on corrupt data"), "{e}");
+    assert!(
+        e.to_string().contains("decoder failed on corrupt data"),
+        "{e}"
+    );
 }

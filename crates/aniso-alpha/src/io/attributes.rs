@@ -137,6 +137,7 @@ impl Values {
 
     /// Value `i` as an `f64` (exact for every type but 64-bit integers
     /// beyond 2^53).
+    #[allow(clippy::unnecessary_cast)] // `as f64` is a no-op for the F64 arm
     pub fn get_f64(&self, i: usize) -> f64 {
         each!(self, v => v[i] as f64)
     }

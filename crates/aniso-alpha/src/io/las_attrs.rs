@@ -334,7 +334,7 @@ impl Names {
 /// bytes).
 pub(crate) fn record_attributes(src: &LasSource) -> Vec<Attribute> {
     let len = src.record_len;
-    let n = if len == 0 { 0 } else { src.records.len() / len };
+    let n = src.records.len().checked_div(len).unwrap_or(0);
     let recs = || src.records.chunks_exact(len);
     let mut taken = Names::new(&["x", "y", "z"]);
     let mut out = Vec::new();
