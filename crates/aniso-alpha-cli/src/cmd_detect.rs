@@ -394,7 +394,7 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
         crate::view::write_html(
             p,
             &name,
-            &points,
+            points,
             &det.labels,
             &part_labels,
             &report,
@@ -402,7 +402,7 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
         )?;
     }
     if let Some(p) = &args.png {
-        crate::picture::write_detection_png(p, &points, &det, &part_labels, timings)?;
+        crate::picture::write_detection_png(p, points, &det, &part_labels, timings)?;
     }
     let mut out = summary(&name, &det, &detector, &report, seconds);
     if let Some(ev) = &scores {

@@ -2,6 +2,8 @@
 //! laspy's test data and CGAL's `urban.las`, checked against the `las`
 //! crate), and kept by `write_labelled_cloud` (LAS/LAZ records byte for
 //! byte, PLY properties), with the structure and part ids added.
+// Rows of every PLY scalar type, and loops over parallel columns.
+#![allow(clippy::type_complexity, clippy::needless_range_loop)]
 
 use std::path::{Path, PathBuf};
 

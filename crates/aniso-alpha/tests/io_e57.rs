@@ -103,6 +103,7 @@ fn cartesian_float_rgb_reads_like_the_e57_crate() {
 }
 
 #[test]
+#[allow(clippy::approx_constant)] // the generator's own 3.14, not π
 fn spherical_points_are_converted_and_invalid_ones_skipped() {
     let path = fixture("tiny_spherical.e57");
     let c = read_points(&path, &with_attributes()).unwrap();
