@@ -64,9 +64,16 @@ fn check(r: Result<PointCloud, IoError>) {
 
 fn contained(file: &str) -> bool {
     // The registry's las-0.x/laz-0.x, and the patched laz in vendor/laz.
-    ["/laz-", "/las-", "\\laz-", "\\las-", "vendor/laz/", "vendor\\laz\\"]
-        .iter()
-        .any(|c| file.contains(c))
+    [
+        "/laz-",
+        "/las-",
+        "\\laz-",
+        "\\las-",
+        "vendor/laz/",
+        "vendor\\laz\\",
+    ]
+    .iter()
+    .any(|c| file.contains(c))
 }
 
 fuzz_target!(
