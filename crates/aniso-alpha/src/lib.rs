@@ -57,4 +57,6 @@ pub mod synth;
 
 pub use alpha::AlphaComplex;
 pub use delaunay::{DelaunayError, Triangulation};
-pub use io::read_points;
+pub use detect::detector::{DetectError, Detection, Detector, Given};
+pub use detect::StructureKind;
+pub use io::{read_points, IoError, PointCloud, ReadOptions};

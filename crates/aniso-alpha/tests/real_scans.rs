@@ -12,9 +12,8 @@
 
 use std::path::Path;
 
-use aniso_alpha::detect::detector::{Detection, Detector, Given};
-use aniso_alpha::detect::StructureKind;
-use aniso_alpha::io::{read_points, ReadOptions};
+// The crate root's API, as a user writes it.
+use aniso_alpha::{read_points, Detection, Detector, Given, ReadOptions, StructureKind};
 
 fn fixture(name: &str) -> (Vec<[f64; 3]>, Option<Vec<i64>>) {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
