@@ -280,11 +280,13 @@ fn pcd_keeps_fields_splits_counts_and_unpacks_rgb() {
 
 // ------------------------------------------------------------------ LAS
 
+#[cfg(feature = "las")]
 const FIXTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/las");
 
 /// The real LAS/LAZ files: laspy's test data (formats 1, 3, 4, 6, 7; LAS
 /// 1.2 to 1.4; extended VLRs, a COPC file, described and undescribed
 /// extra bytes) and CGAL's `urban.las`.
+#[cfg(feature = "las")]
 const REAL: [&str; 11] = [
     "simple.las",
     "simple.laz",

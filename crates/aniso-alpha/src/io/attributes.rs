@@ -249,7 +249,8 @@ impl Vlr {
         &self.user_id[..end] == user && self.record_id == record_id
     }
 
-    /// The 54-byte VLR header followed by the payload.
+    /// The 54-byte VLR header followed by the payload (the LAS writer's).
+    #[cfg_attr(not(feature = "las"), allow(dead_code))]
     pub(crate) fn to_bytes(&self, out: &mut Vec<u8>) {
         out.extend_from_slice(&self.reserved.to_le_bytes());
         out.extend_from_slice(&self.user_id);

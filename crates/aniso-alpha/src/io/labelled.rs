@@ -18,8 +18,10 @@
 
 use std::path::Path;
 
+#[cfg(feature = "las")]
+use super::atomic_write;
 use super::attributes::{Attribute, Values};
-use super::{atomic_write, IoError, Mesh, PlyEncoding, PointCloud};
+use super::{IoError, Mesh, PlyEncoding, PointCloud};
 
 /// What [`write_labelled_cloud`] adds to a cloud.
 #[derive(Debug, Clone, Copy)]
