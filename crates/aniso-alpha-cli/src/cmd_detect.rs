@@ -8,7 +8,7 @@ use aniso_alpha::detect::detector::{Detection, Detector, Given, OrientationSet, 
 use aniso_alpha::detect::orientations::Sampler;
 use aniso_alpha::detect::StructureKind;
 use aniso_alpha::eval::evaluate;
-use aniso_alpha::io::{write_scene, Mesh, ReadOptions};
+use aniso_alpha::io::{write_scene, Labelled, Mesh, PointCloud, ReadOptions};
 use aniso_alpha::report::detection_json;
 use aniso_alpha::synth::SceneOptions;
 use clap::{Args, ValueEnum};
@@ -37,12 +37,19 @@ alpha is a radius (the short semi-axis of the ellipsoid), not CGAL's squared alp
 Without INPUT, runs on a built-in example scene (a Fig. 10-like polyhedron in uniform background, \
 planes, alpha 1, lambda2 4, lambda3 8, min-size 20) and says where it wrote its results.\n\
 --labels writes one integer per input point: its structure id, or -1; --part-labels its part \
-(plane or segment) id, or -1. Parts are disjoint.\n\n\
+(plane or segment) id, or -1. Parts are disjoint.\n\
+--output OUT.las|.laz|.ply writes the input cloud back with every attribute it had (a LAS/LAZ \
+input's records byte for byte; another input to LAS becomes point format 0 with its attributes \
+as extra bytes) and two int32 fields, structure and part (-1 off the structures); .obj writes \
+the parts' meshes only. --classify planes=6 also gives the structures' points that LAS class; \
+--background-classes 7,18 leaves the points of those classes out of the detection (labelled -1).\n\n\
 Examples:\n  aniso-alpha detect\n  \
 aniso-alpha detect scan.ply --structure planes --labels labels.txt --part-labels parts.txt --report report.json\n  \
 aniso-alpha detect scene.xyz --structure lines --alpha 1 --lambda3 10 --min-size 4 --labels labels.txt\n  \
 aniso-alpha detect scan.ply --structure planes --alpha 1 --lambda2 4 --lambda3 8 --min-size 20 \
---output planes.ply --report report.json --threads 2"
+--output planes.ply --report report.json --threads 2\n  \
+aniso-alpha detect scan.laz --structure planes --output scan_labelled.laz --classify planes=6 \
+--background-classes 7,18"
 )]
 pub struct DetectArgs {
     /// Input point file; omit it to run the built-in example
@@ -93,11 +100,22 @@ pub struct DetectArgs {
     /// Write one part (plane or segment) label per input point, or -1
     #[arg(long, value_name = "OUT.txt")]
     pub part_labels: Option<PathBuf>,
-    /// Write the input points with their structure and part ids and one
-    /// clean mesh per part (PLY faces and edges with structure and part
-    /// ids, or OBJ by extension)
-    #[arg(long, value_name = "OUT.ply")]
+    /// Write the input points with every attribute they had, their
+    /// structure and part ids, and one clean mesh per part: PLY (faces and
+    /// edges with structure and part ids), LAS/LAZ (every record kept byte
+    /// for byte, the ids as two int32 extra-bytes fields), or OBJ
+    /// (geometry only), by extension
+    #[arg(long, value_name = "OUT.ply|las|laz")]
     pub output: Option<PathBuf>,
+    /// With a .las/.laz/.ply --output: give the points of the structures
+    /// found this LAS classification, e.g. planes=6 (building)
+    #[arg(long, value_name = "KIND=CLASS", value_parser = common::parse_classify, requires = "output")]
+    pub classify: Option<common::Classify>,
+    /// Exclude the points of these LAS classes from the detection
+    /// (labelled -1), comma-separated, e.g. 7,18 (noise); needs a
+    /// classification (LAS, or a PLY/PCD 'classification' property)
+    #[arg(long, value_name = "C1,C2,...", value_parser = common::parse_classes)]
+    pub background_classes: Option<aniso_alpha::io::ClassSet>,
     /// Write the raw union of the scanned alpha-shapes (debugging; PLY or OBJ)
     #[arg(long, value_name = "OUT.ply")]
     pub union: Option<PathBuf>,
@@ -205,7 +223,23 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
         std::fs::create_dir_all(&dir)
             .map_err(|e| CliError::msg(format!("{}: cannot create folder: {e}", dir.display())))?;
     }
-    for out in [&output_path, &args.union].into_iter().flatten() {
+    let labelled_output = match &output_path {
+        Some(p) => common::cloud_output(p)? == common::CloudOutput::Labelled,
+        None => false,
+    };
+    if let Some(c) = args.classify {
+        if !labelled_output {
+            return Err(CliError::msg(
+                "--classify needs a .las, .laz or .ply --output",
+            ));
+        }
+        if c.lines != (args.structure == Some(Structure::Lines)) {
+            return Err(CliError::msg(
+                "--classify names another structure kind than --structure",
+            ));
+        }
+    }
+    if let Some(out) = &args.union {
         common::mesh_format(out)?;
     }
     let inputs: Vec<&std::path::Path> = args.input.iter().map(|p| p.as_path()).collect();
@@ -222,10 +256,14 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
             ("--png", args.png.as_deref()),
         ],
     )?;
-    let (points, truth, name) = match &args.input {
+    let (cloud, truth, name) = match &args.input {
         Some(input) => {
-            let cloud = common::read_input(input, &ReadOptions::default(), timings)?;
-            (cloud.points, None, input.display().to_string())
+            let options = ReadOptions {
+                attributes: labelled_output || args.background_classes.is_some(),
+                ..ReadOptions::default()
+            };
+            let cloud = common::read_input(input, &options, timings)?;
+            (cloud, None, input.display().to_string())
         }
         None => {
             let scene = timings.phase("synth", || SceneOptions::polyhedron().seed(1).generate())?;
@@ -233,15 +271,31 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
                 timings.phase("write", || write_scene(p, &scene, true))?;
             }
             let name = "built-in example (Fig. 10-like polyhedron in background)".to_string();
-            (scene.points.clone(), Some(scene), name)
+            let cloud = PointCloud {
+                points: scene.points.clone(),
+                ..PointCloud::default()
+            };
+            (cloud, Some(scene), name)
         }
     };
+    // --background-classes: the detection runs on the other points; ids
+    // and meshes are mapped back to the input's points.
+    let keep = match &args.input {
+        Some(input) => common::kept_points(&cloud, input, args.background_classes)?,
+        None => None,
+    };
+    let subset: Option<Vec<[f64; 3]>> = keep
+        .as_ref()
+        .map(|k| k.iter().map(|&i| cloud.points[i as usize]).collect());
+    let points: &[[f64; 3]] = subset.as_deref().unwrap_or(&cloud.points);
+    let keep = keep.as_deref();
+    let n_input = cloud.points.len();
     let in_file = |e: aniso_alpha::detect::detector::DetectError| match &args.input {
         Some(p) => CliError::in_file(p, e),
         None => CliError::msg(e.to_string()),
     };
     let start = Instant::now();
-    let detector = timings.phase("estimate", || detector(args, &points, example))?;
+    let detector = timings.phase("estimate", || detector(args, points, example))?;
     let n_orient = detector.orientation_count().map_err(|e| {
         let flags = match args.sampler {
             Some(SamplerKind::Fibonacci) => format!("--step {}", args.step),
@@ -256,37 +310,50 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
         true
     };
     let det = timings
-        .phase("detect", || detector.clone().progress(&tick).run(&points))
+        .phase("detect", || detector.clone().progress(&tick).run(points))
         .map_err(in_file)?;
     let seconds = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
 
-    let part_labels = det.part_labels();
+    let part_labels = common::spread(&det.part_labels(), keep, n_input);
+    let labels = common::spread(&det.labels, keep, n_input);
     if let Some(p) = &labels_path {
-        common::write_output(p, timings, |w| write_ints(w, &det.labels))?;
+        common::write_output(p, timings, |w| write_ints(w, &labels))?;
     }
     if let Some(p) = &parts_path {
         common::write_output(p, timings, |w| write_ints(w, &part_labels))?;
     }
     if let Some(p) = &output_path {
-        let (edges, faces, element_labels) = part_meshes(&det, &points);
-        let mesh = Mesh {
-            labels: Some(&det.labels),
-            parts: Some(&part_labels),
-            edges: &edges,
-            faces: &faces,
-            element_labels: &element_labels,
-            ..Mesh::new(&points)
-        };
-        common::write_mesh(p, &mesh, timings)?;
+        let (mut edges, mut faces, element_labels) = part_meshes(&det, points);
+        common::reindex(&mut edges, keep);
+        common::reindex(&mut faces, keep);
+        if labelled_output {
+            let labelled = Labelled {
+                edges: &edges,
+                faces: &faces,
+                element_labels: &element_labels,
+                classify: args.classify.map(|c| c.class),
+                ..Labelled::new(&labels, &part_labels)
+            };
+            common::write_labelled(p, &cloud, &labelled, timings)?;
+        } else {
+            let mesh = Mesh {
+                edges: &edges,
+                faces: &faces,
+                ..Mesh::new(&cloud.points)
+            };
+            common::write_mesh(p, &mesh, timings)?;
+        }
     }
     if let Some(p) = &args.union {
-        let (edges, faces) = split_simplices(&det);
+        let (mut edges, mut faces) = split_simplices(&det);
+        common::reindex(&mut edges, keep);
+        common::reindex(&mut faces, keep);
         let mesh = Mesh {
-            labels: Some(&det.labels),
+            labels: Some(&labels),
             edges: &edges,
             faces: &faces,
-            ..Mesh::new(&points)
+            ..Mesh::new(&cloud.points)
         };
         common::write_mesh(p, &mesh, timings)?;
     }
@@ -327,7 +394,7 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
         crate::view::write_html(
             p,
             &name,
-            &points,
+            points,
             &det.labels,
             &part_labels,
             &report,
@@ -335,7 +402,7 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
         )?;
     }
     if let Some(p) = &args.png {
-        crate::picture::write_detection_png(p, &points, &det, &part_labels, timings)?;
+        crate::picture::write_detection_png(p, points, &det, &part_labels, timings)?;
     }
     let mut out = summary(&name, &det, &detector, &report, seconds);
     if let Some(ev) = &scores {

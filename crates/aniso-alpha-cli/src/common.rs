@@ -67,7 +67,7 @@ pub fn set_format(format: Option<aio::Format>) {
 /// clap parser for `--format`.
 pub fn parse_format(s: &str) -> Result<aio::Format, String> {
     aio::Format::from_name(s).ok_or_else(|| {
-        format!("unknown format '{s}' (expected xyz, txt, csv, pts, ply, las, laz or pcd)")
+        format!("unknown format '{s}' (expected xyz, txt, csv, pts, ply, las, laz, pcd or e57)")
     })
 }
 
@@ -389,6 +389,134 @@ pub fn write_mesh(path: &Path, mesh: &Mesh<'_>, timings: &mut Timings) -> Result
         MeshFormat::Ply => aio::write_ply(path, mesh, PlyEncoding::BinaryLittleEndian),
         MeshFormat::Obj => aio::write_obj(path, mesh),
     })?;
+    Ok(())
+}
+
+/// What `detect --output` writes, by extension.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CloudOutput {
+    /// `.ply`, `.las`, `.laz`: the input cloud with its attributes, the
+    /// structure and part ids (and, PLY, the part meshes).
+    Labelled,
+    /// `.obj`: geometry only.
+    Obj,
+}
+
+/// The kind of a `detect --output` path, by extension.
+pub fn cloud_output(path: &Path) -> Result<CloudOutput, CliError> {
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    match ext.as_str() {
+        "ply" | "las" | "laz" => Ok(CloudOutput::Labelled),
+        "obj" => Ok(CloudOutput::Obj),
+        _ => Err(CliError::msg(format!(
+            "{}: unknown output extension (expected .ply, .las, .laz or .obj)",
+            path.display()
+        ))),
+    }
+}
+
+/// The points a detection runs on when LAS classes are excluded
+/// (`--background-classes`): indices into the input, ascending. `None`
+/// keeps every point. The classes come from the cloud's `classification`
+/// attribute (LAS, or a PLY/PCD property of that name).
+pub fn kept_points(
+    cloud: &PointCloud,
+    input: &Path,
+    exclude: Option<aio::ClassSet>,
+) -> Result<Option<Vec<u32>>, CliError> {
+    let Some(exclude) = exclude else {
+        return Ok(None);
+    };
+    let class = cloud
+        .attributes
+        .iter()
+        .find(|a| a.name == "classification")
+        .ok_or_else(|| {
+            CliError::in_file(
+                input,
+                "--background-classes needs a classification (LAS, or a PLY/PCD property 'classification')",
+            )
+        })?;
+    let n = u32::try_from(cloud.points.len())
+        .map_err(|_| CliError::in_file(input, "more than 2^32 - 1 points"))?;
+    let keep: Vec<u32> = (0..n)
+        .filter(|&i| {
+            let c = class.values.get_f64(i as usize);
+            !(0.0..=255.0).contains(&c) || !exclude.contains(c as u8)
+        })
+        .collect();
+    info(format_args!(
+        "{}: {} of {} points excluded by --background-classes (labelled -1)",
+        display_input(input),
+        cloud.points.len() - keep.len(),
+        cloud.points.len()
+    ));
+    Ok(Some(keep))
+}
+
+/// Per-point values of a subset spread back over all `n` input points
+/// (−1 where a point was excluded).
+pub fn spread(values: &[i64], keep: Option<&[u32]>, n: usize) -> Vec<i64> {
+    match keep {
+        None => values.to_vec(),
+        Some(keep) => {
+            let mut out = vec![-1; n];
+            for (&i, &v) in keep.iter().zip(values) {
+                out[i as usize] = v;
+            }
+            out
+        }
+    }
+}
+
+/// Indices into a subset mapped back to the input's.
+pub fn reindex<const K: usize>(items: &mut [[u32; K]], keep: Option<&[u32]>) {
+    if let Some(keep) = keep {
+        for v in items.iter_mut().flatten() {
+            *v = keep[*v as usize];
+        }
+    }
+}
+
+/// `--classify KIND=CLASS`: the LAS class given to the points of the
+/// structures found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Classify {
+    /// `planes` or `lines`.
+    pub lines: bool,
+    /// The class, 0–255.
+    pub class: u8,
+}
+
+/// clap parser for `--classify planes=6` / `lines=N`.
+pub fn parse_classify(s: &str) -> Result<Classify, String> {
+    let (kind, class) = s
+        .split_once('=')
+        .ok_or_else(|| format!("expected planes=CLASS or lines=CLASS, got '{s}'"))?;
+    let lines = match kind.trim() {
+        "planes" => false,
+        "lines" => true,
+        k => return Err(format!("'{k}' is not planes or lines")),
+    };
+    let class = class
+        .trim()
+        .parse::<u8>()
+        .map_err(|_| format!("'{}' is not a LAS class (0-255)", class.trim()))?;
+    Ok(Classify { lines, class })
+}
+
+/// Writes the input cloud with structure and part ids (and meshes) as
+/// PLY, LAS or LAZ, as phase `write`.
+pub fn write_labelled(
+    path: &Path,
+    cloud: &PointCloud,
+    labelled: &aio::Labelled<'_>,
+    timings: &mut Timings,
+) -> Result<(), CliError> {
+    timings.phase("write", || aio::write_labelled_cloud(path, cloud, labelled))?;
     Ok(())
 }
 

@@ -76,7 +76,7 @@ pub struct QuietArgs {
 #[derive(Debug, Clone, Copy, Args)]
 #[command(next_help_heading = "Common options")]
 pub struct FormatArgs {
-    /// Input format, overriding the extension: xyz, ply, las, laz, pcd
+    /// Input format, overriding the extension: xyz, ply, las, laz, pcd, e57
     /// (an INPUT of `-` is standard input, text unless --format says otherwise)
     #[arg(long, value_name = "FMT", value_parser = common::parse_format)]
     pub format: Option<aniso_alpha::io::Format>,

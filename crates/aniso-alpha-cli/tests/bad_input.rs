@@ -156,12 +156,12 @@ fn bad_paths() {
     let d = TempDir::new("paths");
     let out = d.0.join("out.tets");
     let good = d.file("good.xyz", b"0 0 0\n1 0 0\n0 1 0\n0 0 1\n");
-    let unknown = d.file("points.e57", b"0 0 0\n");
+    let unknown = d.file("points.e58", b"0 0 0\n");
     expect_error(
         &d,
         &unknown,
         &out,
-        &["points.e57", "unknown file extension"],
+        &["points.e58", "unknown file extension"],
     );
     expect_error(
         &d,

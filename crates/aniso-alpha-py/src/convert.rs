@@ -17,16 +17,20 @@ pub struct Points<'py> {
 impl<'py> Points<'py> {
     /// Converts `obj` (an array-like of shape (n, 3)).
     ///
-    /// A C-contiguous float64 ndarray is borrowed as it is, without a copy;
-    /// anything else (lists, other dtypes, Fortran order, strided views) is
-    /// converted by `numpy.ascontiguousarray(obj, dtype=float64)`.
+    /// A C-contiguous, aligned float64 ndarray is borrowed as it is,
+    /// without a copy; anything else (lists, other dtypes, Fortran order,
+    /// strided views, unaligned buffers) is converted by
+    /// `numpy.require(obj, dtype=float64, requirements=("C", "A"))`.
     ///
     /// # Errors
     /// `ValueError` for a wrong shape or a non-real dtype (numpy's own
     /// errors for what it cannot convert).
     pub fn extract(obj: &Bound<'py, PyAny>) -> PyResult<Self> {
         if let Ok(a) = obj.cast::<PyArray2<f64>>() {
-            if a.is_c_contiguous() {
+            // Unaligned buffers (e.g. numpy arrays unpickled from one
+            // message frame, as Dask does) are copied below.
+            let aligned = (a.data() as usize).is_multiple_of(std::mem::align_of::<f64>());
+            if a.is_c_contiguous() && aligned {
                 check_shape(a.as_untyped())?;
                 return Ok(Points {
                     array: a.try_readonly()?,
@@ -44,9 +48,11 @@ impl<'py> Points<'py> {
                 dtype.str()?
             )));
         }
+        // C-contiguous and aligned, float64: a copy unless `a` already is.
         let kwargs = PyDict::new(py);
         kwargs.set_item("dtype", np.getattr("float64")?)?;
-        let a = np.call_method("ascontiguousarray", (a,), Some(&kwargs))?;
+        kwargs.set_item("requirements", ("C", "A"))?;
+        let a = np.call_method("require", (a,), Some(&kwargs))?;
         check_shape(a.cast::<PyUntypedArray>()?)?;
         let a = a.cast_into::<PyArray2<f64>>()?;
         Ok(Points {

@@ -13,6 +13,7 @@ mod convert;
 mod errors;
 mod report;
 mod run;
+mod split;
 
 use std::path::PathBuf;
 
@@ -112,7 +113,80 @@ fn alpha_intervals<'py>(
 
 /// Labels (int64 (n,)), part labels (int64 (n,)) and the JSON text of
 /// `{"structures": [...], "parameters": {...}}`.
-type DetectOut<'py> = (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<i64>>, String);
+pub(crate) type DetectOut<'py> = (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<i64>>, String);
+
+/// The parameters of a detection call, checked.
+pub(crate) struct Params {
+    kind: StructureKind,
+    given: Given,
+}
+
+impl Params {
+    /// Checks `structure` and the values given.
+    pub(crate) fn new(
+        structure: &str,
+        alpha: Option<f64>,
+        lambda2: Option<f64>,
+        lambda3: Option<f64>,
+        min_size: Option<i64>,
+    ) -> PyResult<Self> {
+        let planes = match structure {
+            "lines" => false,
+            "planes" => true,
+            other => {
+                return Err(PyValueError::new_err(format!(
+                    "structure must be \"lines\" or \"planes\", got {other:?}"
+                )))
+            }
+        };
+        if !planes && lambda2.is_some() {
+            return Err(PyValueError::new_err(
+                "lambda2 is a parameter of planes (lines use lambda3 only)",
+            ));
+        }
+        let min_size = min_size
+            .map(|m| {
+                u32::try_from(m).map_err(|_| {
+                    PyValueError::new_err(format!(
+                        "bad parameter: min_size must be between 1 and {}, got {m}",
+                        u32::MAX
+                    ))
+                })
+            })
+            .transpose()?;
+        let kind = if planes {
+            StructureKind::Planes
+        } else {
+            StructureKind::Lines
+        };
+        Ok(Params {
+            kind,
+            given: Given {
+                alpha,
+                lambda2,
+                lambda3,
+                min_size,
+            },
+        })
+    }
+}
+
+/// The detector of a call: with alpha, lambda3 and min_size all given, the
+/// CLI's explicit run (the paper's box sampler; lambda2 of planes defaults
+/// to lambda3); otherwise parameters and orientations from the data, the
+/// given ones kept ([`Detector::auto`]).
+pub(crate) fn detector_for(p: &Params, pts: &[[f64; 3]]) -> PyResult<Detector<'static>> {
+    let g = &p.given;
+    Ok(match (g.alpha, g.lambda3, g.min_size) {
+        (Some(alpha), Some(lambda3), Some(min_size)) => match p.kind {
+            StructureKind::Planes => {
+                Detector::planes(alpha, g.lambda2.unwrap_or(lambda3), lambda3, min_size)
+            }
+            StructureKind::Lines => Detector::lines(alpha, lambda3, min_size),
+        },
+        _ => Detector::auto(p.kind, pts, g).map_err(value_error)?,
+    })
+}
 
 /// Structure detection (SPEC §4): `structure` is "lines" or "planes". With
 /// alpha, lambda3 and min_size all given, the CLI's explicit run (the
@@ -131,60 +205,15 @@ fn detect<'py>(
     min_size: Option<i64>,
     threads: Option<i64>,
 ) -> PyResult<DetectOut<'py>> {
-    let planes = match structure {
-        "lines" => false,
-        "planes" => true,
-        other => {
-            return Err(PyValueError::new_err(format!(
-                "structure must be \"lines\" or \"planes\", got {other:?}"
-            )))
-        }
-    };
-    if !planes && lambda2.is_some() {
-        return Err(PyValueError::new_err(
-            "lambda2 is a parameter of planes (lines use lambda3 only)",
-        ));
-    }
-    let min_size = min_size
-        .map(|m| {
-            u32::try_from(m).map_err(|_| {
-                PyValueError::new_err(format!(
-                    "bad parameter: min_size must be between 1 and {}, got {m}",
-                    u32::MAX
-                ))
-            })
-        })
-        .transpose()?;
+    let params = Params::new(structure, alpha, lambda2, lambda3, min_size)?;
     let points = Points::extract(points)?;
     let threads = thread_count(threads)?;
-    let kind = if planes {
-        StructureKind::Planes
-    } else {
-        StructureKind::Lines
-    };
-    let given = Given {
-        alpha,
-        lambda2,
-        lambda3,
-        min_size,
-    };
     let pts = points.as_slice();
     // The whole call (estimation included) runs on the pool of `detached`,
     // which the library's parallel loops use: no `Detector::threads`, which
     // would start a second pool.
     let (labels, parts, json) = detached(py, threads, |_| {
-        let detector = match (alpha, lambda3, min_size) {
-            // Explicit, as `aniso-alpha detect`: the paper's box sampler;
-            // lambda2 of planes defaults to lambda3.
-            (Some(alpha), Some(lambda3), Some(min_size)) => match kind {
-                StructureKind::Planes => {
-                    Detector::planes(alpha, lambda2.unwrap_or(lambda3), lambda3, min_size)
-                }
-                StructureKind::Lines => Detector::lines(alpha, lambda3, min_size),
-            },
-            // Parameters and orientations from the data, the given ones kept.
-            _ => Detector::auto(kind, pts, &given).map_err(value_error)?,
-        };
+        let detector = detector_for(&params, pts)?;
         let det = detector.run(pts).map_err(value_error)?;
         let json = report::detection_json(&det, &detector);
         let parts = det.part_labels();
@@ -224,6 +253,8 @@ fn _panic(py: Python<'_>, on_worker: bool) -> PyResult<()> {
 /// The Rust side of `aniso_alpha` (private: use the package's functions).
 #[pymodule(name = "_native")]
 mod native {
+    #[pymodule_export]
+    use super::split::{plan, tile_step, PyPlan};
     #[pymodule_export]
     use super::{_panic, _points_address, alpha_intervals, delaunay, detect, read};
 

@@ -34,6 +34,7 @@ const NO_LABELS: ReadOptions = ReadOptions {
     read_labels: false,
     format: None,
     background_classes: ClassSet::LAS_BACKGROUND,
+    attributes: false,
 };
 
 #[test]
@@ -403,7 +404,7 @@ fn extension_dispatch_and_file_errors() {
         read_points(&p, &NO_LABELS).unwrap().points,
         vec![[1.0, 2.0, 3.0]]
     );
-    let e = read_points(&d.join("a.e57"), &NO_LABELS).unwrap_err();
+    let e = read_points(&d.join("a.e58"), &NO_LABELS).unwrap_err();
     assert!(matches!(e, IoError::UnknownFormat { .. }));
     let e = read_points(&d.join("missing.xyz"), &NO_LABELS).unwrap_err();
     assert!(matches!(e, IoError::Open { .. }));

@@ -9,8 +9,12 @@ use proptest::prelude::*;
 const NAMES: [&str; 5] = ["f.xyz", "f.ply", "f.pcd", "f.las", "f.laz"];
 
 fn opts(labels: bool) -> ReadOptions {
+    // Attributes are kept on the label runs: both paths are fuzzed.
     if labels {
-        ReadOptions::with_labels(3)
+        ReadOptions {
+            attributes: true,
+            ..ReadOptions::with_labels(3)
+        }
     } else {
         ReadOptions::default()
     }
@@ -23,6 +27,9 @@ fn check(name: &str, bytes: &[u8], labels: bool) {
             assert!(c.points.iter().flatten().all(|v| v.is_finite()));
             if let Some(l) = &c.labels {
                 assert_eq!(l.len(), c.points.len());
+            }
+            for a in &c.attributes {
+                assert_eq!(a.values.len(), c.points.len(), "{}", a.name);
             }
         }
         Err(e) => {

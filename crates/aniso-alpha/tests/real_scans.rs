@@ -293,3 +293,63 @@ fn lamppost_pole_is_one_line() {
     eprintln!("pole: {} of {} points", pole.vertices.len(), points.len());
     assert!(pole.vertices.len() >= 1000);
 }
+
+#[test]
+fn room_is_four_parts() {
+    // The room: three walls and a floor on a 5 cm grid with 0.5 cm
+    // of Gaussian noise across them, and 2,000 outliers in the room's box
+    // (fixed seed). It must come out as four parts, one per surface, no
+    // surface twice.
+    let mut state = 0x0_2004_u64;
+    let mut uniform = move || {
+        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let gauss = |u: &mut dyn FnMut() -> f64| {
+        let (a, b) = (u().max(1e-300), u());
+        (-2.0 * a.ln()).sqrt() * (std::f64::consts::TAU * b).cos()
+    };
+    let (mut points, mut truth) = (Vec::new(), Vec::new());
+    let (w, h, step, noise) = (4.0, 2.5, 0.05, 0.005);
+    let n_w = (w / step) as usize;
+    let n_h = (h / step) as usize;
+    for i in 0..=n_w {
+        for j in 0..=n_w {
+            let e = noise * gauss(&mut uniform);
+            points.push([i as f64 * step, j as f64 * step, e]);
+            truth.push(0);
+        }
+    }
+    for (label, wall) in [(1, 0), (2, 1), (3, 2)] {
+        for i in 0..=n_w {
+            for j in 1..=n_h {
+                let (s, z) = (i as f64 * step, j as f64 * step);
+                let e = noise * gauss(&mut uniform);
+                points.push(match wall {
+                    0 => [e, s, z],
+                    1 => [s, e, z],
+                    _ => [w + e, s, z],
+                });
+                truth.push(label);
+            }
+        }
+    }
+    for _ in 0..2000 {
+        points.push([uniform() * w, uniform() * w, uniform() * h]);
+        truth.push(-1);
+    }
+    let det = Detector::auto(StructureKind::Planes, &points, &Given::default())
+        .unwrap()
+        .run(&points)
+        .unwrap();
+    let s = score(&truth, &det.part_labels(), 1000);
+    eprintln!("room: {s:?}");
+    assert_eq!(s.big, 4);
+    assert_eq!(s.found, 4, "{s:?}");
+    assert_eq!(s.parts, 4, "{s:?}");
+    assert!(s.f1 >= 0.95, "{s:?}");
+    check_parts(&det, &points);
+}

@@ -13,6 +13,10 @@ Functions: :func:`detect`, :func:`delaunay`, :func:`alpha_intervals`,
 :func:`read`. Every long call releases the GIL and takes ``threads=``
 (default: all cores); bad input raises ``ValueError`` with the library's
 message.
+
+:mod:`aniso_alpha.distributed` (with the optional ``dask[distributed]``,
+the ``distributed`` extra) runs :func:`detect` tile by tile on a Dask
+cluster, with the same result.
 """
 
 from ._api import AlphaIntervals, Detection, alpha_intervals, delaunay, detect, read

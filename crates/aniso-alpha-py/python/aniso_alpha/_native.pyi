@@ -2,7 +2,7 @@
 # (crates/aniso-alpha-py/src/lib.rs). The public, documented API is the
 # package `aniso_alpha`; these are its private building blocks.
 
-from typing import Optional, Tuple
+from typing import List, Optional, Tuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -32,6 +32,66 @@ def detect(
     threads: Optional[int] = None,
 ) -> Tuple[NDArray[np.int64], NDArray[np.int64], str]:
     """(labels, part_labels, JSON text of {"structures": [...], "parameters": {...}})."""
+
+class Plan:
+    """A split detection run (aniso_alpha.distributed); made by `plan`."""
+
+    @property
+    def halo(self) -> float:
+        """The halo width: the largest 2·alpha·lambda_max of the jobs."""
+    @property
+    def tile(self) -> float:
+        """The tile side."""
+    @property
+    def jobs(self) -> int:
+        """The number of jobs (orientations)."""
+    def with_tile(self, tile: float) -> "Plan":
+        """The same plan with tiles of another side."""
+    def tiles(self, points: ArrayLike) -> List[Tuple[Tuple[int, int, int], NDArray[np.uint32]]]:
+        """(cell, ids ascending) per tile."""
+    def members(
+        self, ids: NDArray[np.uint32]
+    ) -> Optional[Tuple[NDArray[np.uint64], NDArray[np.uint32]]]:
+        """(offsets, positions) of each group's members among ids, or None (every point)."""
+    def step_spec(
+        self,
+    ) -> Tuple[str, float, NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.uint32]]:
+        """(kind, side, rotations (j, 3, 3), elongations (j, 3), alphas (j,), groups (j,))."""
+    def finish(
+        self,
+        points: ArrayLike,
+        outputs: List[Tuple[NDArray[np.uint32], NDArray[np.uint64], int]],
+        threads: Optional[int] = None,
+    ) -> Tuple[NDArray[np.int64], NDArray[np.int64], str]:
+        """(labels, part_labels, JSON report) from the tiles' outputs."""
+
+def plan(
+    points: ArrayLike,
+    structure: str,
+    tile: float,
+    alpha: Optional[float] = None,
+    lambda2: Optional[float] = None,
+    lambda3: Optional[float] = None,
+    min_size: Optional[int] = None,
+    threads: Optional[int] = None,
+) -> Plan:
+    """The plan of a split run with tiles of side `tile`."""
+
+def tile_step(
+    kind: str,
+    side: float,
+    rotations: NDArray[np.float64],
+    elongations: NDArray[np.float64],
+    alphas: NDArray[np.float64],
+    groups: NDArray[np.uint32],
+    cell: Tuple[int, int, int],
+    points: ArrayLike,
+    ids: NDArray[np.uint32],
+    member_offsets: Optional[NDArray[np.uint64]] = None,
+    member_ids: Optional[NDArray[np.uint32]] = None,
+    threads: Optional[int] = None,
+) -> Tuple[NDArray[np.uint32], NDArray[np.uint64], int]:
+    """(faces flat, offsets per job, points triangulated) of one tile."""
 
 def read(path: str) -> NDArray[np.float64]:
     """float64 (n, 3), the points of a point file in file order."""

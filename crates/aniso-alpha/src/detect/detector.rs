@@ -42,7 +42,7 @@ use super::filter::{component_size_mask, FilterError};
 use super::orientations::{orientations, OrientationError, Sampler};
 use super::prune::CandidatePairs;
 use super::scan::{run_job, union, Face, Job, JobResult, Pruning, ScanError, RADIUS_SLACK};
-use super::StructureKind;
+pub use super::StructureKind;
 use crate::aniso::{Anisotropy, AnisotropyError};
 use std::fmt;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -419,7 +419,7 @@ impl<'a> Detector<'a> {
         }
     }
 
-    fn check_values(&self) -> Result<(), DetectError> {
+    pub(crate) fn check_values(&self) -> Result<(), DetectError> {
         let bad = |m: String| Err(DetectError::BadParameter(m));
         if !(self.alpha.is_finite() && self.alpha > 0.0) {
             return bad(format!(
@@ -484,7 +484,7 @@ impl<'a> Detector<'a> {
     }
 
     /// The jobs of the run and the scale of each group.
-    fn jobs<'p>(
+    pub(crate) fn jobs<'p>(
         &self,
         modes: &'p [ModeScan],
         rotations: &[Mat3],
@@ -532,7 +532,9 @@ impl<'a> Detector<'a> {
         ))
     }
 
-    fn run_k<S: Face>(&self, points: &[[f64; 3]]) -> Result<Detection, DetectError> {
+    /// The jobs of a run over this detector's orientation set (checked
+    /// against [`MAX_ORIENTATIONS`]) and the scale of each group.
+    pub(crate) fn scan_jobs(&self) -> Result<(Vec<Job<'_>>, Vec<Scale>), DetectError> {
         let (modes, rotations): (&[ModeScan], Vec<Mat3>) = match &self.set {
             OrientationSet::Data(m) => (m.as_slice(), Vec::new()),
             _ => (&[], self.orientation_set()?),
@@ -544,6 +546,35 @@ impl<'a> Detector<'a> {
                 jobs.len()
             )));
         }
+        Ok((jobs, scales))
+    }
+
+    /// A copy of this detector without its progress callback (so that it
+    /// can outlive the callback, e.g. in a [`super::split::Plan`]).
+    pub(crate) fn detached(&self) -> Detector<'static> {
+        Detector {
+            kind: self.kind,
+            alpha: self.alpha,
+            lambda2: self.lambda2,
+            lambda3: self.lambda3,
+            nb_c: self.nb_c,
+            set: self.set.clone(),
+            prune: self.prune,
+            part_angle_deg: self.part_angle_deg,
+            epsilon: self.epsilon,
+            threads: self.threads,
+            tile: self.tile,
+            estimate: self.estimate.clone(),
+            progress: None,
+        }
+    }
+
+    fn run_k<S: Face>(&self, points: &[[f64; 3]]) -> Result<Detection, DetectError> {
+        let (jobs, scales) = self.scan_jobs()?;
+        let modes: &[ModeScan] = match &self.set {
+            OrientationSet::Data(m) => m.as_slice(),
+            _ => &[],
+        };
         // Candidate pairs for the pruning, once for all orientations over
         // every point (unless there are too many).
         let lmax = self
@@ -569,10 +600,7 @@ impl<'a> Detector<'a> {
         let done = AtomicUsize::new(0);
         let cancelled = AtomicBool::new(false);
         let total = jobs.len();
-        let chance =
-            super::assemble::ChanceScale::measure(points, self.alpha, self.elongation(), total);
-        let scan_nb_c =
-            super::assemble::scan_min_size(self.kind, self.nb_c, self.epsilon.is_some(), chance);
+        let scan_nb_c = self.scan_min_size(points, total);
         let one = |job: &Job<'_>| -> Result<JobResult<S>, DetectError> {
             if cancelled.load(Ordering::Relaxed) {
                 return Err(DetectError::Cancelled);
@@ -608,9 +636,37 @@ impl<'a> Detector<'a> {
             stats.filtered_simplices += r.faces.len() as u64;
             found.push((job.group, r.faces));
         }
+        self.finish_k(points, found, scales, stats)
+    }
+
+    /// The path filter's threshold in the scan of `orientations`
+    /// orientations of `points`: nb_c, or for lines under the significance
+    /// test a shorter one from the measured background
+    /// (docs/method.md §4, `detect::assemble::scan_min_size`).
+    pub(crate) fn scan_min_size(&self, points: &[[f64; 3]], orientations: usize) -> u32 {
+        let chance = super::assemble::ChanceScale::measure(
+            points,
+            self.alpha,
+            self.elongation(),
+            orientations,
+        );
+        super::assemble::scan_min_size(self.kind, self.nb_c, self.epsilon.is_some(), chance)
+    }
+
+    /// The steps after the scan: the union of the jobs' filtered simplices
+    /// (`found`: per job, its group and its simplices), the component
+    /// filter and the assembly. `stats` holds the scan's figures.
+    pub(crate) fn finish_k<S: Face>(
+        &self,
+        points: &[[f64; 3]],
+        found: Vec<(u32, Vec<S>)>,
+        scales: Vec<Scale>,
+        mut stats: RunStats,
+    ) -> Result<Detection, DetectError> {
+        let total = stats.orientations;
         let (all, groups) = union(found);
         stats.union_simplices = all.len();
-        let keep = component_size_mask(&all, scan_nb_c)?;
+        let keep = component_size_mask(&all, self.scan_min_size(points, total))?;
         let mut kept = Vec::with_capacity(all.len());
         let mut kept_groups = Vec::with_capacity(all.len());
         for ((s, g), k) in all.into_iter().zip(groups).zip(keep) {
@@ -689,7 +745,7 @@ fn elongation(kind: StructureKind, lambda2: f64, lambda3: f64) -> [f64; 3] {
 }
 
 /// Input checks: not empty, finite, in the range of exact arithmetic.
-fn check_points(points: &[[f64; 3]]) -> Result<(), DetectError> {
+pub(crate) fn check_points(points: &[[f64; 3]]) -> Result<(), DetectError> {
     if points.is_empty() {
         return Err(DetectError::Empty);
     }

@@ -18,7 +18,10 @@
 //!   [`outline`] (outlines and meshes of planar parts) and [`significance`]
 //!   (the a-contrario test);
 //! * [`detection`]: the result types;
-//! * [`detector`]: the parameters and the run that chains the steps.
+//! * [`detector`]: the parameters and the run that chains the steps;
+//! * [`split`]: the same run split into per-tile steps that can run
+//!   elsewhere (other processes or machines), and the step that gathers
+//!   them.
 
 mod assemble;
 pub mod detection;
@@ -35,6 +38,7 @@ pub mod parts;
 pub mod prune;
 mod scan;
 pub mod significance;
+pub mod split;
 
 /// Which structures are sought: k = 1 (lines, edges) or k = 2 (planes,
 /// triangles).

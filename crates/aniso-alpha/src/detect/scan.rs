@@ -161,7 +161,7 @@ fn sentinels(lo: [f64; 3], hi: [f64; 3], alpha: f64) -> [[f64; 3]; 4] {
 /// `map[..]`), as sorted input-index simplices. Points at positions ≥
 /// `owned_below` of `map` are halo points: a simplex is kept only when its
 /// smallest vertex (in input numbering) is owned.
-fn faces_of<S: Face>(
+pub(crate) fn faces_of<S: Face>(
     mut q: Vec<[f64; 3]>,
     map: &[u32],
     alpha: f64,
@@ -186,7 +186,7 @@ fn faces_of<S: Face>(
 }
 
 /// The points of `ids` kept by the pruning under `a`, and their transforms.
-fn pruned(
+pub(crate) fn pruned(
     points: &[[f64; 3]],
     ids: &[u32],
     a: &Anisotropy,
@@ -222,6 +222,27 @@ fn pruned(
     }
 }
 
+/// The pruning radius of a job: 2α, inflated by [`RADIUS_SLACK`].
+pub(crate) fn prune_radius(job: &Job<'_>) -> f64 {
+    2.0 * job.alpha * (1.0 + RADIUS_SLACK)
+}
+
+/// The halo width of a job's tiles: 2α·λ_max, inflated twice by
+/// [`RADIUS_SLACK`].
+pub(crate) fn halo_width(job: &Job<'_>) -> f64 {
+    let lmax = job
+        .anisotropy
+        .lambdas()
+        .iter()
+        .fold(1.0f64, |m, &l| m.max(l));
+    2.0 * job.alpha * lmax * (1.0 + RADIUS_SLACK) * (1.0 + RADIUS_SLACK)
+}
+
+/// The tile (integer cell of side `side`) that owns a point.
+pub(crate) fn tile_cell(p: &[f64; 3], side: f64) -> [i64; 3] {
+    p.map(|x| (x / side).floor() as i64)
+}
+
 /// Unfiltered `F_{k,α,Q}` of one job, as sorted input-index simplices, and
 /// the number of points triangulated. With `tile = Some(side)`, the job's
 /// points are cut into tiles with halos (module doc).
@@ -240,8 +261,7 @@ pub(crate) fn raw_faces<S: Face>(
         }
     };
     let a = &job.anisotropy;
-    let radius = 2.0 * job.alpha * (1.0 + RADIUS_SLACK);
-    let lmax = a.lambdas().iter().fold(1.0f64, |m, &l| m.max(l));
+    let radius = prune_radius(job);
     let Some(side) = tile.filter(|&s| s.is_finite() && s > 0.0) else {
         let (map, q) = pruned(points, ids, a, radius, pruning);
         let n = map.len();
@@ -250,8 +270,8 @@ pub(crate) fn raw_faces<S: Face>(
         return Ok((faces, n));
     };
     // Tiles: integer cells of side `side`; halo `h` around each.
-    let h = 2.0 * job.alpha * lmax * (1.0 + RADIUS_SLACK) * (1.0 + RADIUS_SLACK);
-    let cell = |p: &[f64; 3]| -> [i64; 3] { p.map(|x| (x / side).floor() as i64) };
+    let h = halo_width(job);
+    let cell = |p: &[f64; 3]| -> [i64; 3] { tile_cell(p, side) };
     let mut keyed: Vec<([i64; 3], u32)> = ids
         .iter()
         .map(|&i| (cell(&points[i as usize]), i))

@@ -17,6 +17,8 @@ use std::io::Cursor;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::Path;
 
+use super::attributes::LasSource;
+use super::las_attrs::{parse_vlrs, record_attributes};
 use super::{check_finite, non_empty, ClassSet, IoError, PointCloud};
 
 /// The largest accepted ratio of decompressed point bytes to compressed
@@ -37,11 +39,14 @@ pub(crate) struct Layout {
 }
 
 /// Reads a LAS/LAZ file; with `labels`, the classification gives the
-/// labels, the classes in the set read as background (-1).
+/// labels, the classes in the set read as background (-1); with
+/// `attributes`, the records are kept ([`PointCloud::las`]) and decoded
+/// into [`PointCloud::attributes`].
 pub(crate) fn read_las(
     path: &Path,
     bytes: &[u8],
     labels_with: Option<ClassSet>,
+    attributes: bool,
 ) -> Result<PointCloud, IoError> {
     let read_labels = labels_with.is_some();
     let background = labels_with.unwrap_or(ClassSet::EMPTY);
@@ -59,7 +64,14 @@ pub(crate) fn read_las(
     }
     let class_at = if layout.extended { 16 } else { 15 };
     let class_mask = if layout.extended { 0xFF } else { 0x1F };
+    let mut kept: Vec<u8> = Vec::new();
+    if attributes {
+        kept.reserve(cap.saturating_mul(layout.record_len).min(bytes.len() * 4));
+    }
     let mut sink = |records: &[u8]| -> Result<(), IoError> {
+        if attributes {
+            kept.extend_from_slice(records);
+        }
         for rec in records.chunks_exact(layout.record_len) {
             let p = [0usize, 1, 2].map(|k| {
                 let raw = i32::from_le_bytes([
@@ -132,7 +144,63 @@ pub(crate) fn read_las(
     if read_labels {
         cloud.labels = Some(labels);
     }
+    if attributes {
+        let src = source(bytes, &layout, kept).map_err(bad)?;
+        cloud.attributes = record_attributes(&src);
+        cloud.las = Some(Box::new(src));
+    }
     non_empty(path, cloud)
+}
+
+/// The header, VLRs and data after the points of a LAS file, with its
+/// `records`.
+fn source(bytes: &[u8], layout: &Layout, records: Vec<u8>) -> Result<LasSource, String> {
+    let header_size = u16_at(bytes, 94).ok_or("short header")? as usize;
+    let n_vlrs = u32_at(bytes, 100).ok_or("short header")?;
+    let header = bytes
+        .get(..header_size)
+        .filter(|_| header_size <= layout.data_start)
+        .ok_or("header size past the point data")?
+        .to_vec();
+    let (vlrs, padding) = parse_vlrs(bytes, header_size, n_vlrs, layout.data_start)?;
+    // What follows the points: LAS 1.4 extended VLRs, or a LAS 1.3+
+    // waveform record stored in the file (global encoding bit 1).
+    let points_end = if layout.compressed {
+        layout.data_start as u64
+    } else {
+        layout.data_start as u64 + layout.points * layout.record_len as u64
+    };
+    let len = bytes.len() as u64;
+    let mut tail_start = u64::MAX;
+    let minor = bytes.get(25).copied().unwrap_or(0);
+    let global = u16_at(bytes, 6).unwrap_or(0);
+    if minor >= 3 && header_size >= 235 && global & 2 != 0 {
+        let wf = u64_at(bytes, 227).unwrap_or(0);
+        if wf >= points_end && wf < len {
+            tail_start = tail_start.min(wf);
+        }
+    }
+    if minor >= 4 && header_size >= 247 && u32_at(bytes, 243).unwrap_or(0) > 0 {
+        let ev = u64_at(bytes, 235).unwrap_or(0);
+        if ev >= points_end && ev < len {
+            tail_start = tail_start.min(ev);
+        }
+    }
+    let (tail_start, tail) = if tail_start == u64::MAX {
+        (0, Vec::new())
+    } else {
+        (tail_start, bytes[tail_start as usize..].to_vec())
+    };
+    Ok(LasSource {
+        header,
+        vlrs,
+        padding,
+        point_format: bytes.get(104).copied().unwrap_or(0) & 0x3F,
+        record_len: layout.record_len,
+        records,
+        tail_start,
+        tail,
+    })
 }
 
 /// Runs `f`, turning a panic inside it (from the `las` or `laz` crates on
@@ -527,7 +595,7 @@ mod tests {
         // libFuzzer: an extended VLR of length ~2^64 made the `las` crate
         // panic ("capacity overflow").
         let bytes = include_bytes!("../../tests/fuzz_regressions/las-evlr-capacity-overflow.las");
-        let e = read_las(Path::new("evlr.las"), bytes, Some(ClassSet::EMPTY)).unwrap_err();
+        let e = read_las(Path::new("evlr.las"), bytes, Some(ClassSet::EMPTY), true).unwrap_err();
         assert!(
             e.to_string().starts_with("evlr.las: invalid LAS/LAZ file"),
             "{e}"
@@ -535,10 +603,66 @@ mod tests {
     }
 
     #[test]
+    fn fuzz_regression_gps_time_switch_recursion() {
+        // libFuzzer: corrupt GPS times coded as endless "switch to another
+        // time sequence"; laz 0.13 recursed once per switch and overflowed
+        // the stack (SIGSEGV with a 2 MiB thread stack, this file; 8 MiB
+        // for others). The vendored laz loops and gives an error. Read on
+        // a thread with a 1 MiB stack so that a recursion would show.
+        let bytes = include_bytes!("../../tests/fuzz_regressions/laz-gps-switch-recursion.laz");
+        for attributes in [false, true] {
+            let e = std::thread::Builder::new()
+                .stack_size(1 << 20)
+                .spawn(move || {
+                    read_las(
+                        Path::new("gps.laz"),
+                        bytes,
+                        Some(ClassSet::EMPTY),
+                        attributes,
+                    )
+                })
+                .unwrap()
+                .join()
+                .unwrap()
+                .unwrap_err();
+            assert!(
+                e.to_string().contains("endless GPS time sequence switches"),
+                "{e}"
+            );
+        }
+    }
+
+    #[test]
+    fn fuzz_regression_many_extra_byte_names() {
+        // libFuzzer (timeout, 39 s): a record of 16,474 bytes, 16,454 of
+        // them extra bytes, each a column; their names were made unique
+        // by scanning a list (quadratic, cubic for repeated names), before
+        // the reader found the file has no point. Now a set (see
+        // unique_names_stay_unique_and_linear): milliseconds.
+        let bytes =
+            include_bytes!("../../tests/fuzz_regressions/las-extra-bytes-names-timeout.las");
+        let e = read_las(Path::new("names.las"), bytes, None, true).unwrap_err();
+        assert!(matches!(e, IoError::NoPoints { .. }), "{e}");
+    }
+
+    #[test]
+    fn unique_names_stay_unique_and_linear() {
+        let mut n = super::super::las_attrs::Names::new(&["x", "y", "z"]);
+        assert_eq!(n.unique("x", "f"), "x_2");
+        assert_eq!(n.unique("a b", "f"), "a_b");
+        assert_eq!(n.unique("  ", "f"), "f");
+        assert_eq!(n.unique("a_b_2", "f"), "a_b_2");
+        assert_eq!(n.unique("a b", "f"), "a_b_3");
+        let all: std::collections::HashSet<String> =
+            (0..65_536).map(|_| n.unique("same", "f")).collect();
+        assert_eq!(all.len(), 65_536);
+    }
+
+    #[test]
     fn fuzz_regression_huge_record_length() {
         // libFuzzer found a header with a huge record length and point
         // count: the reader allocated 2.7 GB at once.
         let bytes = include_bytes!("../../tests/fuzz_regressions/las-oom-record-length.las");
-        let _ = read_las(Path::new("oom.las"), bytes, Some(ClassSet::EMPTY));
+        let _ = read_las(Path::new("oom.las"), bytes, Some(ClassSet::EMPTY), true);
     }
 }

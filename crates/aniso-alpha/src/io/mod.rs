@@ -8,6 +8,7 @@
 //! | `.ply` | PLY ascii, binary little- or big-endian; x/y/z of any scalar type |
 //! | `.las` `.laz` | LAS/LAZ with scale and offset applied (cargo feature `las`) |
 //! | `.pcd` | PCD ascii, binary and binary_compressed |
+//! | `.e57` | E57, every scan, each moved by its pose (cargo feature `e57`) |
 //!
 //! Point `i` of a [`PointCloud`] is the `i`-th point of the file. Every
 //! error is an [`IoError`] that names the file (and, for text, the line);
@@ -26,10 +27,18 @@
 //! ```
 
 mod atomic;
+mod attributes;
+#[cfg(feature = "e57")]
+mod e57;
 mod error;
+mod labelled;
 mod labels;
 #[cfg(feature = "las")]
 mod las;
+#[cfg(feature = "las")]
+mod las_attrs;
+#[cfg(feature = "las")]
+mod las_write;
 mod lzf;
 mod obj;
 mod pcd;
@@ -44,7 +53,9 @@ use std::path::Path;
 pub use atomic::{
     atomic_write, check_output_path, output_key, remove_temp_files, resolve_output, same_file,
 };
+pub use attributes::{Attribute, AttributeType, LasSource, Values, Vlr};
 pub use error::IoError;
+pub use labelled::{write_labelled_cloud, Labelled};
 pub use labels::{read_labels, read_labels_bytes, write_labels};
 pub use obj::write_obj;
 pub use ply::{write_ply, write_ply_to, Mesh, PlyEncoding};
@@ -58,6 +69,15 @@ pub struct PointCloud {
     /// One label per point, when asked for and present (see
     /// [`ReadOptions`]); -1 conventionally means background.
     pub labels: Option<Vec<i64>>,
+    /// Every other per-point property of the file, typed as in the file
+    /// (colours, normals, intensity, classification, GPS time, any PLY
+    /// vertex property, PCD field, LAS record field or extra bytes), when
+    /// asked for with [`ReadOptions::attributes`]; empty otherwise.
+    pub attributes: Vec<Attribute>,
+    /// For a LAS/LAZ file read with [`ReadOptions::attributes`]: its
+    /// header, VLRs and point records as in the file, so that a LAS output
+    /// keeps every record byte for byte ([`write_labelled_cloud`]).
+    pub las: Option<Box<LasSource>>,
     /// What the reader guessed and the user should hear about (e.g. a
     /// first line taken as a header); the CLI prints them.
     pub warnings: Vec<ReadWarning>,
@@ -74,6 +94,14 @@ pub enum ReadWarning {
         /// The line (shortened).
         text: String,
     },
+    /// Points of the file were not read (E57 points whose coordinates
+    /// are flagged invalid).
+    SkippedPoints {
+        /// How many.
+        count: u64,
+        /// Why.
+        reason: &'static str,
+    },
 }
 
 impl std::fmt::Display for ReadWarning {
@@ -81,6 +109,9 @@ impl std::fmt::Display for ReadWarning {
         match self {
             ReadWarning::HeaderLine { line, text } => {
                 write!(f, "line {line} taken as a header: '{text}'")
+            }
+            ReadWarning::SkippedPoints { count, reason } => {
+                write!(f, "{count} points skipped: {reason}")
             }
         }
     }
@@ -103,6 +134,11 @@ pub struct ReadOptions {
     /// the labels; by default 0 and 1 (never classified, unclassified), 7
     /// (low noise) and 18 (high noise), see [`ClassSet::LAS_BACKGROUND`].
     pub background_classes: ClassSet,
+    /// Keep every per-point attribute of the file in
+    /// [`PointCloud::attributes`] (PLY, PCD, LAS/LAZ, E57), and a LAS
+    /// file's records in [`PointCloud::las`]. Off, a reader decodes x, y,
+    /// z (and the labels) only, as fast as before.
+    pub attributes: bool,
 }
 
 /// A set of LAS classification codes (0–255).
@@ -162,6 +198,7 @@ impl ReadOptions {
             read_labels: true,
             format: None,
             background_classes: ClassSet::LAS_BACKGROUND,
+            attributes: false,
         }
     }
 }
@@ -177,9 +214,11 @@ pub enum Format {
     Las,
     /// `.pcd`.
     Pcd,
+    /// `.e57`.
+    E57,
 }
 
-const EXPECTED_POINTS: &str = ".xyz, .txt, .csv, .pts, .ply, .las, .laz or .pcd";
+const EXPECTED_POINTS: &str = ".xyz, .txt, .csv, .pts, .ply, .las, .laz, .pcd or .e57";
 
 impl Format {
     /// The format of a point file, from its extension (case-insensitive).
@@ -203,7 +242,7 @@ impl Format {
 
     /// The format named by an extension or a `--format` value
     /// (case-insensitive, without the dot): `xyz` `txt` `csv` `pts` `ply`
-    /// `las` `laz` `pcd`.
+    /// `las` `laz` `pcd` `e57`.
     ///
     /// ```
     /// use aniso_alpha::io::Format;
@@ -216,6 +255,7 @@ impl Format {
             "ply" => Format::Ply,
             "las" | "laz" => Format::Las,
             "pcd" => Format::Pcd,
+            "e57" => Format::E57,
             _ => return None,
         })
     }
@@ -352,6 +392,7 @@ fn parse_format(
         Format::Ply => read_ply_bytes(path, bytes, options),
         Format::Las => read_las_bytes(path, bytes, options),
         Format::Pcd => read_pcd_bytes(path, bytes, options),
+        Format::E57 => read_e57_bytes(path, bytes, options),
     }
 }
 
@@ -387,7 +428,7 @@ pub fn read_ply_bytes(
     bytes: &[u8],
     options: &ReadOptions,
 ) -> Result<PointCloud, IoError> {
-    ply::read_ply(name, bytes, options.read_labels)
+    ply::read_ply(name, bytes, options.read_labels, options.attributes)
 }
 
 /// Parses a PCD file (ascii, binary or binary_compressed) held in memory;
@@ -405,7 +446,7 @@ pub fn read_pcd_bytes(
     bytes: &[u8],
     options: &ReadOptions,
 ) -> Result<PointCloud, IoError> {
-    pcd::read_pcd(name, bytes, options.read_labels)
+    pcd::read_pcd(name, bytes, options.read_labels, options.attributes)
 }
 
 /// Parses a LAS or LAZ file held in memory (scale and offset applied);
@@ -423,6 +464,7 @@ pub fn read_las_bytes(
             name,
             bytes,
             options.read_labels.then_some(options.background_classes),
+            options.attributes,
         )
     }
     #[cfg(not(feature = "las"))]
@@ -431,6 +473,32 @@ pub fn read_las_bytes(
         Err(IoError::Unsupported {
             path: name.to_path_buf(),
             message: "LAS/LAZ support is not compiled in (cargo feature `las`)",
+        })
+    }
+}
+
+/// Parses an E57 file held in memory: the points of every scan, each
+/// moved by its pose into the file's coordinate system (points flagged
+/// invalid are skipped, with a [`ReadWarning::SkippedPoints`]); with
+/// `options.attributes`, every other field (intensity, colours, row and
+/// column, time stamps, extension fields) in its own type. E57 has no
+/// classification: `labels` stay `None`. Needs the cargo feature `e57`;
+/// without it this returns [`IoError::Unsupported`].
+pub fn read_e57_bytes(
+    name: &Path,
+    bytes: &[u8],
+    options: &ReadOptions,
+) -> Result<PointCloud, IoError> {
+    #[cfg(feature = "e57")]
+    {
+        e57::read_e57(name, bytes, options.attributes)
+    }
+    #[cfg(not(feature = "e57"))]
+    {
+        let _ = (bytes, options);
+        Err(IoError::Unsupported {
+            path: name.to_path_buf(),
+            message: "E57 support is not compiled in (cargo feature `e57`)",
         })
     }
 }

@@ -2,6 +2,7 @@
 
 use std::path::Path;
 
+use super::attributes::{Attribute, Values};
 use super::error::show_token;
 use super::lzf;
 use super::ply::Scalar;
@@ -205,10 +206,96 @@ fn locate(path: &Path, h: &Header, name: &str) -> Result<Option<(usize, Scalar)>
     Ok(Some((i, s)))
 }
 
+/// One kept attribute column of a PCD file.
+#[derive(Debug, Clone, Copy)]
+enum Col {
+    /// Component `comp` of field `field`, of type `scalar`.
+    Plain {
+        field: usize,
+        comp: usize,
+        scalar: Scalar,
+    },
+    /// A packed colour (`rgb` or `rgba`, 4 bytes: PCL's 0xAARRGGBB),
+    /// kept as `u8` columns red, green, blue (and alpha).
+    Rgb { field: usize, alpha: bool },
+}
+
+/// The attribute columns of every field but x, y, z and padding (`_`):
+/// a field of COUNT k > 1 gives `name_0` … `name_{k-1}`.
+fn columns(path: &Path, h: &Header) -> Result<(Vec<Col>, Vec<Attribute>), IoError> {
+    let n = h.points.min(1 << 20);
+    let mut cols = Vec::new();
+    let mut attrs = Vec::new();
+    for (fi, f) in h.fields.iter().enumerate() {
+        if matches!(f.name.as_str(), "x" | "y" | "z" | "_") {
+            continue;
+        }
+        if (f.name == "rgb" || f.name == "rgba") && f.size == 4 && f.count == 1 {
+            let alpha = f.name == "rgba";
+            cols.push(Col::Rgb { field: fi, alpha });
+            let names: &[&str] = if alpha {
+                &["red", "green", "blue", "alpha"]
+            } else {
+                &["red", "green", "blue"]
+            };
+            for name in names {
+                attrs.push(Attribute::new(*name, Values::U8(Vec::with_capacity(n))));
+            }
+            continue;
+        }
+        let scalar = f.scalar().ok_or_else(|| {
+            IoError::format(
+                path,
+                format!(
+                    "PCD field '{}' has an unsupported type {} of size {}",
+                    show_token(f.name.as_bytes()),
+                    f.kind as char,
+                    f.size
+                ),
+            )
+        })?;
+        for comp in 0..f.count {
+            cols.push(Col::Plain {
+                field: fi,
+                comp,
+                scalar,
+            });
+            let name = if f.count == 1 {
+                f.name.clone()
+            } else {
+                format!("{}_{comp}", f.name)
+            };
+            attrs.push(Attribute::new(
+                name,
+                Values::with_capacity(scalar.attribute_type(), n),
+            ));
+        }
+    }
+    Ok((cols, attrs))
+}
+
+/// Pushes a packed colour onto the next 3 (or 4) columns.
+fn push_rgb(attrs: &mut [Attribute], v: u32, alpha: bool) {
+    let parts = [v >> 16, v >> 8, v, v >> 24];
+    let k = if alpha { 4 } else { 3 };
+    for (a, c) in attrs.iter_mut().zip(&parts[..k]) {
+        a.values.push_f64(f64::from(*c & 0xFF));
+    }
+}
+
+/// Number of attribute columns a `Col` fills.
+fn width(c: &Col) -> usize {
+    match c {
+        Col::Plain { .. } => 1,
+        Col::Rgb { alpha, .. } => 3 + usize::from(*alpha),
+    }
+}
+
 pub(crate) fn read_pcd(
     path: &Path,
     bytes: &[u8],
     read_labels: bool,
+    attributes: bool,
 ) -> Result<PointCloud, IoError> {
     let h = parse_header(path, bytes)?;
     let mut xyz = Vec::with_capacity(3);
@@ -224,8 +311,18 @@ pub(crate) fn read_pcd(
         None
     };
     let data = &bytes[h.data_start..];
+    let (cols, attrs) = if attributes {
+        columns(path, &h)?
+    } else {
+        (Vec::new(), Vec::new())
+    };
+    let keep = Keep {
+        cols: &cols,
+        attrs,
+        sizes: h.fields.iter().map(|f| f.size).collect(),
+    };
     let cloud = match h.data {
-        Data::Ascii => read_ascii(path, data, &h, xyz, label)?,
+        Data::Ascii => read_ascii(path, data, &h, xyz, label, keep)?,
         Data::Binary => {
             let stride: usize = h.fields.iter().map(Field::bytes).sum();
             let offsets = offsets(&h);
@@ -242,7 +339,7 @@ pub(crate) fn read_pcd(
                 ));
             }
             // Field f of point i starts at i * stride + offsets[f].
-            decode(path, data, h.points, xyz, label, |f, i| {
+            decode(path, data, h.points, xyz, label, keep, |f, i| {
                 i * stride + offsets[f]
             })?
         }
@@ -280,7 +377,9 @@ pub(crate) fn read_pcd(
                 acc += f.bytes() * h.points;
             }
             let fb: Vec<usize> = h.fields.iter().map(Field::bytes).collect();
-            decode(path, &raw, h.points, xyz, label, |f, i| base[f] + i * fb[f])?
+            decode(path, &raw, h.points, xyz, label, keep, |f, i| {
+                base[f] + i * fb[f]
+            })?
         }
     };
     non_empty(path, cloud)
@@ -298,6 +397,14 @@ fn offsets(h: &Header) -> Vec<usize> {
         .collect()
 }
 
+/// The attribute columns being filled.
+struct Keep<'a> {
+    cols: &'a [Col],
+    attrs: Vec<Attribute>,
+    /// SIZE of each field.
+    sizes: Vec<usize>,
+}
+
 /// Decodes binary points, `at(field, point)` giving the byte offset (in
 /// bounds: the callers checked the data size).
 fn decode(
@@ -306,6 +413,7 @@ fn decode(
     n: usize,
     xyz: [(usize, Scalar); 3],
     label: Option<(usize, Scalar)>,
+    mut keep: Keep<'_>,
     at: impl Fn(usize, usize) -> usize,
 ) -> Result<PointCloud, IoError> {
     let get = |(f, s): (usize, Scalar), i: usize| -> Result<f64, IoError> {
@@ -326,7 +434,33 @@ fn decode(
         if let (Some(l), Some(out)) = (label, cloud.labels.as_mut()) {
             out.push(get(l, i)? as i64);
         }
+        let mut k = 0;
+        for c in keep.cols {
+            match *c {
+                Col::Plain {
+                    field,
+                    comp,
+                    scalar,
+                } => {
+                    let o = at(field, i) + comp * keep.sizes[field];
+                    let b = data
+                        .get(o..o + scalar.size())
+                        .ok_or_else(|| IoError::format(path, "PCD file truncated"))?;
+                    keep.attrs[k].values.push_bytes(b, false);
+                }
+                Col::Rgb { field, alpha } => {
+                    let o = at(field, i);
+                    let b = data
+                        .get(o..o + 4)
+                        .ok_or_else(|| IoError::format(path, "PCD file truncated"))?;
+                    let v = u32::from_le_bytes([b[0], b[1], b[2], b[3]]);
+                    push_rgb(&mut keep.attrs[k..], v, alpha);
+                }
+            }
+            k += width(c);
+        }
     }
+    cloud.attributes = keep.attrs;
     Ok(cloud)
 }
 
@@ -336,6 +470,7 @@ fn read_ascii(
     h: &Header,
     xyz: [(usize, Scalar); 3],
     label: Option<(usize, Scalar)>,
+    mut keep: Keep<'_>,
 ) -> Result<PointCloud, IoError> {
     // Token index of each field's first component.
     let mut tok_of = Vec::with_capacity(h.fields.len());
@@ -392,7 +527,47 @@ fn read_ascii(
             })?;
             out.push(v);
         }
+        let mut k = 0;
+        for c in keep.cols {
+            let field = match *c {
+                Col::Plain { field, .. } | Col::Rgb { field, .. } => field,
+            };
+            let comp = match *c {
+                Col::Plain { comp, .. } => comp,
+                Col::Rgb { .. } => 0,
+            };
+            let t = toks[tok_of[field] + comp];
+            let bad = |why: String| {
+                IoError::parse(
+                    path,
+                    ln,
+                    format!(
+                        "invalid value '{}' for field '{}': {why}",
+                        show_token(t),
+                        show_token(h.fields[field].name.as_bytes())
+                    ),
+                )
+            };
+            match *c {
+                Col::Plain { scalar, .. } => {
+                    let v = scalar.parse(t).map_err(bad)?;
+                    keep.attrs[k].values.push_f64(v);
+                }
+                Col::Rgb { alpha, .. } => {
+                    // PCL prints a float-typed rgb as the float whose bits
+                    // are the colour; an integer-typed one as the integer.
+                    let v = if h.fields[field].kind == b'F' {
+                        (Scalar::F32.parse(t).map_err(bad)? as f32).to_bits()
+                    } else {
+                        Scalar::U32.parse(t).map_err(bad)? as u32
+                    };
+                    push_rgb(&mut keep.attrs[k..], v, alpha);
+                }
+            }
+            k += width(c);
+        }
     }
+    cloud.attributes = keep.attrs;
     if cloud.points.len() < h.points {
         return Err(IoError::parse(
             path,

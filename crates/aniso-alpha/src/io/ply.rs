@@ -3,6 +3,7 @@
 use std::io::Write;
 use std::path::Path;
 
+use super::attributes::{Attribute, AttributeType, Values};
 use super::error::show_token;
 use super::text::parse_f64;
 use super::{atomic_write, check_finite, non_empty, IoError, PointCloud};
@@ -41,6 +42,20 @@ impl Scalar {
             Scalar::I16 | Scalar::U16 => 2,
             Scalar::I32 | Scalar::U32 | Scalar::F32 => 4,
             Scalar::F64 => 8,
+        }
+    }
+
+    /// The attribute type of this PLY type.
+    pub(crate) fn attribute_type(self) -> AttributeType {
+        match self {
+            Scalar::I8 => AttributeType::I8,
+            Scalar::U8 => AttributeType::U8,
+            Scalar::I16 => AttributeType::I16,
+            Scalar::U16 => AttributeType::U16,
+            Scalar::I32 => AttributeType::I32,
+            Scalar::U32 => AttributeType::U32,
+            Scalar::F32 => AttributeType::F32,
+            Scalar::F64 => AttributeType::F64,
         }
     }
 
@@ -260,13 +275,22 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header, IoError> {
     })
 }
 
-/// Where x, y, z and the label are among the vertex properties.
+/// Where x, y, z, the label and the kept attributes are among the vertex
+/// properties.
 struct VertexLayout {
     xyz: [usize; 3],
     label: Option<usize>,
+    /// Scalar properties other than x, y, z kept as attributes (with
+    /// `ReadOptions::attributes`): property index and type.
+    attrs: Vec<(usize, Scalar)>,
 }
 
-fn vertex_layout(path: &Path, el: &Element, read_labels: bool) -> Result<VertexLayout, IoError> {
+fn vertex_layout(
+    path: &Path,
+    el: &Element,
+    read_labels: bool,
+    attributes: bool,
+) -> Result<VertexLayout, IoError> {
     let find = |name: &str| el.props.iter().position(|p| p.name == name);
     let mut xyz = [0usize; 3];
     for (k, name) in ["x", "y", "z"].iter().enumerate() {
@@ -288,13 +312,44 @@ fn vertex_layout(path: &Path, el: &Element, read_labels: bool) -> Result<VertexL
     } else {
         None
     };
-    Ok(VertexLayout { xyz, label })
+    // Vertex list properties are not kept (they are rare and have no
+    // per-point column form).
+    let attrs = if attributes {
+        el.props
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| !xyz.contains(i))
+            .filter_map(|(i, p)| match p.kind {
+                Kind::Scalar(s) => Some((i, s)),
+                Kind::List { .. } => None,
+            })
+            .collect()
+    } else {
+        Vec::new()
+    };
+    Ok(VertexLayout { xyz, label, attrs })
+}
+
+/// Empty attribute columns for the layout's attributes.
+fn attribute_columns(el: &Element, layout: &VertexLayout) -> Vec<Attribute> {
+    let n = el.count.min(1 << 20);
+    layout
+        .attrs
+        .iter()
+        .map(|&(i, s)| {
+            Attribute::new(
+                el.props[i].name.clone(),
+                Values::with_capacity(s.attribute_type(), n),
+            )
+        })
+        .collect()
 }
 
 pub(crate) fn read_ply(
     path: &Path,
     bytes: &[u8],
     read_labels: bool,
+    attributes: bool,
 ) -> Result<PointCloud, IoError> {
     let header = parse_header(path, bytes)?;
     let vertex = header
@@ -302,7 +357,7 @@ pub(crate) fn read_ply(
         .iter()
         .position(|e| e.name == "vertex")
         .ok_or_else(|| IoError::format(path, "PLY file has no 'vertex' element"))?;
-    let layout = vertex_layout(path, &header.elements[vertex], read_labels)?;
+    let layout = vertex_layout(path, &header.elements[vertex], read_labels, attributes)?;
     let data = &bytes[header.data_start..];
     let cloud = match header.encoding {
         Encoding::Ascii => read_ascii(path, data, &header, vertex, &layout)?,
@@ -362,6 +417,7 @@ fn read_binary(
         if is_vertex {
             let cap = el.count.min(data.len() - off);
             cloud.points.reserve(cap);
+            cloud.attributes = attribute_columns(el, layout);
         }
         for i in 0..el.count {
             for (pi, p) in el.props.iter().enumerate() {
@@ -398,6 +454,9 @@ fn read_binary(
             }
             if is_vertex {
                 push_vertex(path, &values, layout, &mut cloud, None)?;
+                for (c, &(i, _)) in cloud.attributes.iter_mut().zip(&layout.attrs) {
+                    c.values.push_f64(values[i]);
+                }
             }
         }
     }
@@ -435,6 +494,16 @@ fn read_fixed_vertices(
     };
     cloud.points.reserve(el.count);
     let mut labels = Vec::new();
+    if !layout.attrs.is_empty() {
+        let mut columns = attribute_columns(el, layout);
+        let at: Vec<usize> = layout.attrs.iter().map(|&(i, _)| offsets[i]).collect();
+        for rec in data.chunks_exact(stride) {
+            for (c, &o) in columns.iter_mut().zip(&at) {
+                c.values.push_bytes(&rec[o..], big);
+            }
+        }
+        cloud.attributes = columns;
+    }
     for rec in data.chunks_exact(stride) {
         let p = [
             fx.1.decode(&rec[fx.0..], big),
@@ -495,8 +564,17 @@ fn read_ascii(
     for (ei, el) in header.elements.iter().enumerate() {
         let is_vertex = ei == vertex;
         let mut values = vec![0.0f64; el.props.len()];
+        // Per property: whether it is read (x, y, z, the label, attributes).
+        let mut wanted = vec![false; el.props.len()];
         if is_vertex {
             cloud.points.reserve(el.count.min(data.len() / 6));
+            cloud.attributes = attribute_columns(el, layout);
+            for i in layout.xyz.iter().chain(&layout.label) {
+                wanted[*i] = true;
+            }
+            for &(i, _) in &layout.attrs {
+                wanted[i] = true;
+            }
         }
         for i in 0..el.count {
             let (ln, raw) = loop {
@@ -530,9 +608,7 @@ fn read_ascii(
                 match p.kind {
                     Kind::Scalar(s) => {
                         let t = toks.next().ok_or_else(missing)?;
-                        let wanted =
-                            is_vertex && (layout.xyz.contains(&pi) || layout.label == Some(pi));
-                        if wanted {
+                        if wanted[pi] {
                             values[pi] = s.parse(t).map_err(|why| {
                                 IoError::parse(
                                     path,
@@ -566,6 +642,9 @@ fn read_ascii(
             }
             if is_vertex {
                 push_vertex(path, &values, layout, &mut cloud, Some(ln))?;
+                for (c, &(i, _)) in cloud.attributes.iter_mut().zip(&layout.attrs) {
+                    c.values.push_f64(values[i]);
+                }
             }
         }
     }
@@ -604,6 +683,11 @@ pub struct Mesh<'a> {
     /// One part id per point (the int vertex property `part`), if any
     /// (PLY only).
     pub parts: Option<&'a [i64]>,
+    /// More vertex properties, one value per point each, written after
+    /// `structure` and `part` in their own type (64-bit integers as
+    /// `double`; PLY only). Names must be unique, without whitespace, and
+    /// none of x, y, z, structure, part.
+    pub attributes: &'a [Attribute],
     /// Edges (PLY element `edge`, OBJ `l` lines).
     pub edges: &'a [[u32; 2]],
     /// Triangles (PLY element `face`, OBJ `f` lines).
@@ -621,6 +705,7 @@ impl<'a> Mesh<'a> {
             points,
             labels: None,
             parts: None,
+            attributes: &[],
             edges: &[],
             faces: &[],
             element_labels: &[],
@@ -638,6 +723,33 @@ impl<'a> Mesh<'a> {
             if let Some(v) = l.iter().find(|v| i32::try_from(**v).is_err()) {
                 return Err(invalid(format!("label {v} does not fit a PLY int")));
             }
+        }
+        let mut names: Vec<&str> = vec!["x", "y", "z"];
+        if self.labels.is_some() {
+            names.push("structure");
+        }
+        if self.parts.is_some() {
+            names.push("part");
+        }
+        for a in self.attributes {
+            if a.values.len() != n {
+                return Err(invalid(format!(
+                    "attribute '{}' has {} values for {} points",
+                    a.name,
+                    a.values.len(),
+                    n
+                )));
+            }
+            if a.name.is_empty() || a.name.chars().any(|c| c.is_whitespace()) {
+                return Err(invalid(format!(
+                    "attribute name '{}' is not a PLY property name",
+                    a.name
+                )));
+            }
+            if names.contains(&a.name.as_str()) {
+                return Err(invalid(format!("two vertex properties named '{}'", a.name)));
+            }
+            names.push(&a.name);
         }
         let ne = self.edges.len() + self.faces.len();
         if !self.element_labels.is_empty() && self.element_labels.len() != ne {
@@ -714,6 +826,9 @@ pub fn write_ply_to(
     if mesh.parts.is_some() {
         w.write_all(b"property int part\n")?;
     }
+    for a in mesh.attributes {
+        writeln!(w, "property {} {}", ply_type_name(a.values.ty()), a.name)?;
+    }
     let el = !mesh.element_labels.is_empty();
     let el_props: &[u8] = if el {
         b"property int structure\nproperty int part\n"
@@ -749,6 +864,9 @@ pub fn write_ply_to(
                 for l in [mesh.labels, mesh.parts].into_iter().flatten() {
                     write!(w, " {}", l[i])?;
                 }
+                for a in mesh.attributes {
+                    write_ascii_value(w, &a.values, i)?;
+                }
                 w.write_all(b"\n")?;
             }
             for (k, e) in mesh.edges.iter().enumerate() {
@@ -782,6 +900,14 @@ pub fn write_ply_to(
                 for l in [mesh.labels, mesh.parts].into_iter().flatten() {
                     buf.extend_from_slice(&(l[i] as i32).to_le_bytes());
                 }
+                for a in mesh.attributes {
+                    match &a.values {
+                        Values::I64(_) | Values::U64(_) => {
+                            buf.extend_from_slice(&a.values.get_f64(i).to_le_bytes())
+                        }
+                        v => v.write_le(i, &mut buf),
+                    }
+                }
                 flush(&mut buf, false)?;
             }
             for (k, e) in mesh.edges.iter().enumerate() {
@@ -811,4 +937,34 @@ pub fn write_ply_to(
         }
     }
     Ok(())
+}
+
+/// The PLY type an attribute is written as (64-bit integers as `double`,
+/// PLY having none).
+fn ply_type_name(ty: AttributeType) -> &'static str {
+    match ty {
+        AttributeType::I8 => "char",
+        AttributeType::U8 => "uchar",
+        AttributeType::I16 => "short",
+        AttributeType::U16 => "ushort",
+        AttributeType::I32 => "int",
+        AttributeType::U32 => "uint",
+        AttributeType::F32 => "float",
+        AttributeType::F64 | AttributeType::I64 | AttributeType::U64 => "double",
+    }
+}
+
+/// ` value` of attribute values `v` at `i`, in shortest round-trip form.
+fn write_ascii_value(w: &mut dyn Write, v: &Values, i: usize) -> std::io::Result<()> {
+    match v {
+        Values::I8(x) => write!(w, " {}", x[i]),
+        Values::U8(x) => write!(w, " {}", x[i]),
+        Values::I16(x) => write!(w, " {}", x[i]),
+        Values::U16(x) => write!(w, " {}", x[i]),
+        Values::I32(x) => write!(w, " {}", x[i]),
+        Values::U32(x) => write!(w, " {}", x[i]),
+        Values::I64(_) | Values::U64(_) => write!(w, " {}", v.get_f64(i)),
+        Values::F32(x) => write!(w, " {}", x[i]),
+        Values::F64(x) => write!(w, " {}", x[i]),
+    }
 }

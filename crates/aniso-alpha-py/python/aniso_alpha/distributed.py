@@ -1,0 +1,283 @@
+"""Tiled detection on Dask: :func:`detect` spreads the triangulations of a
+large cloud over the workers of a ``dask.distributed`` cluster (a
+``LocalCluster`` on this machine by default, or any cluster a ``Client``
+reaches) and returns the same :class:`~aniso_alpha.Detection` as
+:func:`aniso_alpha.detect`.
+
+Needs the optional dependency ``dask[distributed]``
+(``pip install "crates/aniso-alpha-py[distributed]"``).
+
+How a run goes (SPEC §8; ARCHITECTURE.md, "Distributed detection"):
+
+1. The driver (this process) reads the cloud and makes a plan: the
+   parameters, estimated once from the whole cloud when not given (so
+   every tile uses the same ones), the orientations, and the tiles: cubes
+   of side ``tile``, each with a halo of 2·alpha·lambda_max around it.
+2. Each tile's points (float64 (m, 3)), their ids and which orientation
+   group looks at which of them are scattered to a worker as numpy arrays;
+   the worker triangulates them once per orientation and sends back the
+   simplices of F_{k,alpha,Q} that the tile's core owns (uint32 arrays). A
+   worker never sees more than one tile and its halo at a time.
+3. The driver gathers the simplices and finishes: the per-orientation path
+   filter, the union, the component filter and the structures. The
+   simplices owned by the cores are exactly the whole cloud's, so the
+   labels are those of :func:`aniso_alpha.detect`.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from typing import Any, List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from . import _native
+from ._api import Detection, PathLike, read
+
+__all__ = ["detect", "load", "plan"]
+
+Source = Union[PathLike, Sequence[PathLike], ArrayLike, Any]
+
+# The tiles of the default side hold about this many points each (core):
+# a triangulation of this size takes well under a second per orientation
+# and a few hundred MB at most.
+TILE_POINTS = 200_000
+
+# The default side is at least this many halos, so that a tile's halo does
+# not outweigh its core (with side = 2·halo a planar tile triangulates at
+# most (1 + 2/2)² = 4 times its own points).
+MIN_SIDE_HALOS = 2.0
+
+
+def load(source: Source) -> np.ndarray:
+    """The points of ``source`` as one float64 (n, 3) C-contiguous array:
+    a path to a point file (any format :func:`aniso_alpha.read` reads), a
+    list of paths (LAS/LAZ tiles or any point files, concatenated in list
+    order), a Dask array of shape (n, 3) (computed), or any array-like of
+    shape (n, 3).
+
+    >>> import numpy as np
+    >>> from aniso_alpha.distributed import load
+    >>> load([[0, 0, 0], [1, 2, 3]]).dtype
+    dtype('float64')
+    """
+    if isinstance(source, (str, os.PathLike)):
+        return read(source)
+    if isinstance(source, (list, tuple)) and source and all(
+        isinstance(s, (str, os.PathLike)) for s in source
+    ):
+        return np.ascontiguousarray(np.concatenate([read(s) for s in source]))
+    if hasattr(source, "compute") and hasattr(source, "chunks"):
+        source = source.compute()
+    a = np.ascontiguousarray(source, dtype=np.float64)
+    if a.ndim != 2 or a.shape[1] != 3:
+        raise ValueError(f"points must be an array of shape (n, 3), got shape {a.shape}")
+    return a
+
+
+def _default_tile(points: np.ndarray, halo: float, tiles_wanted: int) -> float:
+    """The largest side (halving from the cloud's extent) that gives at
+    least ``tiles_wanted`` occupied cells, but not below
+    MIN_SIDE_HALOS·halo."""
+    lo = points.min(axis=0)
+    extent = float(np.max(points.max(axis=0) - lo))
+    floor = MIN_SIDE_HALOS * halo
+    side = max(extent, floor, 1e-300) * (1 + 1e-9)
+    sample = points
+    if len(points) > 100_000:
+        sample = points[np.random.default_rng(0).choice(len(points), 100_000, replace=False)]
+    scale = len(points) / len(sample)
+    while side / 2 >= floor:
+        cells = np.unique(np.floor(sample / side).astype(np.int64), axis=0)
+        if len(cells) >= tiles_wanted and len(sample) * scale / len(cells) <= TILE_POINTS:
+            break
+        side /= 2
+    return side
+
+
+def plan(
+    points: ArrayLike,
+    structure: str,
+    *,
+    tile: Optional[float] = None,
+    workers: int = 1,
+    alpha: Optional[float] = None,
+    lambda2: Optional[float] = None,
+    lambda3: Optional[float] = None,
+    min_size: Optional[int] = None,
+    threads: Optional[int] = None,
+) -> "_native.Plan":
+    """The plan of a tiled run over ``points`` (the parameters as
+    :func:`aniso_alpha.detect` chooses them, and the tiles): what
+    :func:`detect` runs. ``tile`` is the side of the tiles (input units);
+    by default, the largest side that gives at least 4 tiles per worker and
+    at most about 200,000 points per tile, but not below 2 halos.
+
+    The plan has ``tile``, ``halo`` (2·alpha·lambda_max), ``jobs`` (the
+    number of orientations) and ``tiles(points)``: a list of (cell, ids).
+    """
+    pts = load(points)
+    if tile is not None and not (math.isfinite(tile) and tile > 0):
+        raise ValueError(f"tile must be positive and finite, got {tile}")
+    p = _native.plan(
+        pts, structure, tile if tile is not None else 1.0, alpha, lambda2, lambda3, min_size, threads
+    )
+    if tile is None:
+        p = p.with_tile(_default_tile(pts, p.halo, 4 * max(1, int(workers))))
+    return p
+
+
+def _run_tile(spec: Tuple, payload: Tuple, threads: int) -> Tuple[np.ndarray, np.ndarray, int]:
+    """The task a worker runs: every orientation of ``spec`` on one tile."""
+    kind, side, rotations, elongations, alphas, groups = spec
+    cell, points, ids, members = payload
+    offsets, positions = members if members is not None else (None, None)
+    # Arrays unpickled from one message frame may be unaligned: the
+    # extension reads aligned, C-contiguous buffers (a copy if need be).
+    rotations, elongations, alphas, groups, ids, offsets, positions = (
+        None if a is None else np.require(a, requirements=("C", "A"))
+        for a in (rotations, elongations, alphas, groups, ids, offsets, positions)
+    )
+    return _native.tile_step(
+        kind, side, rotations, elongations, alphas, groups, cell, points, ids,
+        offsets, positions, threads,
+    )
+
+
+def _workers(client: Any) -> int:
+    try:
+        return max(1, len(client.scheduler_info().get("workers", {})))
+    except Exception:  # noqa: BLE001 - a count for the default tile size only
+        return 1
+
+
+def detect(
+    source: Source,
+    structure: str,
+    *,
+    tile: Optional[float] = None,
+    client: Any = None,
+    n_workers: Optional[int] = None,
+    alpha: Optional[float] = None,
+    lambda2: Optional[float] = None,
+    lambda3: Optional[float] = None,
+    min_size: Optional[int] = None,
+    threads: Optional[int] = None,
+    task_threads: int = 1,
+) -> Detection:
+    """Finds lines or planes as :func:`aniso_alpha.detect` does, with the
+    triangulations run as Dask tasks, tile by tile.
+
+    Args:
+        source: a path to a point file, a list of paths (e.g. LAS/LAZ tiles,
+            read and concatenated in order), a Dask array of shape (n, 3),
+            or any array-like of shape (n, 3).
+        structure: ``"lines"`` or ``"planes"``.
+        tile: the side of the tiles, in input units (default: see
+            :func:`plan`). Any side gives the same result; smaller tiles
+            mean less memory per task and more halo work.
+        client: a ``dask.distributed.Client``; ``None`` starts a
+            ``LocalCluster`` of ``n_workers`` processes (default: one per
+            core), one thread each, and closes it at the end.
+        n_workers: the workers of the LocalCluster started without a client.
+        alpha, lambda2, lambda3, min_size: as :func:`aniso_alpha.detect`;
+            the missing ones are estimated once, from the whole cloud, on
+            this process.
+        threads: threads of the estimate and of the final step, on this
+            process (default: all cores).
+        task_threads: threads of each tile task (default 1: Dask runs one
+            task per worker thread).
+
+    Returns:
+        the :class:`~aniso_alpha.Detection` of :func:`aniso_alpha.detect`
+        on the same points: the same labels, part labels, structures and
+        parameters.
+
+    Raises:
+        ValueError: as :func:`aniso_alpha.detect`, and a bad ``tile``.
+        ImportError: ``dask.distributed`` is not installed.
+
+    Two planes of a grid, cut into tiles of side 8 (smaller than the
+    planes), on a LocalCluster of 2 processes:
+
+    >>> import numpy as np, aniso_alpha as aa
+    >>> from aniso_alpha import distributed
+    >>> g = np.arange(30.0)
+    >>> x, y = (a.ravel() for a in np.meshgrid(g, g))
+    >>> pts = np.vstack([np.c_[x, y, np.full(900, 10.0)], np.c_[x, np.full(900, 15.0), y]])
+    >>> pts += np.random.default_rng(1).normal(0, 0.01, pts.shape)
+    >>> det = distributed.detect(pts, "planes", tile=8.0, n_workers=2)
+    >>> len(det.structures), bool((det.labels == aa.detect(pts, "planes").labels).all())
+    (2, True)
+
+    On a cluster, pass its client (``Client("scheduler-address:8786")``).
+    """
+    from dask.distributed import Client, LocalCluster
+
+    points = load(source)
+    own = None
+    if client is None:
+        n = int(n_workers) if n_workers else (os.cpu_count() or 1)
+        cluster = LocalCluster(
+            n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None
+        )
+        own = (Client(cluster), cluster)
+        client = own[0]
+    try:
+        p = plan(
+            points,
+            structure,
+            tile=tile,
+            workers=_workers(client),
+            alpha=alpha,
+            lambda2=lambda2,
+            lambda3=lambda3,
+            min_size=min_size,
+            threads=threads,
+        )
+        outputs = _run(client, p, points, task_threads)
+        labels, part_labels, report = p.finish(points, outputs, threads)
+    finally:
+        if own is not None:
+            own[0].close()
+            own[1].close()
+    r = json.loads(report)
+    return Detection(labels, part_labels, r["structures"], r["parameters"])
+
+
+def _run(client: Any, p: "_native.Plan", points: np.ndarray, task_threads: int) -> List[Tuple]:
+    """Runs every tile of ``p`` on ``client``'s workers, at most a few tiles
+    per worker in flight (the driver never holds every tile's copy of its
+    points at once); returns the tiles' outputs in completion order."""
+    from dask.distributed import as_completed
+
+    [spec] = client.scatter([p.step_spec()], broadcast=True)
+    tiles = iter(p.tiles(points))
+    limit = 2 * _workers(client) + 2
+    outputs: List[Tuple] = []
+
+    def submit(tile: Tuple) -> Any:
+        cell, ids = tile
+        payload = (cell, np.ascontiguousarray(points[ids]), ids, p.members(ids))
+        [data] = client.scatter([payload])
+        return client.submit(_run_tile, spec, data, task_threads, pure=False)
+
+    pending = as_completed([submit(t) for _, t in zip(range(limit), tiles)])
+    for done in pending:
+        faces, offsets, triangulated = done.result()
+        # Unpickled from one frame, the arrays may be unaligned (see _run_tile).
+        outputs.append(
+            (
+                np.require(faces, requirements=("C", "A")),
+                np.require(offsets, requirements=("C", "A")),
+                triangulated,
+            )
+        )
+        done.release()
+        nxt = next(tiles, None)
+        if nxt is not None:
+            pending.add(submit(nxt))
+    return outputs
