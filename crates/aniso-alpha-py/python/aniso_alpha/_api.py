@@ -266,7 +266,7 @@ def read(path: PathLike) -> NDArray[np.float64]:
     """The points of a point file: float64 array of shape (n, 3), in file
     order, the format chosen by extension: ``.xyz`` ``.txt`` ``.csv``
     ``.pts`` (text: x y z in the first three columns), ``.ply`` (ascii and
-    binary), ``.las`` ``.laz``, ``.pcd``.
+    binary), ``.las`` ``.laz``, ``.pcd``, ``.e57``.
 
     Raises:
         OSError: the file cannot be opened (``FileNotFoundError``...).
