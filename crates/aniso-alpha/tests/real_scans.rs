@@ -13,6 +13,7 @@
 use std::path::Path;
 
 // The crate root's API, as a user writes it.
+use aniso_alpha::rng::SplitMix64;
 use aniso_alpha::{read_points, Detection, Detector, Given, ReadOptions, StructureKind};
 
 fn fixture(name: &str) -> (Vec<[f64; 3]>, Option<Vec<i64>>) {
@@ -28,6 +29,27 @@ fn fixture(name: &str) -> (Vec<[f64; 3]>, Option<Vec<i64>>) {
     )
     .unwrap();
     (cloud.points, cloud.labels)
+}
+
+/// `detect POINTS --structure planes` with every parameter from the data.
+fn planes_from_the_data(points: &[[f64; 3]]) -> Detection {
+    Detector::auto(StructureKind::Planes, points, &Given::default())
+        .unwrap()
+        .run(points)
+        .unwrap()
+}
+
+/// The bounding box of `points` and its largest side.
+fn bounds(points: &[[f64; 3]]) -> ([f64; 3], [f64; 3], f64) {
+    let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
+    for p in points {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let size = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
+    (lo, hi, size)
 }
 
 #[derive(Debug)]
@@ -130,10 +152,7 @@ fn check_parts(det: &Detection, points: &[[f64; 3]]) {
 fn ball_every_plane_from_the_data() {
     let (points, truth) = fixture("ball.ply");
     let truth = truth.unwrap();
-    let det = Detector::auto(StructureKind::Planes, &points, &Given::default())
-        .unwrap()
-        .run(&points)
-        .unwrap();
+    let det = planes_from_the_data(&points);
     let s = score(&truth, &det.part_labels(), 1000);
     eprintln!("ball: {s:?}, {} orientations", det.stats.orientations);
     assert_eq!(s.big, 20);
@@ -150,10 +169,7 @@ fn building_planes_from_the_data() {
     // The misses are stepped facades that the labels count as one plane.
     let (points, truth) = fixture("building.ply");
     let truth = truth.unwrap();
-    let det = Detector::auto(StructureKind::Planes, &points, &Given::default())
-        .unwrap()
-        .run(&points)
-        .unwrap();
+    let det = planes_from_the_data(&points);
     let s = score(&truth, &det.part_labels(), 1000);
     eprintln!("building: {s:?}, {} orientations", det.stats.orientations);
     assert_eq!(s.big, 11);
@@ -170,14 +186,7 @@ fn mixed_density_keeps_every_plane() {
     // station half the object's size away; fixed seed).
     let (points, truth) = fixture("ball.ply");
     let truth = truth.unwrap();
-    let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
-    for p in &points {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    let size = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
+    let (lo, hi, size) = bounds(&points);
     let station = [
         lo[0] - 0.5 * size,
         0.5 * (lo[1] + hi[1]),
@@ -185,26 +194,15 @@ fn mixed_density_keeps_every_plane() {
     ];
     let dist = |p: &[f64; 3]| ((0..3).map(|k| (p[k] - station[k]).powi(2)).sum::<f64>()).sqrt();
     let near = points.iter().map(dist).fold(f64::MAX, f64::min);
-    let mut state = 0x5eed_u64;
-    let mut uniform = || {
-        // SplitMix64.
-        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut rng = SplitMix64::new(0x5eed);
     let (mut kept, mut kept_truth) = (Vec::new(), Vec::new());
     for (p, &t) in points.iter().zip(&truth) {
-        if uniform() < (near / dist(p)).powi(2) {
+        if rng.uniform() < (near / dist(p)).powi(2) {
             kept.push(*p);
             kept_truth.push(t);
         }
     }
-    let det = Detector::auto(StructureKind::Planes, &kept, &Given::default())
-        .unwrap()
-        .run(&kept)
-        .unwrap();
+    let det = planes_from_the_data(&kept);
     // Planes that kept at least 300 points (a third of the 1,000 rule).
     let s = score(&kept_truth, &det.part_labels(), 300);
     eprintln!("ball thinned to {} points: {s:?}", kept.len());
@@ -222,14 +220,7 @@ fn tiles_give_the_untiled_result() {
     let (points, _) = fixture("ball.ply");
     let auto = Detector::auto(StructureKind::Planes, &points, &Given::default()).unwrap();
     let whole = auto.clone().run(&points).unwrap();
-    let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
-    for p in &points {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    let size = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
+    let (_, _, size) = bounds(&points);
     let tiled = auto.tile(Some(size / 4.0)).run(&points).unwrap();
     assert!(!whole.simplices.is_empty());
     assert_eq!(whole.simplices, tiled.simplices);
@@ -300,16 +291,10 @@ fn room_is_four_parts() {
     // of Gaussian noise across them, and 2,000 outliers in the room's box
     // (fixed seed). It must come out as four parts, one per surface, no
     // surface twice.
-    let mut state = 0x0_2004_u64;
-    let mut uniform = move || {
-        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    };
-    let gauss = |u: &mut dyn FnMut() -> f64| {
-        let (a, b) = (u().max(1e-300), u());
+    let mut rng = SplitMix64::new(0x2004);
+    // Box–Muller.
+    let gauss = |r: &mut SplitMix64| {
+        let (a, b) = (r.uniform().max(1e-300), r.uniform());
         (-2.0 * a.ln()).sqrt() * (std::f64::consts::TAU * b).cos()
     };
     let (mut points, mut truth) = (Vec::new(), Vec::new());
@@ -318,7 +303,7 @@ fn room_is_four_parts() {
     let n_h = (h / step) as usize;
     for i in 0..=n_w {
         for j in 0..=n_w {
-            let e = noise * gauss(&mut uniform);
+            let e = noise * gauss(&mut rng);
             points.push([i as f64 * step, j as f64 * step, e]);
             truth.push(0);
         }
@@ -327,7 +312,7 @@ fn room_is_four_parts() {
         for i in 0..=n_w {
             for j in 1..=n_h {
                 let (s, z) = (i as f64 * step, j as f64 * step);
-                let e = noise * gauss(&mut uniform);
+                let e = noise * gauss(&mut rng);
                 points.push(match wall {
                     0 => [e, s, z],
                     1 => [s, e, z],
@@ -338,13 +323,10 @@ fn room_is_four_parts() {
         }
     }
     for _ in 0..2000 {
-        points.push([uniform() * w, uniform() * w, uniform() * h]);
+        points.push([rng.uniform() * w, rng.uniform() * w, rng.uniform() * h]);
         truth.push(-1);
     }
-    let det = Detector::auto(StructureKind::Planes, &points, &Given::default())
-        .unwrap()
-        .run(&points)
-        .unwrap();
+    let det = planes_from_the_data(&points);
     let s = score(&truth, &det.part_labels(), 1000);
     eprintln!("room: {s:?}");
     assert_eq!(s.big, 4);
