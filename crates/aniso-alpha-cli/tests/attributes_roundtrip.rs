@@ -11,6 +11,9 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+mod common;
+use common::TempDir;
+
 use aniso_alpha::io::{read_points, Attribute, PointCloud, ReadOptions, Values};
 
 const BIN: &str = env!("CARGO_BIN_EXE_aniso-alpha");
@@ -19,26 +22,6 @@ fn fixture(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../aniso-alpha/tests/fixtures")
         .join(name)
-}
-
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(name: &str) -> Self {
-        let d = std::env::temp_dir().join(format!("aniso-rt-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).unwrap();
-        TempDir(d)
-    }
-    fn path(&self, name: &str) -> PathBuf {
-        self.0.join(name)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
 }
 
 fn s(p: &Path) -> &str {
@@ -205,7 +188,7 @@ const URBAN: [&str; 2] = ["--structure", "planes"];
 
 #[test]
 fn las_and_laz_outputs_keep_every_field_and_add_the_ids() {
-    let dir = TempDir::new("las");
+    let dir = TempDir::new("rt", "las");
     let input = fixture("las/urban.las");
     let before = read_all(&input);
     for (out, classify) in [("out.las", None), ("out.laz", Some(6u8))] {
@@ -247,7 +230,7 @@ fn las_and_laz_outputs_keep_every_field_and_add_the_ids() {
 fn a_laz_input_round_trips_through_laspy() {
     // A LAS 1.4 file (point format 6, extended VLRs) compressed, with
     // --background-classes: every field still comes back.
-    let dir = TempDir::new("laz14");
+    let dir = TempDir::new("rt", "laz14");
     let input = fixture("las/1_4_w_evlr.laz");
     let out = dir.path("out.laz");
     let ids = detect(
@@ -262,7 +245,7 @@ fn a_laz_input_round_trips_through_laspy() {
 
 #[test]
 fn ply_and_e57_inputs_keep_their_attributes_in_ply() {
-    let dir = TempDir::new("ply");
+    let dir = TempDir::new("rt", "ply");
     // E57 (libE57's sample, float x/y/z and 8-bit colours) to PLY.
     let e57 = fixture("e57/tinyCartesianFloatRgb.e57");
     let ply = dir.path("from_e57.ply");
@@ -291,7 +274,7 @@ fn ply_and_e57_inputs_keep_their_attributes_in_ply() {
 fn e57_to_las_keeps_colours_as_fields() {
     // A cloud that is not LAS goes to a LAS 1.2 file of point format 0,
     // its attributes as typed extra bytes; laspy reads them back.
-    let dir = TempDir::new("e57las");
+    let dir = TempDir::new("rt", "e57las");
     let e57 = fixture("e57/tinyCartesianFloatRgb.e57");
     let out = dir.path("out.las");
     let ids = detect(&dir, &e57, &out, &["--structure", "planes"]);

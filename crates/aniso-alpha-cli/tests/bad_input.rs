@@ -1,33 +1,13 @@
 //! Malformed input through the built binary: exit status 1, one line on
 //! stderr naming the file (and line for text), no panic, no output file.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
 
+mod common;
+use common::TempDir;
+
 const BIN: &str = env!("CARGO_BIN_EXE_aniso-alpha");
-
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(name: &str) -> Self {
-        let d = std::env::temp_dir().join(format!("aniso-cli-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).unwrap();
-        TempDir(d)
-    }
-
-    fn file(&self, name: &str, bytes: &[u8]) -> PathBuf {
-        let p = self.0.join(name);
-        std::fs::write(&p, bytes).unwrap();
-        p
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
 
 fn run(args: &[&Path]) -> Output {
     Command::new(BIN)
@@ -80,7 +60,7 @@ fn binary_ply(header_count: usize, written: usize) -> Vec<u8> {
 
 #[test]
 fn malformed_text_inputs() {
-    let d = TempDir::new("text");
+    let d = TempDir::new("cli", "text");
     let out = d.0.join("out.tets");
     let cases: [(&str, &[u8], &[&str]); 7] = [
         ("empty.xyz", b"", &["empty.xyz", "no points"]),
@@ -119,7 +99,7 @@ fn malformed_text_inputs() {
 
 #[test]
 fn malformed_binary_inputs() {
-    let d = TempDir::new("binary");
+    let d = TempDir::new("cli", "binary");
     let out = d.0.join("out.tets");
     let mut truncated = binary_ply(4, 4);
     truncated.truncate(truncated.len() - 5);
@@ -153,7 +133,7 @@ fn malformed_binary_inputs() {
 
 #[test]
 fn bad_paths() {
-    let d = TempDir::new("paths");
+    let d = TempDir::new("cli", "paths");
     let out = d.0.join("out.tets");
     let good = d.file("good.xyz", b"0 0 0\n1 0 0\n0 1 0\n0 0 1\n");
     let unknown = d.file("points.e58", b"0 0 0\n");
@@ -191,7 +171,7 @@ fn bad_paths() {
 
 #[test]
 fn valid_input_gets_past_reading() {
-    let d = TempDir::new("valid");
+    let d = TempDir::new("cli", "valid");
     let out = d.0.join("out.tets");
     let input = d.file("good.xyz", b"0 0 0\n1 0 0\n0 1 0\n0 0 1\n");
     let o = run(&[Path::new("delaunay"), &input, Path::new("--tets"), &out]);
@@ -265,7 +245,7 @@ fn bad_usage_exits_2() {
 #[test]
 fn timings_are_json_on_success_only() {
     // With an error, stderr keeps its single line even with --timings.
-    let d = TempDir::new("timings");
+    let d = TempDir::new("cli", "timings");
     let input = d.file("bad.xyz", b"1 2\n");
     let o = run(&[
         Path::new("delaunay"),
@@ -281,7 +261,7 @@ fn timings_are_json_on_success_only() {
 
 #[test]
 fn coordinates_beyond_exact_arithmetic() {
-    let d = TempDir::new("range");
+    let d = TempDir::new("cli", "range");
     let out = d.0.join("out.tets");
     let huge = d.file("huge.xyz", b"0 0 0\n1 0 0\n0 1 0\n0 0 1e200\n");
     expect_error(&d, &huge, &out, &["huge.xyz", "point 3", "rescale"]);
@@ -295,7 +275,7 @@ fn coordinates_beyond_exact_arithmetic() {
 /// Issue 19 §4: text that used to be misread silently.
 #[test]
 fn misread_text_is_an_error() {
-    let d = TempDir::new("misread");
+    let d = TempDir::new("cli", "misread");
     let out = d.0.join("out.tets");
     let utf16: Vec<u8> = "\u{feff}0 0 0\n1 0 0\n0 1 0\n0 0 1\n"
         .encode_utf16()
@@ -330,7 +310,7 @@ fn misread_text_is_an_error() {
 
 #[test]
 fn header_guess_warns_unless_quiet() {
-    let d = TempDir::new("header");
+    let d = TempDir::new("cli", "header");
     let out = d.0.join("out.tets");
     let input = d.file("h.xyz", b"X Y Z\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n");
     let o = run(&[Path::new("delaunay"), &input, Path::new("--tets"), &out]);
@@ -358,7 +338,7 @@ fn header_guess_warns_unless_quiet() {
 #[test]
 fn stdin_and_format_override() {
     use std::io::Write;
-    let d = TempDir::new("stdin");
+    let d = TempDir::new("cli", "stdin");
     let out = d.0.join("out.tets");
     let mut child = Command::new(BIN)
         .args(["delaunay", "-", "--tets"])
@@ -409,7 +389,7 @@ fn stdin_and_format_override() {
 /// Issue 19 §3: parameters whose size or range cannot work.
 #[test]
 fn huge_m2_is_a_clear_error() {
-    let d = TempDir::new("m2");
+    let d = TempDir::new("cli", "m2");
     let input = d.file("p.xyz", b"0 0 0\n1 0 0\n0 1 0\n0 0 1\n");
     let o = Command::new(BIN)
         .arg("detect")
@@ -441,7 +421,7 @@ fn huge_m2_is_a_clear_error() {
 /// swallowed and the run exited 0 with no structure.
 #[test]
 fn out_of_range_lambda3_names_the_parameter() {
-    let d = TempDir::new("lambda3");
+    let d = TempDir::new("cli", "lambda3");
     let scene = d.0.join("s.xyz");
     let o = Command::new(BIN)
         .args(["synth", "lines", "--seed", "1", "--output"])

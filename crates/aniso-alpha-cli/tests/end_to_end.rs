@@ -4,32 +4,15 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+mod common;
+use common::TempDir;
+
 const BIN: &str = env!("CARGO_BIN_EXE_aniso-alpha");
 
 fn fixture(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../aniso-alpha/tests/fixtures")
         .join(name)
-}
-
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(name: &str) -> Self {
-        let d = std::env::temp_dir().join(format!("aniso-e2e-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).unwrap();
-        TempDir(d)
-    }
-    fn path(&self, name: &str) -> PathBuf {
-        self.0.join(name)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
 }
 
 fn run_in(dir: Option<&Path>, args: &[&str]) -> Output {
@@ -89,7 +72,7 @@ fn read_tets(p: &Path) -> Vec<[u32; 4]> {
 
 #[test]
 fn delaunay_equals_cgal_on_every_fixture() {
-    let dir = TempDir::new("tets");
+    let dir = TempDir::new("e2e", "tets");
     for name in [
         "random_500",
         "grid_6",
@@ -129,7 +112,7 @@ fn delaunay_equals_cgal_on_every_fixture() {
 /// of each tet, and the same from run to run.
 #[test]
 fn delaunay_on_two_threads_equals_one() {
-    let dir = TempDir::new("threads");
+    let dir = TempDir::new("e2e", "threads");
     let input = dir.path("cloud.xyz");
     // 60,000 points: a jittered lattice with exact duplicates and an
     // integer grid block (ties), in a fixed order.
@@ -194,7 +177,7 @@ fn close(a: f64, b: f64) -> bool {
 
 #[test]
 fn alpha_intervals_equal_cgal() {
-    let dir = TempDir::new("intervals");
+    let dir = TempDir::new("e2e", "intervals");
     let cases: [(&str, &[&str]); 4] = [
         ("grid_6", &[]),
         ("sphere_100", &[]),
@@ -232,7 +215,7 @@ fn alpha_intervals_equal_cgal() {
 
 #[test]
 fn alpha_shape_ply_has_faces_and_edges() {
-    let dir = TempDir::new("shape");
+    let dir = TempDir::new("e2e", "shape");
     let out = dir.path("shape.ply");
     ok(&[
         "alpha",
@@ -256,7 +239,7 @@ fn alpha_shape_ply_has_faces_and_edges() {
 fn aniso_alpha_read(p: &Path) -> usize {
     // Count vertices via the `delaunay` subcommand's reader path: a PLY
     // input is accepted and every point read.
-    let dir = TempDir::new("reread");
+    let dir = TempDir::new("e2e", "reread");
     let tets = dir.path("t.tets");
     let o = ok(&[
         "delaunay",
@@ -273,7 +256,7 @@ fn aniso_alpha_read(p: &Path) -> usize {
 
 #[test]
 fn synth_detect_eval_chain() {
-    let dir = TempDir::new("chain");
+    let dir = TempDir::new("e2e", "chain");
     let scene = dir.path("lines.xyz");
     let labels = dir.path("labels.txt");
     let report = dir.path("report.json");
@@ -338,7 +321,7 @@ fn synth_detect_eval_chain() {
 
 #[test]
 fn detect_without_input_runs_the_example() {
-    let dir = TempDir::new("example");
+    let dir = TempDir::new("e2e", "example");
     let o = run_in(Some(&dir.0), &["detect"]);
     assert_eq!(
         o.status.code(),
@@ -363,7 +346,7 @@ fn detect_without_input_runs_the_example() {
 
 #[test]
 fn bad_parameters_are_clean_errors() {
-    let dir = TempDir::new("badparam");
+    let dir = TempDir::new("e2e", "badparam");
     let scene = dir.path("s.xyz");
     ok(&["synth", "lines", "--output", scene.to_str().unwrap()]);
     // Out of range at parse time: exit 2 (usage).
@@ -431,7 +414,7 @@ fn alpha_optimal_and_boundary_surface() {
         String::from_utf8_lossy(&o.stdout),
         format!("optimal alpha {want:?}\n")
     );
-    let dir = TempDir::new("surface");
+    let dir = TempDir::new("e2e", "surface");
     let (all, surf) = (dir.path("all.ply"), dir.path("surf.ply"));
     ok(&[
         "alpha",
@@ -462,7 +445,7 @@ fn alpha_optimal_and_boundary_surface() {
 /// was asked for as the result (eval's scores) still prints.
 #[test]
 fn quiet_means_quiet() {
-    let dir = TempDir::new("quiet");
+    let dir = TempDir::new("e2e", "quiet");
     let silent = |args: &[&str]| {
         let o = run_in(Some(&dir.0), args);
         assert_eq!(o.status.code(), Some(0), "{args:?}");

@@ -1,40 +1,23 @@
 //! Outputs never destroy anything (issue 19 §2): special files, inputs,
 //! duplicate outputs, symbolic links, read-only folders, signals.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
 use std::time::{Duration, Instant};
 
+mod common;
+use common::TempDir;
+
 const BIN: &str = env!("CARGO_BIN_EXE_aniso-alpha");
 
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(name: &str) -> Self {
-        let d = std::env::temp_dir().join(format!("aniso-out-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).unwrap();
-        TempDir(d)
-    }
-    fn file(&self, name: &str, bytes: &[u8]) -> PathBuf {
-        let p = self.0.join(name);
-        std::fs::write(&p, bytes).unwrap();
-        p
-    }
-    fn temps(&self) -> Vec<String> {
-        std::fs::read_dir(&self.0)
-            .unwrap()
-            .filter_map(|e| e.ok())
-            .map(|e| e.file_name().to_string_lossy().into_owned())
-            .filter(|n| n.contains(".tmp-") || n.contains(".probe-"))
-            .collect()
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
+/// The temporary and probe files left in `d` (none, after any run).
+fn temps(d: &TempDir) -> Vec<String> {
+    std::fs::read_dir(&d.0)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains(".tmp-") || n.contains(".probe-"))
+        .collect()
 }
 
 const POINTS: &[u8] = b"0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 1 1\n";
@@ -58,7 +41,7 @@ fn s(p: &Path) -> &str {
 
 #[test]
 fn an_output_that_is_an_input_is_refused() {
-    let d = TempDir::new("same");
+    let d = TempDir::new("out", "same");
     let a = d.file("a.xyz", POINTS);
     let o = run(&["delaunay", s(&a), "--tets", s(&a)]);
     fails_with(&o, &["--tets", "a.xyz", "is the input file"]);
@@ -76,12 +59,12 @@ fn an_output_that_is_an_input_is_refused() {
         &["is the input file"],
     );
     assert_eq!(std::fs::read(&a).unwrap(), POINTS);
-    assert!(d.temps().is_empty());
+    assert!(temps(&d).is_empty());
 }
 
 #[test]
 fn two_outputs_with_one_path_are_refused() {
-    let d = TempDir::new("dup");
+    let d = TempDir::new("out", "dup");
     let scene = d.0.join("scene.xyz");
     assert_eq!(
         run(&["synth", "lines", "--seed", "1", "--output", s(&scene)])
@@ -114,7 +97,7 @@ fn two_outputs_with_one_path_are_refused() {
 #[test]
 fn special_files_are_refused_and_kept() {
     use std::os::unix::fs::FileTypeExt;
-    let d = TempDir::new("fifo");
+    let d = TempDir::new("out", "fifo");
     let a = d.file("a.xyz", POINTS);
     let fifo = d.0.join("out.tets");
     assert!(Command::new("mkfifo")
@@ -133,13 +116,13 @@ fn special_files_are_refused_and_kept() {
         &["not a regular file"],
     );
     assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
-    assert!(d.temps().is_empty());
+    assert!(temps(&d).is_empty());
 }
 
 #[cfg(unix)]
 #[test]
 fn a_symlinked_output_writes_its_target() {
-    let d = TempDir::new("link");
+    let d = TempDir::new("out", "link");
     let a = d.file("a.xyz", POINTS);
     std::fs::create_dir(d.0.join("sub")).unwrap();
     let target = d.0.join("sub").join("real.tets");
@@ -152,14 +135,14 @@ fn a_symlinked_output_writes_its_target() {
         .file_type()
         .is_symlink());
     assert_eq!(std::fs::read_to_string(&target).unwrap().lines().count(), 2);
-    assert!(d.temps().is_empty());
+    assert!(temps(&d).is_empty());
 }
 
 #[cfg(unix)]
 #[test]
 fn a_read_only_folder_fails_before_the_work() {
     use std::os::unix::fs::PermissionsExt;
-    let d = TempDir::new("ro");
+    let d = TempDir::new("out", "ro");
     let a = d.file("a.xyz", POINTS);
     let ro = d.0.join("ro");
     std::fs::create_dir(&ro).unwrap();
@@ -183,7 +166,7 @@ fn a_read_only_folder_fails_before_the_work() {
 /// `signal` and checks that the temporary file is gone.
 #[cfg(unix)]
 fn interrupted(signal: &str, status: i32) {
-    let d = TempDir::new(&format!("sig{signal}"));
+    let d = TempDir::new("out", &format!("sig{signal}"));
     let out = d.0.join("scene.xyz");
     let mut child = Command::new(BIN)
         .args(["synth", "lines", "--output", s(&out)])
@@ -191,7 +174,7 @@ fn interrupted(signal: &str, status: i32) {
         .spawn()
         .unwrap();
     let start = Instant::now();
-    while d.temps().is_empty() {
+    while temps(&d).is_empty() {
         assert!(start.elapsed() < Duration::from_secs(60), "no temp file");
         std::thread::sleep(Duration::from_millis(20));
     }
@@ -202,7 +185,7 @@ fn interrupted(signal: &str, status: i32) {
     assert!(killed.success());
     let st = child.wait().unwrap();
     assert_eq!(st.code(), Some(status), "{signal}");
-    assert!(d.temps().is_empty(), "{:?}", d.temps());
+    assert!(temps(&d).is_empty(), "{:?}", temps(&d));
     assert!(!out.exists());
 }
 

@@ -12,6 +12,9 @@
 //! `<!-- file: PATH -->` must be that file of the repository, verbatim.
 
 use std::path::{Path, PathBuf};
+
+mod common;
+use common::TempDir;
 use std::process::Command;
 
 const BIN: &str = env!("CARGO_BIN_EXE_aniso-alpha");
@@ -21,24 +24,15 @@ fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(name: &str) -> Self {
-        let d = std::env::temp_dir().join(format!("aniso-readme-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(d.join("docs")).unwrap();
-        let bin = d.join(".bin");
-        std::fs::create_dir_all(&bin).unwrap();
-        std::os::unix::fs::symlink(BIN, bin.join("aniso-alpha")).unwrap();
-        TempDir(d)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
+/// The README's scratch folder: an empty `docs/`, and `aniso-alpha` on
+/// the PATH as `.bin/aniso-alpha` (the binary under test).
+fn readme_dir(name: &str) -> TempDir {
+    let d = TempDir::new("readme", name);
+    std::fs::create_dir_all(d.path("docs")).unwrap();
+    let bin = d.path(".bin");
+    std::fs::create_dir_all(&bin).unwrap();
+    std::os::unix::fs::symlink(BIN, bin.join("aniso-alpha")).unwrap();
+    d
 }
 
 /// A fenced block of the README.
@@ -277,7 +271,7 @@ fn check_readme(readme: &str, dir: &Path) -> Result<Report, String> {
 #[test]
 fn every_readme_command_runs_as_written() {
     let readme = std::fs::read_to_string(repo().join("README.md")).unwrap();
-    let dir = TempDir::new("run");
+    let dir = readme_dir("run");
     let report = check_readme(&readme, &dir.0).unwrap_or_else(|e| panic!("{e}"));
     eprintln!(
         "README: {} commands run, {} output block(s) and {} file block(s) checked, {} skipped:",
@@ -302,7 +296,7 @@ fn every_readme_command_runs_as_written() {
 /// block, a stale file block, an unmarked cargo command.
 #[test]
 fn the_readme_check_can_fail() {
-    let dir = TempDir::new("fail");
+    let dir = readme_dir("fail");
     let fence = "```";
     let bad_command = format!("{fence}sh\naniso-alpha synth circles --output x.xyz\n{fence}\n");
     let e = check_readme(&bad_command, &dir.0).unwrap_err();

@@ -12,29 +12,12 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
+mod common;
+use common::TempDir;
+
 use tiny_skia::Pixmap;
 
 const BIN: &str = env!("CARGO_BIN_EXE_aniso-alpha");
-
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(name: &str) -> Self {
-        let d = std::env::temp_dir().join(format!("aniso-view-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).unwrap();
-        TempDir(d)
-    }
-    fn path(&self, name: &str) -> PathBuf {
-        self.0.join(name)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
 
 fn ok(dir: &Path, args: &[&str]) -> Output {
     let o = Command::new(BIN)
@@ -267,7 +250,7 @@ fn viewer_renders_in_headless_chromium() {
         );
         return;
     };
-    let dir = TempDir::new("chromium");
+    let dir = TempDir::new("view", "chromium");
 
     // The checks can fail: a page with a script error is caught, and a
     // page whose canvas stays empty has no variance.
@@ -401,7 +384,7 @@ fn count_color(p: &Pixmap, c: [u8; 3], tol: i32) -> usize {
 
 #[test]
 fn pictures_of_detection_and_shape() {
-    let dir = TempDir::new("png");
+    let dir = TempDir::new("view", "png");
     let (scene, ..) = scene(&dir);
     ok(
         &dir.0,
