@@ -43,7 +43,7 @@ aniso-alpha alpha scan.xyz --alpha 0.5 --output shape.ply\n  \
 aniso-alpha alpha scan.xyz --optimal-alpha --surface --output surface.ply --png surface.png"
 )]
 pub struct AlphaArgs {
-    /// Input point file (.xyz .txt .csv .pts .ply .las .laz .pcd)
+    /// Input point file (.xyz .txt .csv .pts .ply .las .laz .pcd .e57)
     pub input: PathBuf,
     /// Write the alpha interval of every edge and triangle to this CSV file
     #[arg(long, value_name = "OUT.csv")]

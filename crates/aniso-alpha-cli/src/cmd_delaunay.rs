@@ -17,7 +17,7 @@ orient3d(p_i, p_j, p_k, p_l) > 0. Coplanar or collinear input has no tetrahedron
 Example:\n  aniso-alpha delaunay scan.ply --tets scan.tets --timings"
 )]
 pub struct DelaunayArgs {
-    /// Input point file (.xyz .txt .csv .pts .ply .las .laz .pcd)
+    /// Input point file (.xyz .txt .csv .pts .ply .las .laz .pcd .e57)
     pub input: PathBuf,
     /// Output file of tetrahedra
     #[arg(long, value_name = "OUT")]

@@ -26,7 +26,7 @@ Examples:\n  aniso-alpha view scan.xyz --labels labels.txt --part-labels parts.t
 aniso-alpha view scan.las --output scan.html"
 )]
 pub struct ViewArgs {
-    /// Input point file (.xyz .txt .csv .pts .ply .las .laz .pcd), as given to detect
+    /// Input point file (.xyz .txt .csv .pts .ply .las .laz .pcd .e57), as given to detect
     pub input: PathBuf,
     /// Structure label per point, one per line (`detect --labels`)
     #[arg(long, value_name = "L.txt")]

@@ -28,7 +28,7 @@ use common::{CliError, Timings};
 #[derive(Debug, Parser)]
 #[command(name = "aniso-alpha", version, propagate_version = true)]
 #[command(
-    after_help = "Point files: .xyz .txt .csv .pts (text), .ply, .las/.laz, .pcd; `-` reads text from \
+    after_help = "Point files: .xyz .txt .csv .pts (text), .ply, .las/.laz, .pcd, .e57; `-` reads text from \
 standard input; --format overrides the extension.\n\
 Alpha is a radius throughout (CGAL's Alpha_shape_3 takes its square). The method: docs/method.md.\n\
 Errors exit with status 1 and one line on stderr; bad usage exits with 2.\n\n\
@@ -220,6 +220,10 @@ mod tests {
             }
             let help = sub.render_long_help().to_string();
             assert!(!help.contains("SPEC"), "{name}");
+            // Every input format the readers take is named, E57 included.
+            if matches!(name.as_str(), "delaunay" | "alpha" | "view") {
+                assert!(help.contains(".pcd .e57)"), "{name}");
+            }
             let common = help
                 .find("Common options:")
                 .unwrap_or_else(|| panic!("{name}"));

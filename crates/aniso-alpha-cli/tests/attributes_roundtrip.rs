@@ -306,3 +306,36 @@ fn detect_help_documents_the_labelled_outputs() {
         assert!(help.contains(want), "detect --help lacks '{want}':\n{help}");
     }
 }
+
+#[test]
+fn background_classes_are_left_out_of_the_detection() {
+    // urban.las with its most frequent class in structures declared
+    // background: every point of that class comes out -1 (structure and
+    // part), and without the flag some of them are in structures, so the
+    // check can fail.
+    let dir = TempDir::new("rt", "bgclass");
+    let input = fixture("las/urban.las");
+    let class = as_i64(column(&read_all(&input), "classification"));
+    let plain = detect(&dir, &input, &dir.path("plain.las"), &URBAN);
+    let mut counts = std::collections::BTreeMap::<i64, usize>::new();
+    for (c, &l) in class.iter().zip(&plain.0) {
+        if l >= 0 {
+            *counts.entry(*c).or_default() += 1;
+        }
+    }
+    let (&busiest, &n) = counts.iter().max_by_key(|(_, &n)| n).unwrap();
+    assert!(n > 100, "class {busiest}: {n} points in structures");
+    let flag = busiest.to_string();
+    let mut args = URBAN.to_vec();
+    args.extend(["--background-classes", &flag]);
+    let left_out = detect(&dir, &input, &dir.path("out.las"), &args);
+    let mut others = 0;
+    for i in 0..class.len() {
+        if class[i] == busiest {
+            assert_eq!((left_out.0[i], left_out.1[i]), (-1, -1), "point {i}");
+        } else if left_out.0[i] >= 0 {
+            others += 1;
+        }
+    }
+    eprintln!("class {busiest} left out; {others} points of other classes in structures");
+}

@@ -297,7 +297,7 @@ fn synth_detect_eval_chain() {
         serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     assert_eq!(r["orientations"], 162);
     assert!(r["structures"].as_array().unwrap().len() >= 5);
-    // The report of SPEC §7 / docs/method.md §7: a line's part is a segment.
+    // The report of docs/method.md §7: a line's part is a segment.
     assert_eq!(r["structures"][0]["kind"], "line");
     assert!(r["structures"][0]["rms"].as_f64().is_some());
     let part = &r["structures"][0]["parts"][0];

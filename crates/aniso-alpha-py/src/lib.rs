@@ -188,7 +188,7 @@ pub(crate) fn detector_for(p: &Params, pts: &[[f64; 3]]) -> PyResult<Detector<'s
     })
 }
 
-/// Structure detection (SPEC §4): `structure` is "lines" or "planes". With
+/// Structure detection (docs/method.md §4): `structure` is "lines" or "planes". With
 /// alpha, lambda3 and min_size all given, the CLI's explicit run (the
 /// paper's box sampler); otherwise [`Detector::auto`] estimates what is
 /// missing and scans the data orientation set.

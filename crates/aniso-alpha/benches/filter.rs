@@ -1,4 +1,4 @@
-//! The path filter (SPEC §3) on a large triangulated patch with fins.
+//! The path filter (docs/method.md §3) on a large triangulated patch with fins.
 //!
 //! `cargo bench -p aniso-alpha --bench filter`
 //!

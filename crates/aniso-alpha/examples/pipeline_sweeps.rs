@@ -1,6 +1,6 @@
 //! Quality sweeps of the brute-force detection pipelines of
 //! `tests/lines_pipeline_bruteforce.rs` and
-//! `tests/planes_pipeline_bruteforce.rs` (SPEC §4 without the Delaunay
+//! `tests/planes_pipeline_bruteforce.rs` (docs/method.md §4 without the Delaunay
 //! engine): F1 over densities, seeds and orientation samplers. They print
 //! figures and assert nothing, so they are an example, not tests.
 //!

@@ -7,7 +7,7 @@ reaches) and returns the same :class:`~aniso_alpha.Detection` as
 Needs the optional dependency ``dask[distributed]``
 (``pip install "crates/aniso-alpha-py[distributed]"``).
 
-How a run goes (SPEC §8; ARCHITECTURE.md, "Distributed detection"):
+How a run goes (docs/method.md §8; ARCHITECTURE.md, "Distributed detection"):
 
 1. The driver (this process) reads the cloud and makes a plan: the
    parameters, estimated once from the whole cloud when not given (so

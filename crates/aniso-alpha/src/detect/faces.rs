@@ -1,7 +1,7 @@
 //! `F_{k,α}` at one α, straight from a triangulation.
 //!
 //! The detector needs the edges or triangles of `F_α` for a single α per
-//! orientation, not every interval. With SPEC §1's definitions, for a
+//! orientation, not every interval. With docs/method.md §1's definitions, for a
 //! simplex σ with smallest-circumsphere radius ρ(σ):
 //!
 //! * `α_min(σ) ≥ ρ(σ)` always (every sphere through σ is at least that

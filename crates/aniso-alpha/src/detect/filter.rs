@@ -1,4 +1,4 @@
-//! The path filter of non-significant structures (paper §4.2, SPEC §3) and
+//! The path filter of non-significant structures (paper §4.2, docs/method.md §3) and
 //! plain connected components.
 //!
 //! Works on k-simplices given as vertex-index arrays: edges `[u32; 2]`
@@ -459,7 +459,7 @@ pub fn components<S: Simplex>(simplices: &[S]) -> Result<Vec<u32>, FilterError> 
 
 /// Keeps the simplices of connected components ([`components`]) holding at
 /// least `min_size` distinct simplices: the final clean-up of the union of
-/// all orientations (SPEC §4), which must not use the path filter.
+/// all orientations (docs/method.md §4), which must not use the path filter.
 ///
 /// ```
 /// use aniso_alpha::detect::filter::component_size_mask;

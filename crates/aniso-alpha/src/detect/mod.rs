@@ -2,8 +2,8 @@
 //! the path filter of non-significant structures, and least-squares fits.
 //!
 //! * [`orientations`]: the paper's "box" sampler of rotations and a
-//!   near-uniform Fibonacci alternative (SPEC §4);
-//! * [`filter`]: the path filter (SPEC §3) and connected components;
+//!   near-uniform Fibonacci alternative (docs/method.md §4);
+//! * [`filter`]: the path filter (docs/method.md §3) and connected components;
 //! * [`fit`]: least-squares lines and planes;
 //! * [`parts`]: splitting structures into straight/flat parts, and point
 //!   labelling;

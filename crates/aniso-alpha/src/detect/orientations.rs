@@ -1,4 +1,4 @@
-//! Orientation sets A (SPEC §4): the paper's "box" sampler and a
+//! Orientation sets A (docs/method.md §4): the paper's "box" sampler and a
 //! near-uniform Fibonacci sampler.
 //!
 //! Every orientation is a proper rotation R (rows = ellipsoid axes). For

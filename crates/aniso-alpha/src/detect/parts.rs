@@ -1,5 +1,5 @@
 //! Splitting detected structures into their straight or flat primitives,
-//! and labelling points (SPEC §4, "structures").
+//! and labelling points (docs/method.md §4, "structures").
 //!
 //! The union of the filtered α-shapes merges two crossing lines, two planes
 //! cutting each other, or the facets of a polyhedral surface into one
@@ -227,7 +227,7 @@ pub fn linear_parts(
 /// Labels points from labelled simplices: each of the `n_points` points
 /// gets the id (`ids[s]`) of the largest group (most simplices) among the
 /// simplices containing it (smallest id on ties), or −1 if none does. This
-/// is SPEC §4's "the id of the largest structure that contains it, or
+/// is docs/method.md §4's "the id of the largest structure that contains it, or
 /// background".
 ///
 /// ```

@@ -140,7 +140,7 @@ fn duplicates_and_errors() {
     assert_eq!(component_size_mask(&big, 2).unwrap(), vec![true, true]);
 }
 
-// ---- A deliberately naive oracle, straight from SPEC §3. ----
+// ---- A deliberately naive oracle, straight from docs/method.md §3. ----
 
 fn faces_naive(s: &[u32]) -> Vec<Vec<u32>> {
     (0..s.len())
