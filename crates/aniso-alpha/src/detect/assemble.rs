@@ -877,6 +877,8 @@ pub(crate) fn assemble<S: Face>(
         members: Vec<u32>,
         fit: Primitive,
         cand: usize,
+        /// The candidates of the other pieces of a plane found apart (4b).
+        pieces: Vec<usize>,
         log10_nfa: f64,
     }
     let mut parts: Vec<P> = Vec::new();
@@ -892,6 +894,7 @@ pub(crate) fn assemble<S: Face>(
             members: m,
             fit,
             cand: ci,
+            pieces: Vec::new(),
             log10_nfa: f64::NEG_INFINITY,
         });
     }
@@ -977,11 +980,96 @@ pub(crate) fn assemble<S: Face>(
         parts.retain(|p| p.log10_nfa <= log_eps);
         stats.rejected_parts = before - parts.len();
     }
+    // 4b. One plane, one part: planar parts that are the same plane
+    // (`same_primitive`, the test that merges candidates sharing points)
+    // but lie apart (the panes of one wall's windows, a wall cut in two by
+    // an occluder, the ground on both sides of a house) are one part in
+    // several pieces, as a plane is for RANSAC and for the labels of
+    // CGAL's scans. Lines keep their pieces: a segment is a segment.
+    if S::K == 2 && parts.len() > 1 {
+        let as_cand = |p: &P| Cand {
+            fit: p.fit.clone(),
+            tau: cands[p.cand].tau,
+            cell: cands[p.cand].cell,
+            seeds: p.members.clone(),
+            foot: cands[p.cand].foot.clone(),
+        };
+        let probes: Vec<Cand> = parts.iter().map(as_cand).collect();
+        let mut uf = Uf::new(parts.len());
+        let mut merged = false;
+        for a in 0..parts.len() {
+            for b in a + 1..parts.len() {
+                if uf.find(a as u32) != uf.find(b as u32)
+                    && same_primitive(&probes[a], &probes[b], settings.part_angle_deg, points)
+                {
+                    uf.union(a as u32, b as u32);
+                    merged = true;
+                }
+            }
+        }
+        if merged {
+            let mut groups: Vec<Vec<usize>> = vec![Vec::new(); parts.len()];
+            for p in 0..parts.len() {
+                groups[uf.find(p as u32) as usize].push(p);
+            }
+            let mut old: Vec<Option<P>> = parts.drain(..).map(Some).collect();
+            for g in groups.into_iter().filter(|g| !g.is_empty()) {
+                if g.len() == 1 {
+                    parts.push(old[g[0]].take().expect("each part is in one group"));
+                    continue;
+                }
+                let group: Vec<P> = g
+                    .iter()
+                    .map(|&p| old[p].take().expect("each part is in one group"))
+                    .collect();
+                // The largest piece lends its scale (claim radius, cell).
+                let cand = group
+                    .iter()
+                    .max_by(|x, y| {
+                        x.members
+                            .len()
+                            .cmp(&y.members.len())
+                            .then(y.members[0].cmp(&x.members[0]))
+                    })
+                    .map_or(group[0].cand, |p| p.cand);
+                let log10_nfa = group
+                    .iter()
+                    .map(|p| p.log10_nfa)
+                    .fold(f64::INFINITY, f64::min);
+                let mut members: Vec<u32> = group
+                    .iter()
+                    .flat_map(|p| p.members.iter().copied())
+                    .collect();
+                members.sort_unstable();
+                let fit = S::fit(points, &members);
+                if matches!(fit, Primitive::None) {
+                    // Not reached (each piece has a plane); the pieces stay.
+                    parts.extend(group);
+                    continue;
+                }
+                let pieces: Vec<usize> = group
+                    .iter()
+                    .flat_map(|p| std::iter::once(p.cand).chain(p.pieces.iter().copied()))
+                    .filter(|&c| c != cand)
+                    .collect();
+                parts.push(P {
+                    members,
+                    fit,
+                    cand,
+                    pieces,
+                    log10_nfa,
+                });
+            }
+        }
+    }
     // 5. Structures: parts sharing claims and not crossing.
     let np = parts.len();
     let mut part_of_cand = vec![u32::MAX; cands.len()];
     for (pi, p) in parts.iter().enumerate() {
         part_of_cand[p.cand] = pi as u32;
+        for &c in &p.pieces {
+            part_of_cand[c] = pi as u32;
+        }
     }
     let mut uf = Uf::new(np);
     let mut i = 0;

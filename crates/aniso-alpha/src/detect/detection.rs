@@ -74,7 +74,10 @@ pub struct Part {
     /// A plane part's outline: the boundary of the 2D α-shape of its
     /// points on the plane (outer loop, counter-clockwise seen from the
     /// normal), as points on the plane; a line part's segment: its two end
-    /// points (the extreme projections of its points on the line).
+    /// points (the extreme projections of its points on the line). A
+    /// plane found in pieces apart (one wall's window panes) is one part:
+    /// its outline is then the largest piece's outer loop, and its
+    /// [`Self::mesh`] covers every piece.
     pub outline: Vec<[f64; 3]>,
     /// A plane part's clean mesh: the triangles of that 2D α-shape, over
     /// input point indices (one triangulation of the plane, so no two
