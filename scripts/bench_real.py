@@ -4,7 +4,7 @@ CGAL's Efficient RANSAC, CGAL's region growing and an Open3D
 `segment_plane` loop, in one run, on the same files (issue: real scans).
 
     python3 scripts/bench_real.py [--repeat 3] [--bin target/release/aniso-alpha]
-        [--peer /work/peers-bin/cgal_shapes] [--scans building,ball]
+        [--peer /work/peers-bin/cgal_shapes] [--scans building,ball] [--sim room,house]
 
 Needs: numpy; open3d for the Open3D peer (skipped without it); the CGAL
 peer built from scripts/peers/cgal_shapes.cpp (skipped without it; see the
@@ -44,7 +44,34 @@ PEER_PARAMS = {
                  "open3d": {"distance": 0.3, "min_points": 200}},
     "ball": {"ransac": {}, "region": {},
              "open3d": {"distance": 0.05, "min_points": 200}},
+    # Simulated scans (scripts/simulate_scan.py, `--sim`): epsilon three
+    # times the range noise (3 mm room, 1 cm house), cluster epsilon a few
+    # voxels.
+    "room": {"ransac": {"epsilon": 0.01, "cluster-epsilon": 0.1, "min-points": 200},
+             "region": {"epsilon": 0.01, "min-points": 200},
+             "open3d": {"distance": 0.01, "min_points": 200}},
+    "house": {"ransac": {"epsilon": 0.03, "cluster-epsilon": 0.25, "min-points": 100},
+              "region": {"epsilon": 0.03, "min-points": 100},
+              "open3d": {"distance": 0.03, "min_points": 100}},
 }
+
+# Voxel side (m) to which each simulated scan is thinned: the simulator's
+# 0.1-0.2 degree rays give millions of points, mostly next to the
+# stations; one point per voxel keeps a few hundred thousand.
+SIM_VOXEL = {"room": 0.03, "house": 0.08}
+
+
+def simulated(name, tmp, seed=1):
+    """`simulate_scan.py NAME --seed SEED`, one point per voxel: (points, labels, path)."""
+    raw = os.path.join(tmp, name + ".raw.xyz")
+    subprocess.run([sys.executable, os.path.join(ROOT, "scripts/simulate_scan.py"), name,
+                    "--seed", str(seed), "--output", raw], check=True, capture_output=True)
+    a = np.loadtxt(raw)
+    _, idx = np.unique(np.floor(a[:, :3] / SIM_VOXEL[name]).astype(np.int64), axis=0, return_index=True)
+    a = a[np.sort(idx)]
+    path = os.path.join(tmp, name + ".xyz")
+    np.savetxt(path, a[:, :3], fmt="%.5f")
+    return a[:, :3], a[:, 3].astype(np.int64), path
 
 
 def read_ply(path):
@@ -125,6 +152,7 @@ def main():
     ap.add_argument("--bin", default=os.path.join(ROOT, "target/release/aniso-alpha"))
     ap.add_argument("--peer", default="/work/peers-bin/cgal_shapes")
     ap.add_argument("--scans", default="building,ball")
+    ap.add_argument("--sim", default="", help="simulated scans too, e.g. room,house (needs open3d)")
     a = ap.parse_args()
     try:
         import open3d  # noqa: F401
@@ -137,11 +165,16 @@ def main():
         print(f"({a.peer} not found: the CGAL peers are skipped)", file=sys.stderr)
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
-        for name in a.scans.split(","):
-            ply = os.path.join(FIXTURES, name + ".ply")
-            pts, truth = read_ply(ply)
-            xyz = os.path.join(tmp, name + ".xyz")
-            np.savetxt(xyz, pts, fmt="%.6f")
+        scans = [n for n in a.scans.split(",") if n] + [n for n in a.sim.split(",") if n]
+        for name in scans:
+            if name in SIM_VOXEL:
+                pts, truth, xyz = simulated(name, tmp)
+                ply = xyz
+            else:
+                ply = os.path.join(FIXTURES, name + ".ply")
+                pts, truth = read_ply(ply)
+                xyz = os.path.join(tmp, name + ".xyz")
+                np.savetxt(xyz, pts, fmt="%.6f")
             out = os.path.join(tmp, name + ".labels")
             runs = {}
             for _ in range(a.repeat):
