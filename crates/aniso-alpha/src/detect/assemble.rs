@@ -38,6 +38,7 @@ use super::scan::Face;
 use super::significance::{log10_n_tests, part_log10_nfa};
 use super::StructureKind;
 use crate::geometry::kdtree::KdTree;
+use crate::geometry::{dot, sub};
 
 /// The scale of the candidates found by one group (mode) of orientations.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -70,6 +71,12 @@ const CROSS_SHARE: usize = 5;
 /// Along a line, points within this fraction of the line's extent of the
 /// crossing point count as on neither side.
 const CROSS_LINE_MARGIN: f64 = 0.05;
+
+/// Floor of a plane's side tolerance in [`crosses`], relative to the sum
+/// of the plane's two extents: with a zero RMS residual (exactly planar
+/// points) the points of B within rounding of the plane still count as on
+/// neither side.
+const CROSS_PLANE_SLACK: f64 = 1e-9;
 
 /// Ratio of the outer to the inner radius of the shell in which the local
 /// background density around a part is measured.
@@ -221,13 +228,6 @@ struct Footprint {
 /// Largest number of cells of one footprint; beyond it the cell is
 /// doubled (a coarser footprint, never a failure).
 const MAX_CELLS: usize = 1 << 24;
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
 
 impl Footprint {
     fn frame(fit: &Primitive) -> Option<([f64; 3], [[f64; 3]; 2], bool)> {
@@ -419,7 +419,7 @@ fn crosses(fit: &Primitive, b: &[u32], points: &[[f64; 3]]) -> bool {
     };
     let (pos, neg) = match fit {
         Primitive::Plane(pf) => {
-            let tol = 3.0 * pf.rms_residual + 1e-9 * (pf.extent[0] + pf.extent[1]);
+            let tol = 3.0 * pf.rms_residual + CROSS_PLANE_SLACK * (pf.extent[0] + pf.extent[1]);
             let mut c = (0, 0);
             for &v in b {
                 match side(dot(sub(points[v as usize], pf.centroid), pf.normal), tol) {
