@@ -39,6 +39,7 @@ use super::significance::{log10_n_tests, part_log10_nfa};
 use super::StructureKind;
 use crate::geometry::kdtree::KdTree;
 use crate::geometry::{dot, sub};
+use crate::unionfind::UnionFind;
 
 /// The scale of the candidates found by one group (mode) of orientations.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -532,26 +533,6 @@ fn same_primitive(a: &Cand, b: &Cand, angle_deg: f64, points: &[[f64; 3]]) -> bo
     near as f64 >= SAME_SHARE * small.seeds.len() as f64
 }
 
-struct Uf(Vec<u32>);
-impl Uf {
-    fn new(n: usize) -> Self {
-        Uf((0..n as u32).collect())
-    }
-    fn find(&mut self, mut x: u32) -> u32 {
-        while self.0[x as usize] != x {
-            self.0[x as usize] = self.0[self.0[x as usize] as usize];
-            x = self.0[x as usize];
-        }
-        x
-    }
-    fn union(&mut self, a: u32, b: u32) {
-        let (ra, rb) = (self.find(a), self.find(b));
-        if ra != rb {
-            self.0[ra.max(rb) as usize] = ra.min(rb);
-        }
-    }
-}
-
 /// Greedy extraction of straight/flat primitives from one connected
 /// component (step 1 of the module doc): their inlier vertices and fits.
 fn extract<S: Face>(
@@ -771,7 +752,7 @@ pub(crate) fn assemble<S: Face>(
     let mut claims = claims_of(&cands, &mut stamp);
     // Merge candidates that are one primitive and share claimed points.
     loop {
-        let mut uf = Uf::new(cands.len());
+        let mut uf = UnionFind::new(cands.len());
         let mut merged = false;
         let mut pairs: Vec<(u32, u32)> = Vec::new();
         let mut i = 0;
@@ -798,7 +779,7 @@ pub(crate) fn assemble<S: Face>(
                     points,
                 )
             {
-                uf.union(a, b);
+                uf.union_min_root(a, b);
                 merged = true;
             }
         }
@@ -983,7 +964,7 @@ pub(crate) fn assemble<S: Face>(
     for (pi, p) in parts.iter().enumerate() {
         part_of_cand[p.cand] = pi as u32;
     }
-    let mut uf = Uf::new(np);
+    let mut uf = UnionFind::new(np);
     let mut i = 0;
     let mut pairs: Vec<(u32, u32)> = Vec::new();
     while i < claims.len() {
@@ -1009,7 +990,7 @@ pub(crate) fn assemble<S: Face>(
     for (a, b) in pairs {
         let (pa, pb) = (&parts[a as usize], &parts[b as usize]);
         if !crosses(&pa.fit, &pb.members, points) && !crosses(&pb.fit, &pa.members, points) {
-            uf.union(a, b);
+            uf.union_min_root(a, b);
         }
     }
     let mut members_of: Vec<Vec<u32>> = vec![Vec::new(); np];
