@@ -163,15 +163,11 @@ pub fn modes(axes: &[[f64; 3]], h: f64, min_support: usize) -> Vec<Mode> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::rng::SplitMix64;
 
     fn rng(seed: u64) -> impl FnMut() -> f64 {
-        let mut s = seed;
-        move || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        }
+        let mut rng = SplitMix64::new(seed);
+        move || rng.uniform()
     }
 
     /// Axes scattered by about `spread` radians around `c`, random signs.

@@ -549,6 +549,7 @@ fn tile_job<S: Face>(
 mod tests {
     use super::*;
     use crate::detect::detector::Given;
+    use crate::rng::SplitMix64;
     use crate::synth;
 
     /// Runs a plan tile by tile, each tile seeing only its own points (as a
@@ -607,13 +608,8 @@ mod tests {
     fn auto_split_equals_run() {
         // Two perpendicular noisy planes crossing many tiles.
         let mut pts = Vec::new();
-        let mut s = 7u64;
-        let mut noise = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((s >> 33) as f64 / (1u64 << 31) as f64 - 0.5) * 0.02
-        };
+        let mut rng = SplitMix64::new(7);
+        let mut noise = || (rng.uniform() - 0.5) * 0.02;
         for i in 0..40 {
             for j in 0..40 {
                 let (x, y) = (0.25 * i as f64, 0.25 * j as f64);
