@@ -291,7 +291,7 @@ mod tests {
 
     #[test]
     fn matches_brute_force() {
-        let mut rng = SplitMix64::new(11u64);
+        let mut rng = SplitMix64::new(11);
         let mut rnd = || rng.uniform();
         for round in 0..50 {
             let n = 1 + round * 7;
@@ -316,7 +316,7 @@ mod tests {
 
     #[test]
     fn candidate_pairs_under_a_map_match_brute_force() {
-        let mut rng = SplitMix64::new(3u64);
+        let mut rng = SplitMix64::new(3);
         let mut rnd = || rng.uniform();
         for round in 0..20 {
             let pts: Vec<[f64; 3]> = (0..200)
