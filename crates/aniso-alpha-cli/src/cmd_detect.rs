@@ -7,10 +7,10 @@ use std::time::Instant;
 use aniso_alpha::detect::detector::{Detection, Detector, Given, OrientationSet, Primitive};
 use aniso_alpha::detect::orientations::Sampler;
 use aniso_alpha::detect::StructureKind;
-use aniso_alpha::eval::evaluate;
-use aniso_alpha::io::{write_scene, Labelled, Mesh, PointCloud, ReadOptions};
+use aniso_alpha::eval::{evaluate, Evaluation};
+use aniso_alpha::io::{self, write_scene, Mesh, PointCloud, ReadOptions};
 use aniso_alpha::report::detection_json;
-use aniso_alpha::synth::SceneOptions;
+use aniso_alpha::synth::{Scene, SceneOptions};
 use clap::{Args, ValueEnum};
 use serde_json::json;
 
@@ -205,28 +205,80 @@ fn detector<'a>(
     )
 }
 
-/// Runs `detect`.
-pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
-    let example = args.input.is_none();
-    // The built-in example writes into a folder of its own.
-    let dir = PathBuf::from("aniso-alpha-example");
-    let pick = |given: &Option<PathBuf>, name: &str| -> Option<PathBuf> {
-        given.clone().or_else(|| example.then(|| dir.join(name)))
-    };
-    let labels_path = pick(&args.labels, "labels.txt");
-    let parts_path = pick(&args.part_labels, "parts.txt");
-    let output_path = pick(&args.output, "structures.ply");
-    let report_path = pick(&args.report, "report.json");
-    let html_path = pick(&args.html, "view.html");
-    let scene_path = example.then(|| dir.join("scene.xyz"));
-    if example {
-        std::fs::create_dir_all(&dir)
-            .map_err(|e| CliError::msg(format!("{}: cannot create folder: {e}", dir.display())))?;
+/// The folder the built-in example writes into.
+const EXAMPLE_DIR: &str = "aniso-alpha-example";
+
+/// Where a run writes: the paths given, or for the built-in example its
+/// default files in [`EXAMPLE_DIR`].
+struct OutputPaths {
+    labels: Option<PathBuf>,
+    parts: Option<PathBuf>,
+    output: Option<PathBuf>,
+    report: Option<PathBuf>,
+    html: Option<PathBuf>,
+    /// The example's scene (x y z label part).
+    scene: Option<PathBuf>,
+    /// `output` is the input cloud with its labels (.las/.laz/.ply), not
+    /// the parts' meshes alone.
+    labelled_output: bool,
+}
+
+impl OutputPaths {
+    /// The output paths of a run, checked before any work (formats,
+    /// `--classify` against the output and the structure kind, no output
+    /// overwriting the input or another output); creates the example's
+    /// folder.
+    fn prepare(args: &DetectArgs, example: bool) -> Result<Self, CliError> {
+        let dir = PathBuf::from(EXAMPLE_DIR);
+        let pick = |given: &Option<PathBuf>, name: &str| -> Option<PathBuf> {
+            given.clone().or_else(|| example.then(|| dir.join(name)))
+        };
+        let paths = OutputPaths {
+            labels: pick(&args.labels, "labels.txt"),
+            parts: pick(&args.part_labels, "parts.txt"),
+            output: pick(&args.output, "structures.ply"),
+            report: pick(&args.report, "report.json"),
+            html: pick(&args.html, "view.html"),
+            scene: example.then(|| dir.join("scene.xyz")),
+            labelled_output: false,
+        };
+        if example {
+            std::fs::create_dir_all(&dir).map_err(|e| {
+                CliError::msg(format!("{}: cannot create folder: {e}", dir.display()))
+            })?;
+        }
+        let labelled_output = match &paths.output {
+            Some(p) => common::cloud_output(p)? == common::CloudOutput::Labelled,
+            None => false,
+        };
+        check_classify(args, labelled_output)?;
+        if let Some(out) = &args.union {
+            common::mesh_format(out)?;
+        }
+        let inputs: Vec<&std::path::Path> = args.input.iter().map(|p| p.as_path()).collect();
+        common::check_io(
+            &inputs,
+            &[
+                ("--labels", paths.labels.as_deref()),
+                ("--part-labels", paths.parts.as_deref()),
+                ("--output", paths.output.as_deref()),
+                ("--union", args.union.as_deref()),
+                ("--report", paths.report.as_deref()),
+                ("(scene)", paths.scene.as_deref()),
+                ("--html", paths.html.as_deref()),
+                ("--png", args.png.as_deref()),
+            ],
+        )?;
+        Ok(OutputPaths {
+            labelled_output,
+            ..paths
+        })
     }
-    let labelled_output = match &output_path {
-        Some(p) => common::cloud_output(p)? == common::CloudOutput::Labelled,
-        None => false,
-    };
+}
+
+/// `--classify` needs a labelled cloud output and names the structure
+/// kind looked for.
+fn check_classify(args: &DetectArgs, labelled_output: bool) -> Result<(), CliError> {
     if let Some(c) = args.classify {
         if !labelled_output {
             return Err(CliError::msg(
@@ -239,35 +291,29 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
             ));
         }
     }
-    if let Some(out) = &args.union {
-        common::mesh_format(out)?;
-    }
-    let inputs: Vec<&std::path::Path> = args.input.iter().map(|p| p.as_path()).collect();
-    common::check_io(
-        &inputs,
-        &[
-            ("--labels", labels_path.as_deref()),
-            ("--part-labels", parts_path.as_deref()),
-            ("--output", output_path.as_deref()),
-            ("--union", args.union.as_deref()),
-            ("--report", report_path.as_deref()),
-            ("(scene)", scene_path.as_deref()),
-            ("--html", html_path.as_deref()),
-            ("--png", args.png.as_deref()),
-        ],
-    )?;
-    let (cloud, truth, name) = match &args.input {
+    Ok(())
+}
+
+/// The points to run on: the input file's, or the built-in example's
+/// scene (generated, and written to `paths.scene`), with the scene as the
+/// ground truth and the name the summary and report give the input.
+fn read_cloud(
+    args: &DetectArgs,
+    paths: &OutputPaths,
+    timings: &mut Timings,
+) -> Result<(PointCloud, Option<Scene>, String), CliError> {
+    match &args.input {
         Some(input) => {
             let options = ReadOptions {
-                attributes: labelled_output || args.background_classes.is_some(),
+                attributes: paths.labelled_output || args.background_classes.is_some(),
                 ..ReadOptions::default()
             };
             let cloud = common::read_input(input, &options, timings)?;
-            (cloud, None, input.display().to_string())
+            Ok((cloud, None, input.display().to_string()))
         }
         None => {
             let scene = timings.phase("synth", || SceneOptions::polyhedron().seed(1).generate())?;
-            if let Some(p) = &scene_path {
+            if let Some(p) = &paths.scene {
                 timings.phase("write", || write_scene(p, &scene, true))?;
             }
             let name = "built-in example (Fig. 10-like polyhedron in background)".to_string();
@@ -275,21 +321,20 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
                 points: scene.points.clone(),
                 ..PointCloud::default()
             };
-            (cloud, Some(scene), name)
+            Ok((cloud, Some(scene), name))
         }
-    };
-    // --background-classes: the detection runs on the other points; ids
-    // and meshes are mapped back to the input's points.
-    let keep = match &args.input {
-        Some(input) => common::kept_points(&cloud, input, args.background_classes)?,
-        None => None,
-    };
-    let subset: Option<Vec<[f64; 3]>> = keep
-        .as_ref()
-        .map(|k| k.iter().map(|&i| cloud.points[i as usize]).collect());
-    let points: &[[f64; 3]] = subset.as_deref().unwrap_or(&cloud.points);
-    let keep = keep.as_deref();
-    let n_input = cloud.points.len();
+    }
+}
+
+/// Builds the detector (phase "estimate") and runs it on `points` (phase
+/// "detect") behind a progress bar: the detector, its detection and the
+/// wall seconds of the two.
+fn detect_points<'a>(
+    args: &DetectArgs,
+    points: &[[f64; 3]],
+    example: bool,
+    timings: &mut Timings,
+) -> Result<(Detector<'a>, Detection, f64), CliError> {
     let in_file = |e: aniso_alpha::detect::detector::DetectError| match &args.input {
         Some(p) => CliError::in_file(p, e),
         None => CliError::msg(e.to_string()),
@@ -314,28 +359,59 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
         .map_err(in_file)?;
     let seconds = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
+    Ok((detector, det, seconds))
+}
 
-    let part_labels = common::spread(&det.part_labels(), keep, n_input);
-    let labels = common::spread(&det.labels, keep, n_input);
-    if let Some(p) = &labels_path {
-        common::write_output(p, timings, |w| write_ints(w, &labels))?;
+/// A detection with its labels mapped back to the input's points (the
+/// detection ran on `points`, the input's points at the positions `keep`,
+/// or all of them).
+struct Outcome<'a> {
+    cloud: &'a PointCloud,
+    points: &'a [[f64; 3]],
+    keep: Option<&'a [u32]>,
+    det: &'a Detection,
+    /// Structure id per input point, or −1.
+    labels: Vec<i64>,
+    /// Part id per input point, or −1.
+    part_labels: Vec<i64>,
+}
+
+/// Writes, in this order, the per-point labels (`--labels`,
+/// `--part-labels`), the labelled cloud or the parts' meshes
+/// (`--output`) and the raw union (`--union`).
+fn write_labels_and_meshes(
+    args: &DetectArgs,
+    paths: &OutputPaths,
+    run: &Outcome<'_>,
+    timings: &mut Timings,
+) -> Result<(), CliError> {
+    let Outcome {
+        cloud,
+        points,
+        keep,
+        det,
+        labels,
+        part_labels,
+    } = run;
+    if let Some(p) = &paths.labels {
+        common::write_output(p, timings, |w| write_ints(w, labels))?;
     }
-    if let Some(p) = &parts_path {
-        common::write_output(p, timings, |w| write_ints(w, &part_labels))?;
+    if let Some(p) = &paths.parts {
+        common::write_output(p, timings, |w| write_ints(w, part_labels))?;
     }
-    if let Some(p) = &output_path {
-        let (mut edges, mut faces, element_labels) = part_meshes(&det, points);
-        common::reindex(&mut edges, keep);
-        common::reindex(&mut faces, keep);
-        if labelled_output {
-            let labelled = Labelled {
+    if let Some(p) = &paths.output {
+        let (mut edges, mut faces, element_labels) = part_meshes(det, points);
+        common::reindex(&mut edges, *keep);
+        common::reindex(&mut faces, *keep);
+        if paths.labelled_output {
+            let labelled = io::Labelled {
                 edges: &edges,
                 faces: &faces,
                 element_labels: &element_labels,
                 classify: args.classify.map(|c| c.class),
-                ..Labelled::new(&labels, &part_labels)
+                ..io::Labelled::new(labels, part_labels)
             };
-            common::write_labelled(p, &cloud, &labelled, timings)?;
+            common::write_labelled(p, cloud, &labelled, timings)?;
         } else {
             let mesh = Mesh {
                 edges: &edges,
@@ -346,72 +422,129 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
         }
     }
     if let Some(p) = &args.union {
-        let (mut edges, mut faces) = split_simplices(&det);
-        common::reindex(&mut edges, keep);
-        common::reindex(&mut faces, keep);
+        let (mut edges, mut faces) = split_simplices(det);
+        common::reindex(&mut edges, *keep);
+        common::reindex(&mut faces, *keep);
         let mesh = Mesh {
-            labels: Some(&labels),
+            labels: Some(labels),
             edges: &edges,
             faces: &faces,
             ..Mesh::new(&cloud.points)
         };
         common::write_mesh(p, &mesh, timings)?;
     }
-    let scores = truth.as_ref().and_then(|scene| {
-        evaluate(
-            &scene.labels,
-            Some(&scene.parts),
-            &det.labels,
-            Some(&part_labels),
-        )
-        .ok()
-    });
-    let report = {
-        let mut r = json!({"input": name});
-        if let (Some(o), serde_json::Value::Object(rest)) =
-            (r.as_object_mut(), detection_json(&det, &detector))
-        {
-            o.extend(rest);
-        }
-        r["seconds"] = json!(seconds);
-        if let Some(ev) = &scores {
-            r["scores"] = json!({
-                "precision": ev.precision, "recall": ev.recall, "f1": ev.f1,
-                "structures_found": ev.structures_found, "structures_total": ev.structures_total,
-                "parts_found": ev.parts_found, "parts_total": ev.parts_total,
-            });
-        }
-        r
-    };
-    if let Some(p) = &report_path {
+    Ok(())
+}
+
+/// The JSON report of a run: the input's name, the detection (parameters
+/// with their reasons, structures, parts), the seconds of the run and the
+/// scores against a ground truth.
+fn report_json(
+    name: &str,
+    det: &Detection,
+    detector: &Detector<'_>,
+    seconds: f64,
+    scores: Option<&Evaluation>,
+) -> serde_json::Value {
+    let mut r = json!({"input": name});
+    if let (Some(o), serde_json::Value::Object(rest)) =
+        (r.as_object_mut(), detection_json(det, detector))
+    {
+        o.extend(rest);
+    }
+    r["seconds"] = json!(seconds);
+    if let Some(ev) = scores {
+        r["scores"] = json!({
+            "precision": ev.precision, "recall": ev.recall, "f1": ev.f1,
+            "structures_found": ev.structures_found, "structures_total": ev.structures_total,
+            "parts_found": ev.parts_found, "parts_total": ev.parts_total,
+        });
+    }
+    r
+}
+
+/// Writes, in this order, the report (`--report`, with the timings of the
+/// phases so far), the interactive view (`--html`) and the picture
+/// (`--png`).
+fn write_report_and_views(
+    args: &DetectArgs,
+    paths: &OutputPaths,
+    name: &str,
+    run: &Outcome<'_>,
+    report: &serde_json::Value,
+    timings: &mut Timings,
+) -> Result<(), CliError> {
+    if let Some(p) = &paths.report {
         let mut r = report.clone();
         // Wall seconds of the phases so far (the report itself is the last
         // output written).
         r["timings"] = timings.to_value();
         common::write_json(p, &r, timings)?;
     }
-    if let Some(p) = &html_path {
+    if let Some(p) = &paths.html {
         crate::view::write_html(
             p,
-            &name,
-            points,
-            &det.labels,
-            &part_labels,
-            &report,
+            name,
+            run.points,
+            &run.det.labels,
+            &run.part_labels,
+            report,
             timings,
         )?;
     }
     if let Some(p) = &args.png {
-        crate::picture::write_detection_png(p, points, &det, &part_labels, timings)?;
+        crate::picture::write_detection_png(p, run.points, run.det, &run.part_labels, timings)?;
     }
+    Ok(())
+}
+
+/// Runs `detect`.
+pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
+    let example = args.input.is_none();
+    let paths = OutputPaths::prepare(args, example)?;
+    let (cloud, truth, name) = read_cloud(args, &paths, timings)?;
+    // --background-classes: the detection runs on the other points; ids
+    // and meshes are mapped back to the input's points.
+    let keep = match &args.input {
+        Some(input) => common::kept_points(&cloud, input, args.background_classes)?,
+        None => None,
+    };
+    let subset: Option<Vec<[f64; 3]>> = keep
+        .as_ref()
+        .map(|k| k.iter().map(|&i| cloud.points[i as usize]).collect());
+    let points: &[[f64; 3]] = subset.as_deref().unwrap_or(&cloud.points);
+    let keep = keep.as_deref();
+    let n_input = cloud.points.len();
+    let (detector, det, seconds) = detect_points(args, points, example, timings)?;
+
+    let run = Outcome {
+        cloud: &cloud,
+        points,
+        keep,
+        det: &det,
+        labels: common::spread(&det.labels, keep, n_input),
+        part_labels: common::spread(&det.part_labels(), keep, n_input),
+    };
+    write_labels_and_meshes(args, &paths, &run, timings)?;
+    let scores = truth.as_ref().and_then(|scene| {
+        evaluate(
+            &scene.labels,
+            Some(&scene.parts),
+            &det.labels,
+            Some(&run.part_labels),
+        )
+        .ok()
+    });
+    let report = report_json(&name, &det, &detector, seconds, scores.as_ref());
+    write_report_and_views(args, &paths, &name, &run, &report, timings)?;
+
     let mut out = summary(&name, &det, &detector, &report, seconds);
     if let Some(ev) = &scores {
         out.push_str(&format!("\nAgainst the scene's ground truth:\n{ev}\n"));
     }
     if example {
         out.push_str(&format!(
-            "\nWrote {}: scene.xyz (x y z label part), labels.txt, parts.txt, structures.ply, report.json, view.html\n",
-            dir.display()
+            "\nWrote {EXAMPLE_DIR}: scene.xyz (x y z label part), labels.txt, parts.txt, structures.ply, report.json, view.html\n",
         ));
     }
     common::print_summary(&out)

@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 mod common;
+use aniso_alpha::rng::SplitMix64;
 use common::TempDir;
 
 const BIN: &str = env!("CARGO_BIN_EXE_aniso-alpha");
@@ -117,12 +118,9 @@ fn delaunay_on_two_threads_equals_one() {
     // 60,000 points: a jittered lattice with exact duplicates and an
     // integer grid block (ties), in a fixed order.
     let mut text = String::new();
-    let mut state = 0x9E37_79B9_7F4A_7C15u64;
+    let mut rng = SplitMix64::new(0x9E37_79B9_7F4A_7C15);
     for i in 0..54_000u64 {
-        state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        let r = (state >> 33) as f64 / (1u64 << 31) as f64;
+        let r = rng.uniform();
         text += &format!("{} {} {}\n", i % 40, i / 40 % 45, (i / 1800) as f64 + r);
     }
     for i in 0..6_000 {

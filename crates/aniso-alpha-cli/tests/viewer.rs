@@ -13,6 +13,7 @@ use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 mod common;
+use aniso_alpha::rng::SplitMix64;
 use common::TempDir;
 
 use tiny_skia::Pixmap;
@@ -200,13 +201,8 @@ fn scene(dir: &TempDir) -> (PathBuf, PathBuf, PathBuf, PathBuf) {
     for i in 0..=30 {
         add([4.0 + i as f64 * 0.5, 4.0, 8.0], 1, 2);
     }
-    let mut s = 7u64;
-    let mut rnd = || {
-        s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (s >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut rng = SplitMix64::new(7);
+    let mut rnd = || rng.uniform();
     for _ in 0..400 {
         add(
             [rnd() * 24.0 - 4.0, rnd() * 14.0 - 2.0, rnd() * 14.0 - 2.0],

@@ -54,6 +54,7 @@ pub mod io;
 pub mod report;
 pub mod rng;
 pub mod synth;
+mod unionfind;
 
 pub use alpha::AlphaComplex;
 pub use delaunay::{DelaunayError, Triangulation};

@@ -90,6 +90,7 @@ pub mod exact;
 
 use crate::delaunay::{DelaunayError, Triangulation, VertexId, EDGES as PAIRS, FACE, INFINITE};
 use crate::geometry::{transform_points, Point3};
+use crate::unionfind::UnionFind;
 
 /// `Q = diag(e)·R` from a rotation and an elongation (the one definition
 /// is [`crate::geometry::q_matrix`]).
@@ -483,7 +484,7 @@ impl AlphaComplex {
             .collect();
         order
             .sort_unstable_by(|&a, &b| self.cell_r[a as usize].total_cmp(&self.cell_r[b as usize]));
-        let mut parent: Vec<u32> = (0..self.cell_r.len() as u32).collect();
+        let mut uf = UnionFind::new(self.cell_r.len());
         let mut added = vec![false; self.cell_r.len()];
         let mut covered = vec![false; self.tri.num_vertices()];
         let mut n_covered = 0usize;
@@ -505,12 +506,8 @@ impl AlphaComplex {
                 }
                 for i in 0..4 {
                     let (n, _) = self.tri.neighbor(t, i);
-                    if added[n as usize] {
-                        let (ra, rb) = (find(&mut parent, t), find(&mut parent, n));
-                        if ra != rb {
-                            parent[ra as usize] = rb;
-                            components -= 1;
-                        }
+                    if added[n as usize] && uf.union(t, n) {
+                        components -= 1;
                     }
                 }
             }
@@ -737,16 +734,6 @@ fn find_edge_id(edges: &[[u32; 2]], start: &[u32], x: u32, y: u32) -> u32 {
         e += 1;
     }
     e as u32
-}
-
-/// Union-find root with path halving.
-fn find(parent: &mut [u32], mut x: u32) -> u32 {
-    while parent[x as usize] != x {
-        let p = parent[parent[x as usize] as usize];
-        parent[x as usize] = p;
-        x = p;
-    }
-    x
 }
 
 /// Step 3 of the algorithm: the circumradius and Gabriel mask (see

@@ -38,6 +38,8 @@ use super::scan::Face;
 use super::significance::{log10_n_tests, part_log10_nfa};
 use super::StructureKind;
 use crate::geometry::kdtree::KdTree;
+use crate::geometry::{dot, sub};
+use crate::unionfind::UnionFind;
 
 /// The scale of the candidates found by one group (mode) of orientations.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -70,6 +72,12 @@ const CROSS_SHARE: usize = 5;
 /// Along a line, points within this fraction of the line's extent of the
 /// crossing point count as on neither side.
 const CROSS_LINE_MARGIN: f64 = 0.05;
+
+/// Floor of a plane's side tolerance in [`crosses`], relative to the sum
+/// of the plane's two extents: with a zero RMS residual (exactly planar
+/// points) the points of B within rounding of the plane still count as on
+/// neither side.
+const CROSS_PLANE_SLACK: f64 = 1e-9;
 
 /// Ratio of the outer to the inner radius of the shell in which the local
 /// background density around a part is measured.
@@ -221,13 +229,6 @@ struct Footprint {
 /// Largest number of cells of one footprint; beyond it the cell is
 /// doubled (a coarser footprint, never a failure).
 const MAX_CELLS: usize = 1 << 24;
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
 
 impl Footprint {
     fn frame(fit: &Primitive) -> Option<([f64; 3], [[f64; 3]; 2], bool)> {
@@ -419,7 +420,7 @@ fn crosses(fit: &Primitive, b: &[u32], points: &[[f64; 3]]) -> bool {
     };
     let (pos, neg) = match fit {
         Primitive::Plane(pf) => {
-            let tol = 3.0 * pf.rms_residual + 1e-9 * (pf.extent[0] + pf.extent[1]);
+            let tol = 3.0 * pf.rms_residual + CROSS_PLANE_SLACK * (pf.extent[0] + pf.extent[1]);
             let mut c = (0, 0);
             for &v in b {
                 match side(dot(sub(points[v as usize], pf.centroid), pf.normal), tol) {
@@ -530,26 +531,6 @@ fn same_primitive(a: &Cand, b: &Cand, angle_deg: f64, points: &[[f64; 3]]) -> bo
         .filter(|&&v| big.fit.distance(&points[v as usize]) <= big.tau)
         .count();
     near as f64 >= SAME_SHARE * small.seeds.len() as f64
-}
-
-struct Uf(Vec<u32>);
-impl Uf {
-    fn new(n: usize) -> Self {
-        Uf((0..n as u32).collect())
-    }
-    fn find(&mut self, mut x: u32) -> u32 {
-        while self.0[x as usize] != x {
-            self.0[x as usize] = self.0[self.0[x as usize] as usize];
-            x = self.0[x as usize];
-        }
-        x
-    }
-    fn union(&mut self, a: u32, b: u32) {
-        let (ra, rb) = (self.find(a), self.find(b));
-        if ra != rb {
-            self.0[ra.max(rb) as usize] = ra.min(rb);
-        }
-    }
 }
 
 /// Greedy extraction of straight/flat primitives from one connected
@@ -771,7 +752,7 @@ pub(crate) fn assemble<S: Face>(
     let mut claims = claims_of(&cands, &mut stamp);
     // Merge candidates that are one primitive and share claimed points.
     loop {
-        let mut uf = Uf::new(cands.len());
+        let mut uf = UnionFind::new(cands.len());
         let mut merged = false;
         let mut pairs: Vec<(u32, u32)> = Vec::new();
         let mut i = 0;
@@ -798,7 +779,7 @@ pub(crate) fn assemble<S: Face>(
                     points,
                 )
             {
-                uf.union(a, b);
+                uf.union_min_root(a, b);
                 merged = true;
             }
         }
@@ -1071,7 +1052,7 @@ pub(crate) fn assemble<S: Face>(
             part_of_cand[c] = pi as u32;
         }
     }
-    let mut uf = Uf::new(np);
+    let mut uf = UnionFind::new(np);
     let mut i = 0;
     let mut pairs: Vec<(u32, u32)> = Vec::new();
     while i < claims.len() {
@@ -1097,7 +1078,7 @@ pub(crate) fn assemble<S: Face>(
     for (a, b) in pairs {
         let (pa, pb) = (&parts[a as usize], &parts[b as usize]);
         if !crosses(&pa.fit, &pb.members, points) && !crosses(&pb.fit, &pa.members, points) {
-            uf.union(a, b);
+            uf.union_min_root(a, b);
         }
     }
     let mut members_of: Vec<Vec<u32>> = vec![Vec::new(); np];

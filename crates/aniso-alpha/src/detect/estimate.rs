@@ -56,6 +56,7 @@ use super::local::{local_shapes, LocalShape};
 use super::modes::{modes, Mode};
 use super::StructureKind;
 use crate::aniso::{completion_first_row, completion_third_row, Mat3};
+use crate::geometry::dot;
 use crate::geometry::kdtree::KdTree;
 
 /// Score (planarity or linearity) from which a point is structure-like: the
@@ -249,10 +250,6 @@ fn thin_along(
         }
     }
     out
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 fn axis64(s: &LocalShape, kind: StructureKind) -> [f64; 3] {

@@ -228,15 +228,11 @@ pub fn edges_at(tri: &Triangulation, alpha: f64) -> Vec<[u32; 2]> {
 mod tests {
     use super::*;
     use crate::alpha::AlphaComplex;
+    use crate::rng::SplitMix64;
 
     fn rnd_points(seed: u64, n: usize, grid: bool) -> Vec<[f64; 3]> {
-        let mut s = seed;
-        let mut next = move || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = SplitMix64::new(seed);
+        let mut next = move || rng.uniform();
         (0..n)
             .map(|_| {
                 if grid {
@@ -279,13 +275,8 @@ mod tests {
     fn certified_radius_is_on_the_side_of_alpha_of_the_careful_one() {
         // Regular, flat (sliver) and nearly flat tets, α near and far from
         // their radius.
-        let mut s = 9u64;
-        let mut next = move || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = SplitMix64::new(9);
+        let mut next = move || rng.uniform();
         let mut exact_needed = 0;
         for t in 0..20_000 {
             let flat = match t % 3 {

@@ -41,6 +41,8 @@
 
 use std::fmt;
 
+use crate::unionfind::UnionFind;
+
 mod sealed {
     pub trait Sealed {}
     impl Sealed for [u32; 2] {}
@@ -228,7 +230,9 @@ impl Incidence {
                 if alive[s as usize] {
                     match first {
                         None => first = Some(s),
-                        Some(a) => uf.union(a, s),
+                        Some(a) => {
+                            uf.union(a, s);
+                        }
                     }
                 }
             }
@@ -251,50 +255,6 @@ impl Incidence {
                 id_of_root[r]
             })
             .collect()
-    }
-}
-
-struct UnionFind {
-    parent: Vec<u32>,
-    size: Vec<u32>,
-}
-
-impl UnionFind {
-    fn new() -> Self {
-        Self {
-            parent: Vec::new(),
-            size: Vec::new(),
-        }
-    }
-    fn reset(&mut self, n: usize) {
-        self.parent.clear();
-        self.parent.extend(0..n as u32);
-        self.size.clear();
-        self.size.resize(n, 1);
-    }
-    fn find(&mut self, mut x: u32) -> u32 {
-        while self.parent[x as usize] != x {
-            let p = self.parent[x as usize];
-            self.parent[x as usize] = self.parent[p as usize];
-            x = p;
-        }
-        x
-    }
-    fn union(&mut self, a: u32, b: u32) {
-        let (mut ra, mut rb) = (self.find(a), self.find(b));
-        if ra == rb {
-            return;
-        }
-        if self.size[ra as usize] < self.size[rb as usize] {
-            std::mem::swap(&mut ra, &mut rb);
-        }
-        self.parent[rb as usize] = ra;
-        self.size[ra as usize] += self.size[rb as usize];
-    }
-    /// Size of x's set.
-    fn size_of(&mut self, x: u32) -> u32 {
-        let r = self.find(x) as usize;
-        self.size[r]
     }
 }
 
@@ -322,7 +282,7 @@ pub fn filter_mask<S: Simplex>(simplices: &[S], nb_c: u32) -> Result<Vec<bool>, 
     let n = inc.n;
     let mut alive = vec![true; n];
     let mut degree = inc.degrees();
-    let mut uf = UnionFind::new();
+    let mut uf = UnionFind::new(0);
     inc.unite(&alive, &degree, true, &mut uf);
     if nb_c <= 1 || n == 0 {
         return Ok(inc
@@ -436,7 +396,7 @@ pub fn paths<S: Simplex>(simplices: &[S]) -> Result<Vec<u32>, FilterError> {
     let inc = Incidence::new(simplices)?;
     let alive = vec![true; inc.n];
     let degree = inc.degrees();
-    let mut uf = UnionFind::new();
+    let mut uf = UnionFind::new(0);
     inc.unite(&alive, &degree, true, &mut uf);
     Ok(inc.label_input(&mut uf))
 }
@@ -452,7 +412,7 @@ pub fn paths<S: Simplex>(simplices: &[S]) -> Result<Vec<u32>, FilterError> {
 pub fn components<S: Simplex>(simplices: &[S]) -> Result<Vec<u32>, FilterError> {
     let inc = Incidence::new(simplices)?;
     let alive = vec![true; inc.n];
-    let mut uf = UnionFind::new();
+    let mut uf = UnionFind::new(0);
     inc.unite(&alive, &[], false, &mut uf);
     Ok(inc.label_input(&mut uf))
 }
@@ -472,7 +432,7 @@ pub fn component_size_mask<S: Simplex>(
 ) -> Result<Vec<bool>, FilterError> {
     let inc = Incidence::new(simplices)?;
     let alive = vec![true; inc.n];
-    let mut uf = UnionFind::new();
+    let mut uf = UnionFind::new(0);
     inc.unite(&alive, &[], false, &mut uf);
     Ok(inc
         .input_to_unique

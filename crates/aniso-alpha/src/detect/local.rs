@@ -31,6 +31,7 @@
 //! ```
 
 use super::StructureKind;
+use crate::geometry::cross;
 use crate::geometry::kdtree::KdTree;
 
 /// Neighbours per neighbourhood: the usual choice for PCA normals (CGAL's
@@ -209,14 +210,6 @@ pub fn eigen_sym3(a: [[f64; 3]; 3]) -> ([f64; 3], [[f64; 3]; 3]) {
     };
     let v2 = cross(v3, v1);
     ([l1, l2, l3], [v1, v2, v3])
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 fn any_orthogonal(u: [f64; 3]) -> [f64; 3] {

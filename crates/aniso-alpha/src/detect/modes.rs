@@ -34,6 +34,7 @@
 //! assert!(m.iter().any(|m| m.axis[0].abs() > 0.999));
 //! ```
 
+use crate::geometry::dot;
 use crate::geometry::kdtree::KdTree;
 
 /// Samples used for the mode search at most.
@@ -50,10 +51,6 @@ pub struct Mode {
     pub axis: [f64; 3],
     /// Axes within the kernel radius of it (scaled to the whole input).
     pub support: usize,
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 fn unit(a: [f64; 3]) -> Option<[f64; 3]> {
@@ -166,15 +163,11 @@ pub fn modes(axes: &[[f64; 3]], h: f64, min_support: usize) -> Vec<Mode> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::rng::SplitMix64;
 
     fn rng(seed: u64) -> impl FnMut() -> f64 {
-        let mut s = seed;
-        move || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        }
+        let mut rng = SplitMix64::new(seed);
+        move || rng.uniform()
     }
 
     /// Axes scattered by about `spread` radians around `c`, random signs.

@@ -287,16 +287,12 @@ impl CandidatePairs {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::rng::SplitMix64;
 
     #[test]
     fn matches_brute_force() {
-        let mut s = 11u64;
-        let mut rnd = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = SplitMix64::new(11);
+        let mut rnd = || rng.uniform();
         for round in 0..50 {
             let n = 1 + round * 7;
             let scale = [1.0, 10.0, 100.0][round % 3];
@@ -320,13 +316,8 @@ mod tests {
 
     #[test]
     fn candidate_pairs_under_a_map_match_brute_force() {
-        let mut s = 3u64;
-        let mut rnd = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = SplitMix64::new(3);
+        let mut rnd = || rng.uniform();
         for round in 0..20 {
             let pts: Vec<[f64; 3]> = (0..200)
                 .map(|_| [rnd() * 60.0, rnd() * 60.0, rnd() * 60.0])

@@ -57,6 +57,15 @@ use super::scan::{faces_of, halo_width, prune_radius, pruned, tile_cell, Face, J
 use super::StructureKind;
 use crate::aniso::Anisotropy;
 
+/// Relative inflation of the halo in the reach of [`Plan::tiles`].
+const TILE_HALO_SLACK: f64 = 1e-6;
+
+/// Inflation of the reach of [`Plan::tiles`] relative to the tile side:
+/// together with [`TILE_HALO_SLACK`] it makes sure that rounding in the
+/// cell computation never leaves out of a tile a point that the exact
+/// halo test of [`Step::run`] would take.
+const TILE_SIDE_SLACK: f64 = 1e-9;
+
 /// One job of a split run: an orientation with its anisotropy, its α and
 /// its group (the mode of a data orientation set it belongs to, or 0).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -247,7 +256,7 @@ impl Plan {
         // Each point goes to every cell whose grown box may hold it; the
         // reach is inflated so that rounding never leaves out a point the
         // exact test of `Step::run` would take.
-        let reach = self.halo * (1.0 + 1e-6) + side * 1e-9;
+        let reach = self.halo * (1.0 + TILE_HALO_SLACK) + side * TILE_SIDE_SLACK;
         let mut pairs: Vec<(u32, u32)> = Vec::new();
         for (i, p) in points.iter().enumerate() {
             if !used[i] {
@@ -540,6 +549,7 @@ fn tile_job<S: Face>(
 mod tests {
     use super::*;
     use crate::detect::detector::Given;
+    use crate::rng::SplitMix64;
     use crate::synth;
 
     /// Runs a plan tile by tile, each tile seeing only its own points (as a
@@ -598,13 +608,8 @@ mod tests {
     fn auto_split_equals_run() {
         // Two perpendicular noisy planes crossing many tiles.
         let mut pts = Vec::new();
-        let mut s = 7u64;
-        let mut noise = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((s >> 33) as f64 / (1u64 << 31) as f64 - 0.5) * 0.02
-        };
+        let mut rng = SplitMix64::new(7);
+        let mut noise = || (rng.uniform() - 0.5) * 0.02;
         for i in 0..40 {
             for j in 0..40 {
                 let (x, y) = (0.25 * i as f64, 0.25 * j as f64);

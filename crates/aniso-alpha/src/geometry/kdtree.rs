@@ -238,15 +238,11 @@ impl KdTree {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::rng::SplitMix64;
 
     fn cloud(n: usize, seed: u64) -> Vec<[f64; 3]> {
-        let mut s = seed;
-        let mut r = move || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = SplitMix64::new(seed);
+        let mut r = move || rng.uniform();
         // Clustered and duplicated points as well as uniform ones.
         (0..n)
             .map(|i| match i % 4 {
