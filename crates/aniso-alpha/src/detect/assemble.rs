@@ -976,14 +976,14 @@ pub(crate) fn assemble<S: Face>(
             foot: cands[p.cand].foot.clone(),
         };
         let probes: Vec<Cand> = parts.iter().map(as_cand).collect();
-        let mut uf = Uf::new(parts.len());
+        let mut uf = UnionFind::new(parts.len());
         let mut merged = false;
         for a in 0..parts.len() {
             for b in a + 1..parts.len() {
                 if uf.find(a as u32) != uf.find(b as u32)
                     && same_primitive(&probes[a], &probes[b], settings.part_angle_deg, points)
                 {
-                    uf.union(a as u32, b as u32);
+                    uf.union_min_root(a as u32, b as u32);
                     merged = true;
                 }
             }
