@@ -401,3 +401,74 @@ fn one_plane_in_pieces_is_one_part() {
     }
     check_parts(&det, &points);
 }
+
+#[test]
+fn a_pole_among_surfaces_is_a_line() {
+    // A street corner: ground (20 × 20 m) and a façade (20 × 8 m) on 10 cm
+    // grids with 1 cm of noise, and a pole 6 m tall, 10 cm in radius,
+    // sampled every 2 cm (fixed seed). Asked for lines with no parameter,
+    // the pole comes out as one vertical segment: the surfaces' points,
+    // whose local directions are anything in their plane, are left out of
+    // the line modes (docs/method.md §8).
+    let mut rng = SplitMix64::new(0x901e);
+    let mut points = Vec::new();
+    let noise = |r: &mut SplitMix64| 0.01 * (r.uniform() - 0.5) * 2.0;
+    for i in 0..200 {
+        for j in 0..200 {
+            let e = noise(&mut rng);
+            points.push([i as f64 * 0.1, j as f64 * 0.1, e]);
+        }
+    }
+    for i in 0..200 {
+        for k in 1..80 {
+            let e = noise(&mut rng);
+            points.push([i as f64 * 0.1, 20.0 + e, k as f64 * 0.1]);
+        }
+    }
+    let first_pole = points.len();
+    let (cx, cy, r) = (10.0, 10.0, 0.1);
+    for k in 0..300 {
+        for a in 0..31 {
+            let t = std::f64::consts::TAU * (a as f64 + 0.5 * (k % 2) as f64) / 31.0;
+            let e = noise(&mut rng);
+            points.push([
+                cx + (r + e) * t.cos(),
+                cy + (r + e) * t.sin(),
+                0.02 * k as f64 + 0.02,
+            ]);
+        }
+    }
+    let det = Detector::auto(StructureKind::Lines, &points, &Given::default())
+        .unwrap()
+        .run(&points)
+        .unwrap();
+    let pole = det
+        .structures
+        .iter()
+        .flat_map(|s| &s.parts)
+        .filter_map(|p| p.segment().map(|s| (p, s)))
+        .find(|(_, [a, b])| {
+            let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+            let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            len >= 5.0 && d[2].abs() / len >= 5f64.to_radians().cos()
+        })
+        .map(|(p, _)| p)
+        .expect("a vertical segment of at least 5 m");
+    let on_pole = pole
+        .vertices
+        .iter()
+        .filter(|&&v| v as usize >= first_pole)
+        .count();
+    eprintln!(
+        "pole: {} points, {on_pole} of {} pole points; {} parts in all",
+        pole.vertices.len(),
+        points.len() - first_pole,
+        det.structures.iter().map(|s| s.parts.len()).sum::<usize>()
+    );
+    assert!(on_pole * 2 >= points.len() - first_pole);
+    assert!(on_pole * 10 >= pole.vertices.len() * 9);
+    // No lines made of the surfaces' points (6 parts when the surfaces'
+    // points are not left out).
+    let parts: usize = det.structures.iter().map(|s| s.parts.len()).sum();
+    assert!(parts <= 3, "{parts} parts");
+}
