@@ -330,10 +330,14 @@ fn background_classes_are_left_out_of_the_detection() {
     args.extend(["--background-classes", &flag]);
     let left_out = detect(&dir, &input, &dir.path("out.las"), &args);
     let mut others = 0;
-    for i in 0..class.len() {
-        if class[i] == busiest {
-            assert_eq!((left_out.0[i], left_out.1[i]), (-1, -1), "point {i}");
-        } else if left_out.0[i] >= 0 {
+    for (i, (&c, (&s, &p))) in class
+        .iter()
+        .zip(left_out.0.iter().zip(&left_out.1))
+        .enumerate()
+    {
+        if c == busiest {
+            assert_eq!((s, p), (-1, -1), "point {i}");
+        } else if s >= 0 {
             others += 1;
         }
     }
