@@ -450,3 +450,66 @@ fn out_of_range_lambda3_names_the_parameter() {
         assert!(stderr.contains("lambda3"), "--lambda3 {l3}: {stderr}");
     }
 }
+
+/// points × orientations over 2e9: a warning with the estimate before the
+/// run (`cmd_detect::warn_if_huge`). 3,000 copies of 3 points and
+/// `--m2 6000` (162 × 6,000 = 972,000 orientations, under the limit of
+/// 1,000,000): 2.9e9. The run itself would take long: the test stops it
+/// once the warning is out.
+#[test]
+fn huge_run_warns_before_it_starts() {
+    use std::io::{BufRead, BufReader};
+    use std::process::Stdio;
+    let d = TempDir::new("cli", "huge");
+    let input = d.file("dups.xyz", "0 0 0\n1 0 0\n0 1 0\n".repeat(1000).as_bytes());
+    let mut child = Command::new(BIN)
+        .arg("detect")
+        .arg(&input)
+        .args([
+            "--structure",
+            "planes",
+            "--alpha",
+            "1",
+            "--lambda2",
+            "4",
+            "--lambda3",
+            "8",
+            "--min-size",
+            "20",
+            "--m2",
+            "6000",
+            "--threads",
+            "1",
+            "--labels",
+        ])
+        .arg(d.path("labels.txt"))
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut warning = None;
+    let mut seen = Vec::new();
+    for line in BufReader::new(child.stderr.take().unwrap()).lines() {
+        let line = line.unwrap();
+        if line.starts_with("warning: a large run") {
+            warning = Some(line);
+            break;
+        }
+        seen.push(line);
+        if seen.len() > 50 {
+            break;
+        }
+    }
+    // Stops the run (if it is still going: it must not have finished).
+    let _ = child.kill();
+    let status = child.wait().unwrap();
+    let warning = warning.unwrap_or_else(|| panic!("no warning; stderr: {seen:?}"));
+    assert!(
+        warning.contains("3000 points × 972000 orientations = 2.92e9"),
+        "{warning}"
+    );
+    assert!(warning.contains("--m1, --m2, --step"), "{warning}");
+    assert!(!status.success());
+    // Stopped before the end: no labels file, complete or partial.
+    assert!(!d.path("labels.txt").exists());
+}

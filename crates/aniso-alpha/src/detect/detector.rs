@@ -254,6 +254,16 @@ impl<'a> Detector<'a> {
         };
         probe.check_values()?;
         let e = estimate(kind, points, given, m2);
+        if ![e.alpha.value, e.lambda2.value, e.lambda3.value]
+            .iter()
+            .all(|v| v.is_finite())
+        {
+            return Err(DetectError::BadParameter(
+                "no spacing to estimate alpha and lambda from (every point is at one \
+                 position): give alpha, lambda3 and min-size"
+                    .into(),
+            ));
+        }
         let mut d = match kind {
             StructureKind::Lines => {
                 Self::lines(e.alpha.value, e.lambda3.value, e.min_size.value as u32)

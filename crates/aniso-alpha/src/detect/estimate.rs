@@ -311,11 +311,11 @@ pub fn mode_rotations(
 /// assert!(e.alpha.estimated && e.alpha.value > 0.0);
 /// ```
 pub fn estimate(kind: StructureKind, points: &[[f64; 3]], given: &Given, m2: u32) -> Estimate {
-    let shapes = local_shapes(points, kind);
+    let shapes = shapes_for(points, kind);
     let surface = match kind {
         StructureKind::Lines => Some(surface_points(
             &shapes,
-            &local_shapes(points, StructureKind::Planes),
+            &shapes_for(points, StructureKind::Planes),
         )),
         StructureKind::Planes => None,
     };
@@ -338,6 +338,42 @@ pub fn surface_points(line_shapes: &[LocalShape], plane_shapes: &[LocalShape]) -
         .zip(plane_shapes)
         .map(|(l, p)| p.planarity() >= SCORE_MIN && p.planarity() >= l.linearity())
         .collect()
+}
+
+/// [`local_shapes`], or for a cloud whose points all sit on copies of
+/// themselves (no neighbour at a non-zero distance), those of its distinct
+/// points ([`shapes_of_distinct`]).
+fn shapes_for(points: &[[f64; 3]], kind: StructureKind) -> Vec<LocalShape> {
+    let shapes = local_shapes(points, kind);
+    if !shapes.iter().any(|s| s.spacing.is_finite()) {
+        return shapes_of_distinct(points, kind).unwrap_or(shapes);
+    }
+    shapes
+}
+
+/// The local shapes of the distinct points of `points`, each copy taking
+/// its position's; `None` when every point is distinct. For a cloud made
+/// of copies of few points, every point with as many copies as the
+/// neighbourhood holds: no neighbour at a non-zero distance, so no spacing
+/// (and α, λ would be NaN) without this.
+fn shapes_of_distinct(points: &[[f64; 3]], kind: StructureKind) -> Option<Vec<LocalShape>> {
+    let key = |p: &[f64; 3]| p.map(|c| (c + 0.0).to_bits()); // -0 and 0 alike
+    let mut order: Vec<u32> = (0..points.len() as u32).collect();
+    order.sort_unstable_by_key(|&i| key(&points[i as usize]));
+    let mut distinct: Vec<[f64; 3]> = Vec::new();
+    let mut of = vec![0u32; points.len()];
+    for (k, &i) in order.iter().enumerate() {
+        let p = points[i as usize];
+        if k == 0 || key(&p) != key(&points[order[k - 1] as usize]) {
+            distinct.push(p);
+        }
+        of[i as usize] = distinct.len() as u32 - 1;
+    }
+    if distinct.len() == points.len() {
+        return None;
+    }
+    let shapes = local_shapes(&distinct, kind);
+    Some(of.iter().map(|&d| shapes[d as usize]).collect())
 }
 
 /// [`estimate`] from local shapes already computed.
