@@ -966,22 +966,72 @@ pub(crate) fn assemble<S: Face>(
     // but lie apart (the panes of one wall's windows, a wall cut in two by
     // an occluder, the ground on both sides of a house) are one part in
     // several pieces, as a plane is for RANSAC and for the labels of
-    // CGAL's scans. Lines keep their pieces: a segment is a segment.
+    // CGAL's scans. A pair is only tested when its normals are within the
+    // part angle and each one's plane passes within τ of the other's
+    // bounding box (O(1); no point of a part whose box the plane misses
+    // can be within τ of it). Lines keep their pieces: a segment is a
+    // segment.
     if S::K == 2 && parts.len() > 1 {
-        let as_cand = |p: &P| Cand {
+        let boxes: Vec<([f64; 3], [f64; 3])> = parts
+            .iter()
+            .map(|p| {
+                let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+                for &v in &p.members {
+                    let q = points[v as usize];
+                    for k in 0..3 {
+                        lo[k] = lo[k].min(q[k]);
+                        hi[k] = hi[k].max(q[k]);
+                    }
+                }
+                (lo, hi)
+            })
+            .collect();
+        // Whether the plane of part `a` passes within its τ of part `b`'s
+        // box: the signed distances of the box's corners span [−τ, τ].
+        let near = |a: usize, b: usize| -> bool {
+            let Primitive::Plane(f) = &parts[a].fit else {
+                return false;
+            };
+            let tau = cands[parts[a].cand].tau;
+            let (lo, hi) = boxes[b];
+            let (mut dmin, mut dmax) = (f64::INFINITY, f64::NEG_INFINITY);
+            for c in 0..8 {
+                let q = [
+                    if c & 1 == 0 { lo[0] } else { hi[0] },
+                    if c & 2 == 0 { lo[1] } else { hi[1] },
+                    if c & 4 == 0 { lo[2] } else { hi[2] },
+                ];
+                let d = dot(sub(q, f.centroid), f.normal);
+                dmin = dmin.min(d);
+                dmax = dmax.max(d);
+            }
+            dmin <= tau && dmax >= -tau
+        };
+        let cos = settings.part_angle_deg.to_radians().cos();
+        let parallel = |a: usize, b: usize| match (&parts[a].fit, &parts[b].fit) {
+            (Primitive::Plane(fa), Primitive::Plane(fb)) => dot(fa.normal, fb.normal).abs() >= cos,
+            _ => false,
+        };
+        let probe = |p: &P| Cand {
             fit: p.fit.clone(),
             tau: cands[p.cand].tau,
             cell: cands[p.cand].cell,
             seeds: p.members.clone(),
             foot: cands[p.cand].foot.clone(),
         };
-        let probes: Vec<Cand> = parts.iter().map(as_cand).collect();
         let mut uf = UnionFind::new(parts.len());
         let mut merged = false;
         for a in 0..parts.len() {
             for b in a + 1..parts.len() {
-                if uf.find(a as u32) != uf.find(b as u32)
-                    && same_primitive(&probes[a], &probes[b], settings.part_angle_deg, points)
+                if parallel(a, b)
+                    && (near(a, b) || near(b, a))
+                    && uf.find(a as u32) != uf.find(b as u32)
+                    && same_primitive(
+                        &probe(&parts[a]),
+                        &probe(&parts[b]),
+                        settings.part_angle_deg,
+                        points,
+                    )
                 {
                     uf.union_min_root(a as u32, b as u32);
                     merged = true;
