@@ -31,12 +31,39 @@ fn fixture(name: &str) -> (Vec<[f64; 3]>, Option<Vec<i64>>) {
     (cloud.points, cloud.labels)
 }
 
-/// `detect POINTS --structure planes` with every parameter from the data.
-fn planes_from_the_data(points: &[[f64; 3]]) -> Detection {
-    Detector::auto(StructureKind::Planes, points, &Given::default())
+/// `detect POINTS --structure KIND` with every parameter from the data.
+fn from_the_data(kind: StructureKind, points: &[[f64; 3]]) -> Detection {
+    Detector::auto(kind, points, &Given::default())
         .unwrap()
         .run(points)
         .unwrap()
+}
+
+/// `detect POINTS --structure planes` with every parameter from the data.
+fn planes_from_the_data(points: &[[f64; 3]]) -> Detection {
+    from_the_data(StructureKind::Planes, points)
+}
+
+/// The first straight part of `det` whose segment is at least 5 m long
+/// and within 5° of vertical: a pole.
+fn vertical_segment(det: &Detection) -> &aniso_alpha::detect::detector::Part {
+    det.structures
+        .iter()
+        .flat_map(|s| &s.parts)
+        .filter_map(|p| p.segment().map(|s| (p, s)))
+        .find(|(_, [a, b])| {
+            let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+            let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            len >= 5.0 && d[2].abs() / len >= 5f64.to_radians().cos()
+        })
+        .map(|(p, _)| p)
+        .expect("a vertical segment of at least 5 m")
+}
+
+/// A standard normal draw (Box–Muller).
+fn gauss(r: &mut SplitMix64) -> f64 {
+    let (a, b) = (r.uniform().max(1e-300), r.uniform());
+    (-2.0 * a.ln()).sqrt() * (std::f64::consts::TAU * b).cos()
 }
 
 /// The bounding box of `points` and its largest side.
@@ -269,22 +296,8 @@ fn lamppost_pole_is_one_line() {
     // the scan's spacing and a line at the scale of its thickness
     // (docs/method.md §8, thick lines).
     let (points, _) = fixture("lamppost.pcd");
-    let det = Detector::auto(StructureKind::Lines, &points, &Given::default())
-        .unwrap()
-        .run(&points)
-        .unwrap();
-    let pole = det
-        .structures
-        .iter()
-        .flat_map(|s| &s.parts)
-        .filter_map(|p| p.segment().map(|s| (p, s)))
-        .find(|(_, [a, b])| {
-            let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-            let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-            len >= 5.0 && d[2].abs() / len >= 5f64.to_radians().cos()
-        })
-        .map(|(p, _)| p)
-        .expect("a vertical segment of at least 5 m");
+    let det = from_the_data(StructureKind::Lines, &points);
+    let pole = vertical_segment(&det);
     eprintln!("pole: {} of {} points", pole.vertices.len(), points.len());
     assert!(pole.vertices.len() >= 1000);
 }
@@ -296,11 +309,6 @@ fn room_is_four_parts() {
     // (fixed seed). It must come out as four parts, one per surface, no
     // surface twice.
     let mut rng = SplitMix64::new(0x2004);
-    // Box–Muller.
-    let gauss = |r: &mut SplitMix64| {
-        let (a, b) = (r.uniform().max(1e-300), r.uniform());
-        (-2.0 * a.ln()).sqrt() * (std::f64::consts::TAU * b).cos()
-    };
     let (mut points, mut truth) = (Vec::new(), Vec::new());
     let (w, h, step, noise) = (4.0, 2.5, 0.05, 0.005);
     let n_w = (w / step) as usize;
@@ -348,10 +356,6 @@ fn one_plane_in_pieces_is_one_part() {
     // 0.2 m, many noise widths, off the panes' plane). A 5 cm grid with
     // 3 mm of noise and 1,000 outliers (fixed seed).
     let mut rng = SplitMix64::new(0x1e7);
-    let gauss = |r: &mut SplitMix64| {
-        let (a, b) = (r.uniform().max(1e-300), r.uniform());
-        (-2.0 * a.ln()).sqrt() * (std::f64::consts::TAU * b).cos()
-    };
     let (mut points, mut truth) = (Vec::new(), Vec::new());
     let (step, noise) = (0.05, 0.003);
     let windows = [(1.0, 2.0), (3.0, 4.0), (5.0, 6.0)]; // y ranges; z in [1, 2]
@@ -438,22 +442,8 @@ fn a_pole_among_surfaces_is_a_line() {
             ]);
         }
     }
-    let det = Detector::auto(StructureKind::Lines, &points, &Given::default())
-        .unwrap()
-        .run(&points)
-        .unwrap();
-    let pole = det
-        .structures
-        .iter()
-        .flat_map(|s| &s.parts)
-        .filter_map(|p| p.segment().map(|s| (p, s)))
-        .find(|(_, [a, b])| {
-            let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-            let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-            len >= 5.0 && d[2].abs() / len >= 5f64.to_radians().cos()
-        })
-        .map(|(p, _)| p)
-        .expect("a vertical segment of at least 5 m");
+    let det = from_the_data(StructureKind::Lines, &points);
+    let pole = vertical_segment(&det);
     let on_pole = pole
         .vertices
         .iter()
