@@ -472,17 +472,36 @@ const SAME_SHARE: f64 = 0.8;
 /// catches a strip along the edge of a plane, found by another mode: it
 /// fits a plane tilted across the strip, whose offset at the other's
 /// centroid says nothing.)
-fn same_primitive(a: &Cand, b: &Cand, angle_deg: f64, points: &[[f64; 3]]) -> bool {
+/// What [`same_primitive`] looks at of a candidate or a part: its
+/// primitive, its claim radius τ and its points.
+#[derive(Clone, Copy)]
+struct Piece<'a> {
+    fit: &'a Primitive,
+    tau: f64,
+    seeds: &'a [u32],
+}
+
+impl Cand {
+    fn piece(&self) -> Piece<'_> {
+        Piece {
+            fit: &self.fit,
+            tau: self.tau,
+            seeds: &self.seeds,
+        }
+    }
+}
+
+fn same_primitive(a: Piece, b: Piece, angle_deg: f64, points: &[[f64; 3]]) -> bool {
     // Two pieces of one noisy line: their own fits can be tens of degrees
     // apart (three points jittered by σ ≈ α over two steps), but the line
     // fitted to both keeps most of their seeds within the claim radius.
     // Lines crossing at an angle, or the two legs of a polyline, leave
     // one piece's far points outside it.
-    if let (Primitive::Line(_), Primitive::Line(_)) = (&a.fit, &b.fit) {
+    if let (Primitive::Line(_), Primitive::Line(_)) = (a.fit, b.fit) {
         let joint: Vec<[f64; 3]> = a
             .seeds
             .iter()
-            .chain(&b.seeds)
+            .chain(b.seeds)
             .map(|&v| points[v as usize])
             .collect();
         if let Ok(f) = fit_line(&joint) {
@@ -498,13 +517,13 @@ fn same_primitive(a: &Cand, b: &Cand, angle_deg: f64, points: &[[f64; 3]]) -> bo
                     .count() as f64
                     >= SAME_SHARE * seeds.len() as f64
             };
-            if within(&a.seeds) && within(&b.seeds) {
+            if within(a.seeds) && within(b.seeds) {
                 return true;
             }
         }
     }
     let cos = angle_deg.to_radians().cos();
-    let parallel = match (&a.fit, &b.fit) {
+    let parallel = match (a.fit, b.fit) {
         (Primitive::Plane(fa), Primitive::Plane(fb)) => dot(fa.normal, fb.normal).abs() >= cos,
         (Primitive::Line(fa), Primitive::Line(fb)) => dot(fa.direction, fb.direction).abs() >= cos,
         _ => false,
@@ -517,7 +536,7 @@ fn same_primitive(a: &Cand, b: &Cand, angle_deg: f64, points: &[[f64; 3]]) -> bo
         Primitive::Line(l) => l.centroid,
         Primitive::None => [f64::NAN; 3],
     };
-    if a.fit.distance(&centroid(&b.fit)) <= a.tau && b.fit.distance(&centroid(&a.fit)) <= b.tau {
+    if a.fit.distance(&centroid(b.fit)) <= a.tau && b.fit.distance(&centroid(a.fit)) <= b.tau {
         return true;
     }
     let (big, small) = if a.seeds.len() >= b.seeds.len() {
@@ -773,8 +792,8 @@ pub(crate) fn assemble<S: Face>(
         for (a, b) in pairs {
             if uf.find(a) != uf.find(b)
                 && same_primitive(
-                    &cands[a as usize],
-                    &cands[b as usize],
+                    cands[a as usize].piece(),
+                    cands[b as usize].piece(),
                     settings.part_angle_deg,
                     points,
                 )
@@ -1012,12 +1031,10 @@ pub(crate) fn assemble<S: Face>(
             (Primitive::Plane(fa), Primitive::Plane(fb)) => dot(fa.normal, fb.normal).abs() >= cos,
             _ => false,
         };
-        let probe = |p: &P| Cand {
-            fit: p.fit.clone(),
-            tau: cands[p.cand].tau,
-            cell: cands[p.cand].cell,
-            seeds: p.members.clone(),
-            foot: cands[p.cand].foot.clone(),
+        let piece = |i: usize| Piece {
+            fit: &parts[i].fit,
+            tau: cands[parts[i].cand].tau,
+            seeds: &parts[i].members,
         };
         let mut uf = UnionFind::new(parts.len());
         let mut merged = false;
@@ -1026,12 +1043,7 @@ pub(crate) fn assemble<S: Face>(
                 if parallel(a, b)
                     && (near(a, b) || near(b, a))
                     && uf.find(a as u32) != uf.find(b as u32)
-                    && same_primitive(
-                        &probe(&parts[a]),
-                        &probe(&parts[b]),
-                        settings.part_angle_deg,
-                        points,
-                    )
+                    && same_primitive(piece(a), piece(b), settings.part_angle_deg, points)
                 {
                     uf.union_min_root(a as u32, b as u32);
                     merged = true;
