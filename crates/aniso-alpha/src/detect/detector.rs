@@ -41,7 +41,9 @@ use super::estimate::{estimate, mode_rotations};
 use super::filter::{component_size_mask, FilterError};
 use super::orientations::{orientations, OrientationError, Sampler};
 use super::prune::CandidatePairs;
-use super::scan::{run_job, union, Face, Job, JobResult, Pruning, ScanError, RADIUS_SLACK};
+use super::scan::{
+    run_job, union, Face, Job, JobResult, Pruning, ScanError, ScanFilter, RADIUS_SLACK,
+};
 pub use super::StructureKind;
 use crate::aniso::{Anisotropy, AnisotropyError};
 use std::fmt;
@@ -610,12 +612,12 @@ impl<'a> Detector<'a> {
         let done = AtomicUsize::new(0);
         let cancelled = AtomicBool::new(false);
         let total = jobs.len();
-        let scan_nb_c = self.scan_min_size(points, total);
+        let sf = self.scan_filter(points, total);
         let one = |job: &Job<'_>| -> Result<JobResult<S>, DetectError> {
             if cancelled.load(Ordering::Relaxed) {
                 return Err(DetectError::Cancelled);
             }
-            let r = run_job::<S>(points, job, &pruning, self.tile, scan_nb_c)?;
+            let r = run_job::<S>(points, job, &pruning, self.tile, sf)?;
             let d = done.fetch_add(1, Ordering::Relaxed) + 1;
             if let Some(cb) = self.progress {
                 if !cb(d, total) {
@@ -654,13 +656,30 @@ impl<'a> Detector<'a> {
     /// test a shorter one from the measured background
     /// (docs/method.md §4, `detect::assemble::scan_min_size`).
     pub(crate) fn scan_min_size(&self, points: &[[f64; 3]], orientations: usize) -> u32 {
+        self.scan_filter(points, orientations).nb_c
+    }
+
+    /// The path filter of each orientation of a scan of `orientations`
+    /// orientations of `points`: [`Self::scan_min_size`], and for lines
+    /// under the significance test the straightness at which chains are
+    /// followed through ramifications (`detect::assemble::straight_cos`).
+    pub(crate) fn scan_filter(&self, points: &[[f64; 3]], orientations: usize) -> ScanFilter {
         let chance = super::assemble::ChanceScale::measure(
             points,
             self.alpha,
             self.elongation(),
             orientations,
         );
-        super::assemble::scan_min_size(self.kind, self.nb_c, self.epsilon.is_some(), chance)
+        let significance = self.epsilon.is_some();
+        ScanFilter {
+            nb_c: super::assemble::scan_min_size(self.kind, self.nb_c, significance, chance),
+            straight_cos: super::assemble::straight_cos(
+                self.kind,
+                significance,
+                matches!(self.set, OrientationSet::Data(_)),
+                chance,
+            ),
+        }
     }
 
     /// The steps after the scan: the union of the jobs' filtered simplices

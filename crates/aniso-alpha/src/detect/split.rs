@@ -52,8 +52,9 @@
 
 use super::detection::{Detection, RunStats};
 use super::detector::{check_points, DetectError, Detector, OrientationSet};
-use super::filter::filter;
-use super::scan::{faces_of, halo_width, prune_radius, pruned, tile_cell, Face, Job, Pruning};
+use super::scan::{
+    faces_of, filter_job, halo_width, prune_radius, pruned, tile_cell, Face, Job, Pruning,
+};
 use super::StructureKind;
 use crate::aniso::Anisotropy;
 
@@ -356,21 +357,25 @@ impl Plan {
             }
         }
         drop(outputs);
-        let nb_c = self.detector.scan_min_size(points, jobs.len());
-        let one = |mut faces: Vec<S>| -> Result<(usize, Vec<S>), DetectError> {
+        let sf = self.detector.scan_filter(points, jobs.len());
+        let one = |(mut faces, job): (Vec<S>, &SplitJob)| -> Result<(usize, Vec<S>), DetectError> {
             faces.sort_unstable();
             faces.dedup();
             let raw = faces.len();
-            Ok((raw, filter(&faces, nb_c)?))
+            Ok((raw, filter_job(&faces, points, &job.anisotropy, sf)?))
         };
         #[cfg(feature = "parallel")]
         let filtered: Vec<Result<(usize, Vec<S>), DetectError>> = {
             use rayon::prelude::*;
-            per_job.into_par_iter().map(one).collect()
+            per_job
+                .into_par_iter()
+                .zip(jobs.par_iter())
+                .map(one)
+                .collect()
         };
         #[cfg(not(feature = "parallel"))]
         let filtered: Vec<Result<(usize, Vec<S>), DetectError>> =
-            per_job.into_iter().map(one).collect();
+            per_job.into_iter().zip(jobs.iter()).map(one).collect();
         let mut found = Vec::with_capacity(jobs.len());
         for (r, job) in filtered.into_iter().zip(jobs) {
             let (raw, faces) = r?;
