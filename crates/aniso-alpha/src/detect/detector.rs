@@ -480,6 +480,38 @@ impl<'a> Detector<'a> {
     pub fn run(&self, points: &[[f64; 3]]) -> Result<Detection, DetectError> {
         self.check_values()?;
         check_points(points)?;
+        // Copies of a point are one point to every step (the triangulation
+        // keeps one, the assembly labels first occurrences), but the
+        // candidate pairs and the scans' point subsets would still visit
+        // each copy: 200 copies of 1,000 points took over 100 s against
+        // 3.6 s for the 1,000. Run on the distinct points and give every
+        // copy its first occurrence's result.
+        let first = super::detection::first_occurrences(points);
+        if first.iter().enumerate().any(|(i, &f)| f as usize != i) {
+            let distinct: Vec<u32> = (0..points.len() as u32)
+                .filter(|&i| first[i as usize] == i)
+                .collect();
+            let sub: Vec<[f64; 3]> = distinct.iter().map(|&i| points[i as usize]).collect();
+            let mut on_distinct = self.clone();
+            if let OrientationSet::Data(modes) = &mut on_distinct.set {
+                // The modes' members are input indices (the estimate ran
+                // on the whole cloud): each becomes its position's index
+                // among the distinct points.
+                let mut at = vec![0u32; points.len()];
+                for (k, &i) in distinct.iter().enumerate() {
+                    at[i as usize] = k as u32;
+                }
+                for m in modes.iter_mut() {
+                    for v in &mut m.points {
+                        *v = at[first[*v as usize] as usize];
+                    }
+                    m.points.sort_unstable();
+                    m.points.dedup();
+                }
+            }
+            let det = on_distinct.run(&sub)?;
+            return Ok(expand_distinct(det, &distinct, first));
+        }
         let go = || match self.kind {
             StructureKind::Lines => self.run_k::<[u32; 2]>(points),
             StructureKind::Planes => self.run_k::<[u32; 3]>(points),
@@ -763,6 +795,32 @@ impl<'a> Detector<'a> {
         out.sort_unstable();
         Ok(out)
     }
+}
+
+/// The detection of a cloud with copies from that of its distinct points
+/// (`distinct`: their input indices, ascending; `first`: per input point,
+/// its first occurrence). Indices map through `distinct`, which keeps
+/// their order, so every sorted list stays sorted.
+fn expand_distinct(mut det: Detection, distinct: &[u32], first: Vec<u32>) -> Detection {
+    let to_input = |v: &mut u32| *v = distinct[*v as usize];
+    for s in &mut det.simplices {
+        s.iter_mut().for_each(to_input);
+    }
+    for st in &mut det.structures {
+        st.vertices.iter_mut().for_each(to_input);
+        for p in &mut st.parts {
+            p.vertices.iter_mut().for_each(to_input);
+            p.mesh.iter_mut().flatten().for_each(to_input);
+        }
+    }
+    // Label of each distinct point, by its input index.
+    let mut by_input = vec![-1i64; first.len()];
+    for (k, &i) in distinct.iter().enumerate() {
+        by_input[i as usize] = det.labels[k];
+    }
+    det.labels = first.iter().map(|&f| by_input[f as usize]).collect();
+    det.first_occurrence = first;
+    det
 }
 
 /// The elongation E for λ₂, λ₃.
