@@ -12,7 +12,7 @@
 #![no_main]
 
 use aniso_alpha::aniso::rotation_from_euler;
-use aniso_alpha::detect::detector::{DetectError, Detection, Detector};
+use aniso_alpha::detect::{DetectError, Detection, Detector};
 use libfuzzer_sys::fuzz_target;
 
 mod points;

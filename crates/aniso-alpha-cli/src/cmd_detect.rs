@@ -4,9 +4,9 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use aniso_alpha::detect::detector::{Detection, Detector, Given, OrientationSet, Primitive};
 use aniso_alpha::detect::orientations::Sampler;
 use aniso_alpha::detect::StructureKind;
+use aniso_alpha::detect::{Detection, Detector, Given, OrientationSet, Primitive};
 use aniso_alpha::eval::{evaluate, Evaluation};
 use aniso_alpha::io::{self, write_scene, Mesh, PointCloud, ReadOptions};
 use aniso_alpha::report::detection_json;
@@ -335,7 +335,7 @@ fn detect_points<'a>(
     example: bool,
     timings: &mut Timings,
 ) -> Result<(Detector<'a>, Detection, f64), CliError> {
-    let in_file = |e: aniso_alpha::detect::detector::DetectError| match &args.input {
+    let in_file = |e: aniso_alpha::detect::DetectError| match &args.input {
         Some(p) => CliError::in_file(p, e),
         None => CliError::msg(e.to_string()),
     };

@@ -395,7 +395,7 @@ pub fn detection_png(
 pub fn write_detection_png(
     path: &std::path::Path,
     points: &[[f64; 3]],
-    det: &aniso_alpha::detect::detector::Detection,
+    det: &aniso_alpha::detect::Detection,
     parts: &[i64],
     timings: &mut crate::common::Timings,
 ) -> Result<(), CliError> {

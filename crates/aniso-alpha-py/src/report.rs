@@ -3,7 +3,7 @@
 //! --report` writes), of which the Python `Detection` keeps `structures`
 //! and `parameters`.
 
-use aniso_alpha::detect::detector::{Detection, Detector};
+use aniso_alpha::detect::{Detection, Detector};
 
 /// The report as JSON text.
 pub fn detection_json(det: &Detection, detector: &Detector) -> String {

@@ -1,12 +1,12 @@
-//! The split run of the library ([`aniso_alpha::detect::split`]) for
+//! The split run of the library (`aniso_alpha::detect::{Plan, Step}`) for
 //! `aniso_alpha.distributed`: a [`PyPlan`] on the driver (the parameters,
 //! the tiles, the finishing step) and [`tile_step`], the per-tile work a
 //! Dask worker runs on the tile's numpy arrays and a few numbers (the
 //! step's spec), without the plan or the rest of the cloud.
 
 use aniso_alpha::aniso::Anisotropy;
-use aniso_alpha::detect::split::{Members, Plan, SplitJob, Step, TileOutput};
 use aniso_alpha::detect::StructureKind;
+use aniso_alpha::detect::{Members, Plan, SplitJob, Step, TileOutput};
 use numpy::ndarray::Array3;
 use numpy::{
     IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,

@@ -5,8 +5,8 @@
 //!
 //! Prints one Markdown table row per run: scene, points, orientations,
 //! wall seconds, point-orientations per second, F1, structures found.
-use aniso_alpha::detect::detector::Detector;
 use aniso_alpha::detect::orientations::Sampler;
+use aniso_alpha::detect::Detector;
 use aniso_alpha::eval::evaluate;
 use aniso_alpha::synth::{Scene, SceneOptions};
 use std::time::Instant;

@@ -11,7 +11,7 @@
 use std::error::Error;
 use std::path::Path;
 
-use aniso_alpha::detect::detector::{Detection, Detector};
+use aniso_alpha::detect::{Detection, Detector};
 use aniso_alpha::io::{read_points, write_labels, ReadOptions};
 
 /// Reads `input`, finds lines (or planes) on `threads` threads, and writes

@@ -58,6 +58,6 @@ mod unionfind;
 
 pub use alpha::AlphaComplex;
 pub use delaunay::{DelaunayError, Triangulation};
-pub use detect::detector::{DetectError, Detection, Detector, Given};
 pub use detect::StructureKind;
+pub use detect::{DetectError, Detection, Detector, Given};
 pub use io::{read_points, IoError, PointCloud, ReadOptions};

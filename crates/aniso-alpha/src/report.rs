@@ -2,7 +2,7 @@
 //! `--report` and the Python package (cargo feature `json`).
 //!
 //! ```
-//! use aniso_alpha::detect::detector::Detector;
+//! use aniso_alpha::detect::Detector;
 //! use aniso_alpha::report::detection_json;
 //! let scene = aniso_alpha::synth::lines(1);
 //! let d = Detector::lines(1.0, 10.0, 4);
@@ -14,9 +14,9 @@
 //! assert_eq!(part["segment"].as_array().unwrap().len(), 2);
 //! ```
 
-use crate::detect::detector::{Detection, Detector, OrientationSet, Part, Primitive, Structure};
 use crate::detect::orientations::Sampler;
 use crate::detect::StructureKind;
+use crate::detect::{Detection, Detector, OrientationSet, Part, Primitive, Structure};
 use serde_json::{json, Value};
 
 /// A finite number, or null (JSON has no infinities).

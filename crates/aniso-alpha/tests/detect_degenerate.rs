@@ -5,10 +5,10 @@
 //! `scripts/bench_degenerate.py --detect` measures the time and memory of
 //! larger such clouds against uniform points (BENCHMARKS.md).
 
-use aniso_alpha::detect::detector::{DetectError, Detection, Detector};
 use aniso_alpha::detect::estimate::Given;
 use aniso_alpha::detect::orientations::Sampler;
 use aniso_alpha::detect::StructureKind;
+use aniso_alpha::detect::{DetectError, Detection, Detector};
 use aniso_alpha::rng::SplitMix64;
 
 /// `n` points with z = 0 and x, y uniform in [0, side] at 1e-3.

@@ -4,7 +4,7 @@
 //! test (docs/method.md §4). `scripts/eval_robustness.py` measures the
 //! whole table over more seeds (BENCHMARKS.md).
 
-use aniso_alpha::detect::detector::{Detection, Detector};
+use aniso_alpha::detect::{Detection, Detector};
 use aniso_alpha::eval::{evaluate, Evaluation};
 use aniso_alpha::synth::{Scene, SceneOptions};
 

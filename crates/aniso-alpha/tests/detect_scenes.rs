@@ -1,7 +1,7 @@
 //! End-to-end detection on the synthetic scenes with the paper's
 //! parameters (docs/method.md §5), scored as in docs/method.md §6.
 
-use aniso_alpha::detect::detector::{Detection, Detector};
+use aniso_alpha::detect::{Detection, Detector};
 use aniso_alpha::eval::{evaluate, Evaluation};
 use aniso_alpha::synth::{Scene, SceneOptions};
 
@@ -175,10 +175,7 @@ fn progress_and_cancellation() {
     let r = Detector::lines(1.0, 10.0, 4)
         .progress(&stop)
         .run(&scene.points);
-    assert_eq!(
-        r,
-        Err(aniso_alpha::detect::detector::DetectError::Cancelled)
-    );
+    assert_eq!(r, Err(aniso_alpha::detect::DetectError::Cancelled));
 }
 
 /// Found by the `detect` fuzz target: an exact duplicate of a structure's

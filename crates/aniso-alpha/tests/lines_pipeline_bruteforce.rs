@@ -264,7 +264,7 @@ fn crossing_lines_are_split_into_two() {
 /// on the lines scene, orientation by orientation.
 #[test]
 fn detector_orientation_faces_equal_brute_force() {
-    use aniso_alpha::detect::detector::Detector;
+    use aniso_alpha::detect::Detector;
     let opts = SceneOptions::lines().seed(3);
     let scene = opts.generate().unwrap();
     let p = opts.paper_params();

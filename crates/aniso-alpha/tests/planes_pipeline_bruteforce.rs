@@ -213,7 +213,7 @@ fn crossing_planes_are_split_into_two() {
 /// triangle" on the polyhedron scene, orientation by orientation.
 #[test]
 fn detector_orientation_faces_equal_brute_force() {
-    use aniso_alpha::detect::detector::Detector;
+    use aniso_alpha::detect::Detector;
     let opts = SceneOptions::polyhedron().seed(2);
     let scene = opts.generate().unwrap();
     let p = opts.paper_params();

@@ -46,7 +46,7 @@ fn planes_from_the_data(points: &[[f64; 3]]) -> Detection {
 
 /// The first straight part of `det` whose segment is at least 5 m long
 /// and within 5° of vertical: a pole.
-fn vertical_segment(det: &Detection) -> &aniso_alpha::detect::detector::Part {
+fn vertical_segment(det: &Detection) -> &aniso_alpha::detect::Part {
     det.structures
         .iter()
         .flat_map(|s| &s.parts)

@@ -23,18 +23,18 @@
 //! significance, groups them into structures, and labels every point.
 //!
 //! ```
-//! use aniso_alpha::detect::detector::Detector;
+//! use aniso_alpha::detect::Detector;
 //! use aniso_alpha::synth;
 //! let scene = synth::lines(1); // paper Fig. 12: 5 lines in 1500 background points
 //! let det = Detector::lines(1.0, 10.0, 4).run(&scene.points)?;
 //! assert!(det.structures.len() >= 4);
 //! let found = det.labels.iter().filter(|&&l| l >= 0).count();
 //! assert!(found >= 40);
-//! # Ok::<(), aniso_alpha::detect::detector::DetectError>(())
+//! # Ok::<(), aniso_alpha::detect::DetectError>(())
 //! ```
 
-pub use super::detection::{Detection, Part, Primitive, RunStats, Structure};
-pub use super::estimate::{Estimate, Given, ModeScan, Param};
+use super::detection::{Detection, RunStats};
+use super::estimate::{Estimate, Given, ModeScan};
 
 use super::assemble::{assemble, Scale, Settings};
 use super::estimate::{estimate, mode_rotations};
@@ -473,6 +473,11 @@ impl<'a> Detector<'a> {
     }
 
     /// Runs the detection on `points`.
+    ///
+    /// Exact copies of a point are one point: the run takes the distinct
+    /// points (in order of first occurrence) and gives every copy its
+    /// first occurrence's labels ([`Detection::first_occurrence`]), so a
+    /// cloud of many copies costs what its distinct points cost.
     ///
     /// # Errors
     /// Bad parameters, empty input, non-finite coordinates, or a

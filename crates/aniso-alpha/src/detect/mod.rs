@@ -17,15 +17,27 @@
 //! * `assemble`: structures and disjoint parts from the union, with
 //!   [`outline`] (outlines and meshes of planar parts) and [`significance`]
 //!   (the a-contrario test);
-//! * [`detection`]: the result types;
-//! * [`detector`]: the parameters and the run that chains the steps;
-//! * [`split`]: the same run split into per-tile steps that can run
+//! * `detection`: the result types ([`Detection`], [`Structure`],
+//!   [`Part`], [`Primitive`], [`RunStats`]);
+//! * `detector`: the parameters and the run that chains the steps
+//!   ([`Detector`], [`DetectError`], [`OrientationSet`]);
+//! * `split`: the same run split into per-tile steps that can run
 //!   elsewhere (other processes or machines), and the step that gathers
-//!   them.
+//!   them ([`Plan`], [`Step`], [`SplitJob`], [`Members`], [`Tile`],
+//!   [`TileOutput`]).
+//!
+//! The pipeline's modules (`detector`, `detection`, `split`, `scan`,
+//! `assemble`) are private; their types are re-exported here.
 
 mod assemble;
-pub mod detection;
-pub mod detector;
+// The pipeline's types, flat: `aniso_alpha::detect::{Detector, Part, …}`
+// (the main ones also at the crate root).
+pub use detection::{Detection, Part, Primitive, RunStats, Structure};
+pub use detector::{DetectError, Detector, Mat3, OrientationSet, LAMBDA_RANGE};
+pub use estimate::{Estimate, Given, ModeScan, Param};
+pub use split::{Members, Plan, SplitJob, Step, Tile, TileOutput};
+mod detection;
+mod detector;
 pub mod estimate;
 pub mod faces;
 pub mod filter;
@@ -38,7 +50,7 @@ pub mod parts;
 pub mod prune;
 mod scan;
 pub mod significance;
-pub mod split;
+mod split;
 
 /// Which structures are sought: k = 1 (lines, edges) or k = 2 (planes,
 /// triangles).

@@ -32,7 +32,7 @@
 //! points triangulated count the halos.
 //!
 //! ```
-//! use aniso_alpha::detect::detector::Detector;
+//! use aniso_alpha::detect::Detector;
 //! use aniso_alpha::synth;
 //! let scene = synth::lines(1);
 //! let d = Detector::lines(1.0, 10.0, 4);
@@ -47,7 +47,7 @@
 //! }
 //! let split = plan.finish(&scene.points, outputs)?;
 //! assert_eq!(split.labels, d.run(&scene.points)?.labels);
-//! # Ok::<(), aniso_alpha::detect::detector::DetectError>(())
+//! # Ok::<(), aniso_alpha::detect::DetectError>(())
 //! ```
 
 use super::detection::{Detection, RunStats};
@@ -553,7 +553,7 @@ fn tile_job<S: Face>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::detect::detector::Given;
+    use crate::detect::Given;
     use crate::rng::SplitMix64;
     use crate::synth;
 
