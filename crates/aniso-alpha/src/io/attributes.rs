@@ -284,3 +284,32 @@ pub struct LasSource {
     /// That data, as in the file.
     pub tail: Vec<u8>,
 }
+
+/// Values reserved over all attribute columns before a reader has seen
+/// the data: 2^24 (128 MiB of `f64` at most).
+const RESERVE_TOTAL: usize = 1 << 24;
+
+/// Values to reserve in each of `columns` attribute columns for `count`
+/// declared records: at most 2^20 per column and [`RESERVE_TOTAL`] over
+/// all of them, so that a header's claims (a large count, thousands of
+/// fields) cannot reserve more than that; past it the columns grow with
+/// the data actually read (issue 19).
+pub(crate) fn reserve_per_column(count: usize, columns: usize) -> usize {
+    count.min(1 << 20).min(RESERVE_TOTAL / columns.max(1))
+}
+
+#[cfg(test)]
+mod reserve_tests {
+    use super::reserve_per_column;
+
+    #[test]
+    fn reservations_are_bounded_whatever_the_header_claims() {
+        assert_eq!(reserve_per_column(1000, 5), 1000);
+        assert_eq!(reserve_per_column(usize::MAX, 1), 1 << 20);
+        assert_eq!(reserve_per_column(10_000_000, 4000), (1 << 24) / 4000);
+        assert_eq!(reserve_per_column(10, 0), 10);
+        for columns in [1, 3, 16, 1000, 100_000] {
+            assert!(reserve_per_column(usize::MAX, columns) * columns <= 1 << 24);
+        }
+    }
+}

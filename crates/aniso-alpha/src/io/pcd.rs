@@ -223,7 +223,19 @@ enum Col {
 /// The attribute columns of every field but x, y, z and padding (`_`):
 /// a field of COUNT k > 1 gives `name_0` … `name_{k-1}`.
 fn columns(path: &Path, h: &Header) -> Result<(Vec<Col>, Vec<Attribute>), IoError> {
-    let n = h.points.min(1 << 20);
+    let columns: usize = h
+        .fields
+        .iter()
+        .filter(|f| !matches!(f.name.as_str(), "x" | "y" | "z" | "_"))
+        .map(|f| {
+            if (f.name == "rgb" || f.name == "rgba") && f.size == 4 && f.count == 1 {
+                3 + usize::from(f.name == "rgba")
+            } else {
+                f.count
+            }
+        })
+        .fold(0usize, usize::saturating_add);
+    let n = super::attributes::reserve_per_column(h.points, columns);
     let mut cols = Vec::new();
     let mut attrs = Vec::new();
     for (fi, f) in h.fields.iter().enumerate() {

@@ -332,7 +332,7 @@ fn vertex_layout(
 
 /// Empty attribute columns for the layout's attributes.
 fn attribute_columns(el: &Element, layout: &VertexLayout) -> Vec<Attribute> {
-    let n = el.count.min(1 << 20);
+    let n = super::attributes::reserve_per_column(el.count, layout.attrs.len());
     layout
         .attrs
         .iter()
