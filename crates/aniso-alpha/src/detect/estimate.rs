@@ -343,12 +343,36 @@ pub fn surface_points(line_shapes: &[LocalShape], plane_shapes: &[LocalShape]) -
 /// [`local_shapes`], or for a cloud whose points all sit on copies of
 /// themselves (no neighbour at a non-zero distance), those of its distinct
 /// points ([`shapes_of_distinct`]).
+///
+/// The distinct points are also taken at once when the copies are so many
+/// that the mean number of copies per position reaches the neighbourhood's
+/// size ([`super::local::NEIGHBOURS`]): the neighbourhoods would then hold
+/// mostly copies, and the nearest-neighbour queries would visit every one
+/// of them (issue 19: 10M points made of 1,000 positions took over 100 s).
+/// A cloud with fewer copies keeps each copy's weight in its neighbours'
+/// neighbourhoods, as before.
 fn shapes_for(points: &[[f64; 3]], kind: StructureKind) -> Vec<LocalShape> {
+    if distinct_count(points) * super::local::NEIGHBOURS <= points.len() {
+        if let Some(shapes) = shapes_of_distinct(points, kind) {
+            return shapes;
+        }
+    }
     let shapes = local_shapes(points, kind);
     if !shapes.iter().any(|s| s.spacing.is_finite()) {
         return shapes_of_distinct(points, kind).unwrap_or(shapes);
     }
     shapes
+}
+
+/// The number of distinct positions among `points` (−0 and 0 alike).
+fn distinct_count(points: &[[f64; 3]]) -> usize {
+    let mut keys: Vec<[u64; 3]> = points
+        .iter()
+        .map(|p| p.map(|c| (c + 0.0).to_bits()))
+        .collect();
+    keys.sort_unstable();
+    keys.dedup();
+    keys.len()
 }
 
 /// The local shapes of the distinct points of `points`, each copy taking
