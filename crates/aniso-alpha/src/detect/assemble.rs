@@ -190,13 +190,7 @@ impl ChanceScale {
         let ellipsoid = 4.0 / 3.0 * std::f64::consts::PI * alpha.powi(3)
             / (elongation[0] * elongation[1] * elongation[2]);
         // Distinct points (copies are one point to the scan; −0.0 is 0.0).
-        let mut keys: Vec<[u64; 3]> = points
-            .iter()
-            .map(|p| p.map(|c| (c + 0.0).to_bits()))
-            .collect();
-        keys.sort_unstable();
-        keys.dedup();
-        let n = keys.len() as f64;
+        let n = super::detection::distinct_count(points) as f64;
         ChanceScale {
             points: n,
             orientations: orientations as f64,

@@ -228,3 +228,17 @@ pub(crate) fn first_occurrences(points: &[[f64; 3]]) -> Vec<u32> {
     }
     first
 }
+
+/// A point's position as a sort key: its coordinates' bits, −0 taken as 0
+/// (the same point to every step; NaN is refused before).
+pub(crate) fn position_key(p: &[f64; 3]) -> [u64; 3] {
+    p.map(|c| (c + 0.0).to_bits())
+}
+
+/// The number of distinct positions among `points` ([`position_key`]).
+pub(crate) fn distinct_count(points: &[[f64; 3]]) -> usize {
+    let mut keys: Vec<[u64; 3]> = points.iter().map(position_key).collect();
+    keys.sort_unstable();
+    keys.dedup();
+    keys.len()
+}

@@ -55,6 +55,7 @@
 //!
 //! Explicit values override the estimates (for every mode).
 
+use super::detection::{distinct_count, position_key};
 use super::local::{local_shapes, LocalShape};
 use super::modes::{modes, Mode};
 use super::StructureKind;
@@ -364,24 +365,13 @@ fn shapes_for(points: &[[f64; 3]], kind: StructureKind) -> Vec<LocalShape> {
     shapes
 }
 
-/// The number of distinct positions among `points` (−0 and 0 alike).
-fn distinct_count(points: &[[f64; 3]]) -> usize {
-    let mut keys: Vec<[u64; 3]> = points
-        .iter()
-        .map(|p| p.map(|c| (c + 0.0).to_bits()))
-        .collect();
-    keys.sort_unstable();
-    keys.dedup();
-    keys.len()
-}
-
 /// The local shapes of the distinct points of `points`, each copy taking
 /// its position's; `None` when every point is distinct. For a cloud made
 /// of copies of few points, every point with as many copies as the
 /// neighbourhood holds: no neighbour at a non-zero distance, so no spacing
 /// (and α, λ would be NaN) without this.
 fn shapes_of_distinct(points: &[[f64; 3]], kind: StructureKind) -> Option<Vec<LocalShape>> {
-    let key = |p: &[f64; 3]| p.map(|c| (c + 0.0).to_bits()); // -0 and 0 alike
+    let key = position_key;
     let mut order: Vec<u32> = (0..points.len() as u32).collect();
     order.sort_unstable_by_key(|&i| key(&points[i as usize]));
     let mut distinct: Vec<[f64; 3]> = Vec::new();
