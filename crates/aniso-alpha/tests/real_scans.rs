@@ -192,18 +192,19 @@ fn ball_every_plane_from_the_data() {
 #[test]
 fn building_planes_from_the_data() {
     // A regression guard at the level measured (BENCHMARKS.md, real
-    // scans): 9 of the 11 labelled planes of >= 1,000 points, F1 0.817.
-    // The misses: a facade that the labels count as one plane, 1.5 m deep
-    // (its steps come out as parts of their own), and a wall whose two
+    // scans): 10 of the 11 labelled planes of >= 1,000 points, F1 0.817.
+    // The miss: a facade that the labels count as one plane, 1.5 m deep
+    // (its steps come out as parts of their own). The wall whose two
     // pieces, 29 m apart, fit planes 0.37 m apart (about 2.3 times their
-    // own RMS), which the part merging (one plane, one part) keeps apart.
+    // own RMS) was the second miss (9/11) until the part merging tested
+    // the plane fitted to both pieces (`assemble::joint_plane_keeps`).
     let (points, truth) = fixture("building.ply");
     let truth = truth.unwrap();
     let det = planes_from_the_data(&points);
     let s = score(&truth, &det.part_labels(), 1000);
     eprintln!("building: {s:?}, {} orientations", det.stats.orientations);
     assert_eq!(s.big, 11);
-    assert!(s.found >= 9, "{s:?}");
+    assert!(s.found >= 10, "{s:?}");
     assert!(s.parts <= 80, "{s:?}");
     assert!(s.f1 >= 0.78, "{s:?}");
     check_parts(&det, &points);

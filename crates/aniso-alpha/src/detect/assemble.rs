@@ -32,7 +32,7 @@
 
 use super::detection::{first_occurrences, Detection, Part, Primitive, RunStats, Structure};
 use super::filter::{components, FilterError};
-use super::fit::fit_line;
+use super::fit::{fit_line, fit_plane_indices};
 use super::outline::outline;
 use super::scan::Face;
 use super::significance::{log10_n_tests, part_log10_nfa};
@@ -593,6 +593,33 @@ fn same_primitive(a: Piece, b: Piece, angle_deg: f64, points: &[[f64; 3]]) -> bo
     near as f64 >= SAME_SHARE * small.seeds.len() as f64
 }
 
+/// Whether two parallel planar pieces that lie apart are one plane seen
+/// in two places: the plane fitted to both keeps, for each piece, at least
+/// [`SAME_SHARE`] of the points its own plane keeps within τ. Two pieces
+/// of one wall fitted apart can tilt by a degree or so each (noise, a
+/// slight bow of the wall), so that either one's plane, carried over the
+/// gap, misses the other by more than τ; the joint plane passes through
+/// both. Two distinct parallel planes (a façade and a wall set back from
+/// it by more than τ) leave about half of each piece outside the joint
+/// plane, which lies between them.
+fn joint_plane_keeps(a: Piece, b: Piece, points: &[[f64; 3]]) -> bool {
+    let joint: Vec<u32> = a.seeds.iter().chain(b.seeds).copied().collect();
+    let Ok(f) = fit_plane_indices(points, &joint) else {
+        return false;
+    };
+    let joint_fit = Primitive::Plane(f);
+    let tau = a.tau.max(b.tau);
+    [a, b].iter().all(|p| {
+        let (mut own, mut kept) = (0usize, 0usize);
+        for &v in p.seeds {
+            let q = &points[v as usize];
+            own += usize::from(p.fit.distance(q) <= p.tau);
+            kept += usize::from(joint_fit.distance(q) <= tau);
+        }
+        own > 0 && kept as f64 >= SAME_SHARE * own as f64
+    })
+}
+
 /// Greedy extraction of straight/flat primitives from one connected
 /// component (step 1 of the module doc): their inlier vertices and fits.
 fn extract<S: Face>(
@@ -1084,7 +1111,8 @@ pub(crate) fn assemble<S: Face>(
                 if parallel(a, b)
                     && (near(a, b) || near(b, a))
                     && uf.find(a as u32) != uf.find(b as u32)
-                    && same_primitive(piece(a), piece(b), settings.part_angle_deg, points)
+                    && (same_primitive(piece(a), piece(b), settings.part_angle_deg, points)
+                        || joint_plane_keeps(piece(a), piece(b), points))
                 {
                     uf.union_min_root(a as u32, b as u32);
                     merged = true;
@@ -1317,4 +1345,139 @@ pub(crate) fn assemble<S: Face>(
             stats,
         },
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::SplitMix64;
+
+    /// Points on z = slope·(x − x0) + offset over [xa, xb] × [ya, yb],
+    /// jittered across by ±`noise` (uniform), on a grid of step 0.25.
+    #[allow(clippy::too_many_arguments)]
+    fn piece(
+        out: &mut Vec<[f64; 3]>,
+        rng: &mut SplitMix64,
+        (xa, xb): (f64, f64),
+        (ya, yb): (f64, f64),
+        slope: f64,
+        x0: f64,
+        offset: f64,
+        noise: f64,
+    ) -> Vec<u32> {
+        let start = out.len() as u32;
+        let (nx, ny) = (((xb - xa) / 0.25) as usize, ((yb - ya) / 0.25) as usize);
+        for i in 0..=nx {
+            for j in 0..=ny {
+                let (x, y) = (xa + 0.25 * i as f64, ya + 0.25 * j as f64);
+                let z = slope * (x - x0) + offset + noise * (2.0 * rng.uniform() - 1.0);
+                out.push([x, y, z]);
+            }
+        }
+        (start..out.len() as u32).collect()
+    }
+
+    fn fit(points: &[[f64; 3]], ids: &[u32]) -> Primitive {
+        Primitive::Plane(fit_plane_indices(points, ids).unwrap())
+    }
+
+    #[test]
+    fn a_wall_bowed_across_a_gap_is_one_plane_for_the_joint_fit_only() {
+        // Two pieces of one wall, 10 m apart, each tilted 0.34° the other
+        // way (a bow of 3 cm at their far ends): either piece's own plane,
+        // carried over the gap, misses the other by 6–18 cm, twice τ, so
+        // the test that merges candidates says "two planes"; the plane
+        // fitted to both keeps them.
+        let mut rng = SplitMix64::new(7);
+        let mut pts = Vec::new();
+        let a = piece(
+            &mut pts,
+            &mut rng,
+            (0.0, 10.0),
+            (0.0, 10.0),
+            0.006,
+            5.0,
+            0.0,
+            0.03,
+        );
+        let b = piece(
+            &mut pts,
+            &mut rng,
+            (20.0, 30.0),
+            (0.0, 10.0),
+            -0.006,
+            25.0,
+            0.0,
+            0.03,
+        );
+        let (fa, fb) = (fit(&pts, &a), fit(&pts, &b));
+        let tau = 0.06;
+        let pa = Piece {
+            fit: &fa,
+            tau,
+            seeds: &a,
+        };
+        let pb = Piece {
+            fit: &fb,
+            tau,
+            seeds: &b,
+        };
+        assert!(!same_primitive(pa, pb, 10.0, &pts));
+        assert!(joint_plane_keeps(pa, pb, &pts));
+        assert!(joint_plane_keeps(pb, pa, &pts));
+    }
+
+    #[test]
+    fn a_wall_set_back_by_five_tau_beside_another_stays_apart() {
+        // A façade and a wall 30 cm behind it, side by side: the joint
+        // plane lies between them and keeps about half of each.
+        let mut rng = SplitMix64::new(8);
+        let mut pts = Vec::new();
+        let a = piece(
+            &mut pts,
+            &mut rng,
+            (0.0, 10.0),
+            (0.0, 10.0),
+            0.0,
+            0.0,
+            0.0,
+            0.03,
+        );
+        let b = piece(
+            &mut pts,
+            &mut rng,
+            (0.0, 10.0),
+            (12.0, 22.0),
+            0.0,
+            0.0,
+            0.3,
+            0.03,
+        );
+        let (fa, fb) = (fit(&pts, &a), fit(&pts, &b));
+        let tau = 0.06;
+        let pa = Piece {
+            fit: &fa,
+            tau,
+            seeds: &a,
+        };
+        let pb = Piece {
+            fit: &fb,
+            tau,
+            seeds: &b,
+        };
+        assert!(!same_primitive(pa, pb, 10.0, &pts));
+        assert!(!joint_plane_keeps(pa, pb, &pts));
+        // The same two pieces in one plane are one.
+        let mut flat = pts.clone();
+        for &v in &b {
+            flat[v as usize][2] -= 0.3;
+        }
+        let fb = fit(&flat, &b);
+        let pb = Piece {
+            fit: &fb,
+            tau,
+            seeds: &b,
+        };
+        assert!(joint_plane_keeps(pa, pb, &flat));
+    }
 }
