@@ -209,10 +209,34 @@ fn write_scans(path: &Path, scans: &[Scan], xml: impl Fn(String) -> String) {
     w.finalize_customized_xml(|x| Ok(xml(x))).unwrap();
 }
 
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("aniso-e57-{}", std::process::id()));
+/// A scratch file in a folder of its own, both removed when dropped.
+struct TmpFile(PathBuf);
+
+impl std::ops::Deref for TmpFile {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl AsRef<Path> for TmpFile {
+    fn as_ref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for TmpFile {
+    fn drop(&mut self) {
+        if let Some(d) = self.0.parent() {
+            let _ = std::fs::remove_dir_all(d);
+        }
+    }
+}
+
+fn tmp(name: &str) -> TmpFile {
+    let d = std::env::temp_dir().join(format!("aniso-e57-{}-{name}", std::process::id()));
     std::fs::create_dir_all(&d).unwrap();
-    d.join(name)
+    TmpFile(d.join(name))
 }
 
 #[test]
