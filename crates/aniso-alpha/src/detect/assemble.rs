@@ -63,6 +63,9 @@ pub(crate) struct Settings {
     pub scales: Vec<Scale>,
     /// log₁₀ ε of the significance test, or `None` for no test.
     pub log10_epsilon: Option<f64>,
+    /// Whether a noisy plane's claim radius may widen (step 2b): with the
+    /// data's orientations, whose α is the median noise of the cloud.
+    pub widen_planes: bool,
 }
 
 /// Relative share of a part's vertices on each side of another part's
@@ -366,20 +369,35 @@ impl Footprint {
         self.bits.iter().filter(|&&b| b).count()
     }
 
-    /// Centres (3D, on the primitive) of the covered cells.
-    fn centres(&self) -> impl Iterator<Item = [f64; 3]> + '_ {
-        (0..self.dims[0]).flat_map(move |i| {
-            (0..self.dims[1]).filter_map(move |j| {
-                if !self.bits[i * self.dims[1] + j] {
-                    return None;
+    /// Blocks of `b` × `b` cells (`b` along a line) holding a covered
+    /// cell: each block's centre (3D, on the primitive) and the distance
+    /// from it to the block's farthest corner, along the primitive.
+    fn blocks(&self, b: usize) -> Vec<([f64; 3], f64)> {
+        let planar = self.axes[1] != [0.0; 3];
+        let bj = if planar { b } else { self.dims[1] };
+        let mut out = Vec::new();
+        for i0 in (0..self.dims[0]).step_by(b) {
+            for j0 in (0..self.dims[1]).step_by(bj) {
+                let (i1, j1) = ((i0 + b).min(self.dims[0]), (j0 + bj).min(self.dims[1]));
+                let any = (i0..i1).any(|i| (j0..j1).any(|j| self.bits[i * self.dims[1] + j]));
+                if !any {
+                    continue;
                 }
-                let u = (self.lo[0] + i as i64) as f64 + 0.5;
-                let v = (self.lo[1] + j as i64) as f64 + 0.5;
-                Some([0, 1, 2].map(|k| {
+                let u = (self.lo[0] + i0 as i64) as f64 + 0.5 * (i1 - i0) as f64;
+                let v = (self.lo[1] + j0 as i64) as f64 + 0.5 * (j1 - j0) as f64;
+                let centre = [0, 1, 2].map(|k| {
                     self.origin[k] + self.cell * (u * self.axes[0][k] + v * self.axes[1][k])
-                }))
-            })
-        })
+                });
+                let (hu, hv) = (0.5 * (i1 - i0) as f64, 0.5 * (j1 - j0) as f64);
+                let half = if planar {
+                    self.cell * (hu * hu + hv * hv).sqrt()
+                } else {
+                    self.cell * hu
+                };
+                out.push((centre, half));
+            }
+        }
+        out
     }
 }
 
@@ -419,14 +437,12 @@ fn for_near(
 ) {
     let mark = stamps.next();
     let stamp = &mut stamps.v;
-    let planar = matches!(c.fit, Primitive::Plane(_));
-    let half = if planar {
-        c.foot.cell * std::f64::consts::FRAC_1_SQRT_2
-    } else {
-        0.5 * c.foot.cell
-    };
-    let r = (half * half + radius * radius).sqrt();
-    for centre in c.foot.centres() {
+    // One ball per block of cells about 2·radius wide (one cell while the
+    // radius is under half a cell): with a radius many cells wide, a ball
+    // per cell would visit each point once per cell within its reach.
+    let b = ((2.0 * radius / c.foot.cell).ceil() as usize).max(1);
+    for (centre, half) in c.foot.blocks(b) {
+        let r = (half * half + radius * radius).sqrt();
         index.within(&centre, r, |i| {
             if stamp[i as usize] == mark {
                 return;
@@ -780,33 +796,55 @@ pub(crate) fn assemble<S: Face>(
     // 2b. Claim radius from the noise (lines under the test): the radius
     // among CLAIM_RADII·τ whose tube makes the candidate least explicable
     // by chance.
-    if settings.kind == StructureKind::Lines && settings.log10_epsilon.is_some() {
+    if (settings.kind == StructureKind::Lines || settings.widen_planes)
+        && settings.log10_epsilon.is_some()
+    {
         let (lo, hi) = crate::geometry::bounding_box(points);
         let volume: f64 = (0..3).map(|k| (hi[k] - lo[k]).max(1e-300)).product();
         let rho_global = firsts.len() as f64 / volume;
         let log10_tests = log10_n_tests(firsts.len(), S::K) + (CLAIM_RADII.len() as f64).log10();
         for c in cands.iter_mut() {
             let base = c.tau;
-            let extent = line_span(&c.fit, &c.seeds, points);
-            let vol = |t: f64| std::f64::consts::PI * t * t * extent;
-            let mut best = (f64::INFINITY, base);
-            for f in CLAIM_RADII {
-                let r = f * base;
-                // A wider tube may cost at most MAX_WIDEN_BACKGROUND
-                // expected background points.
-                if f > 1.0 && rho_global * vol(r) > MAX_WIDEN_BACKGROUND {
-                    break;
+            let planar = matches!(c.fit, Primitive::Plane(_));
+            // A plane whose seeds' RMS is under τ/3 keeps 99% of a
+            // Gaussian spread within τ: nothing for a wider slab to gain.
+            if planar && 3.0 * c.fit.rms() < base {
+                continue;
+            }
+            let extent = if planar {
+                c.foot.count() as f64 * c.cell * c.cell
+            } else {
+                line_span(&c.fit, &c.seeds, points)
+            };
+            let vol = |t: f64| {
+                if planar {
+                    2.0 * t * extent
+                } else {
+                    std::f64::consts::PI * t * t * extent
                 }
+            };
+            // The radii tried: a wider tube may cost a line at most
+            // MAX_WIDEN_BACKGROUND expected background points.
+            let radii: Vec<f64> = CLAIM_RADII
+                .iter()
+                .enumerate()
+                .take_while(|&(i, &f)| {
+                    planar || i == 0 || rho_global * vol(f * base) <= MAX_WIDEN_BACKGROUND
+                })
+                .map(|(_, &f)| f * base)
+                .collect();
+            // One pass over the points near the candidate, out to the
+            // widest radius's shell; each radius then counts its own.
+            let reach = SHELL_RATIO * radii.last().copied().unwrap_or(base);
+            let mut near = Vec::new();
+            for_near(c, reach, points, &index, &mut stamp, &mut |_, d| {
+                near.push(d)
+            });
+            let mut best = (f64::INFINITY, base);
+            for &r in &radii {
                 let outer = SHELL_RATIO * r;
-                let mut residuals = Vec::new();
-                let mut shell = 0usize;
-                for_near(c, outer, points, &index, &mut stamp, &mut |_, d| {
-                    if d <= r {
-                        residuals.push(d);
-                    } else {
-                        shell += 1;
-                    }
-                });
+                let residuals: Vec<f64> = near.iter().copied().filter(|&d| d <= r).collect();
+                let shell = near.iter().filter(|&&d| d > r && d <= outer).count();
                 let rho_local = (shell as f64 + 1.0) / (vol(outer) - vol(r)).max(1e-300);
                 let nfa = part_log10_nfa(
                     &residuals,
@@ -1479,5 +1517,72 @@ mod tests {
             seeds: &b,
         };
         assert!(joint_plane_keeps(pa, pb, &flat));
+    }
+
+    #[test]
+    fn near_points_by_blocks_are_the_brute_force_set() {
+        // A plane and a line candidate among random points; for radii from
+        // a tenth of a cell to ten cells (one ball per cell, then blocks),
+        // `for_near` reports each point within the radius and over the
+        // footprint exactly once.
+        let mut rng = SplitMix64::new(21);
+        let pts: Vec<[f64; 3]> = (0..4000)
+            .map(|_| {
+                [
+                    10.0 * rng.uniform(),
+                    10.0 * rng.uniform(),
+                    2.0 * rng.uniform() - 1.0,
+                ]
+            })
+            .collect();
+        let seeds_plane: Vec<u32> = (0..4000u32)
+            .filter(|&i| {
+                let p = pts[i as usize];
+                p[2].abs() < 0.2 && (p[0] < 4.0 || p[1] > 6.0)
+            })
+            .collect();
+        let seeds_line: Vec<u32> = (0..4000u32)
+            .filter(|&i| {
+                let p = pts[i as usize];
+                p[2].abs() < 0.3 && (p[1] - 5.0).abs() < 0.3 && p[0] < 7.0
+            })
+            .collect();
+        let index = KdTree::new(&pts, None);
+        let mut stamps = Stamps::new(pts.len());
+        for (seeds, line) in [(&seeds_plane, false), (&seeds_line, true)] {
+            let fit = if line {
+                Primitive::Line(
+                    fit_line(&seeds.iter().map(|&v| pts[v as usize]).collect::<Vec<_>>()).unwrap(),
+                )
+            } else {
+                fit(&pts, seeds)
+            };
+            let cell = 0.3;
+            let foot = Footprint::new(&fit, &pts, seeds, cell).unwrap();
+            let cand = Cand {
+                fit: fit.clone(),
+                tau: 0.1,
+                cell,
+                seeds: seeds.clone(),
+                foot,
+            };
+            for radius in [0.03, 0.1, 0.3, 0.7, 1.5, 3.0] {
+                let mut got = Vec::new();
+                for_near(&cand, radius, &pts, &index, &mut stamps, &mut |i, d| {
+                    got.push((i, d))
+                });
+                got.sort_by_key(|a| a.0);
+                let want: Vec<(u32, f64)> = (0..pts.len() as u32)
+                    .filter_map(|i| {
+                        let p = &pts[i as usize];
+                        let d = fit.distance(p);
+                        (d <= radius && cand.foot.contains(p)).then_some((i, d))
+                    })
+                    .collect();
+                assert_eq!(got, want, "line {line}, radius {radius}");
+                // (not vacuous: from 0.3 on, dozens of points at least)
+                assert!(radius < 0.3 || want.len() > 20, "{}", want.len());
+            }
+        }
     }
 }

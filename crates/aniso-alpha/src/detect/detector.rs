@@ -752,6 +752,7 @@ impl<'a> Detector<'a> {
             min_vertices,
             scales,
             log10_epsilon: self.epsilon.map(f64::log10),
+            widen_planes: matches!(self.set, OrientationSet::Data(_)),
         };
         Ok(assemble::<S>(points, kept, kept_groups, &settings, stats)?.detection)
     }
