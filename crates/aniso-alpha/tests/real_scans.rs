@@ -192,21 +192,21 @@ fn ball_every_plane_from_the_data() {
 #[test]
 fn building_planes_from_the_data() {
     // A regression guard at the level measured (BENCHMARKS.md, real
-    // scans): 10 of the 11 labelled planes of >= 1,000 points, F1 0.817.
-    // The miss: a facade that the labels count as one plane, 1.5 m deep
-    // (its steps come out as parts of their own). The wall whose two
-    // pieces, 29 m apart, fit planes 0.37 m apart (about 2.3 times their
-    // own RMS) was the second miss (9/11) until the part merging tested
-    // the plane fitted to both pieces (`assemble::joint_plane_keeps`).
+    // scans): 11 of the 11 labelled planes of >= 1,000 points, F1 0.847.
+    // Before stop 23: 9/11, F1 0.817. A wall whose two pieces, 29 m apart,
+    // fit planes 0.37 m apart was two parts until the part merging tested
+    // the plane fitted to both pieces (`assemble::joint_plane_keeps`); a
+    // facade that the labels count as one plane, 1.5 m deep, lost half its
+    // points until a noisy plane's claim radius could widen.
     let (points, truth) = fixture("building.ply");
     let truth = truth.unwrap();
     let det = planes_from_the_data(&points);
     let s = score(&truth, &det.part_labels(), 1000);
     eprintln!("building: {s:?}, {} orientations", det.stats.orientations);
     assert_eq!(s.big, 11);
-    assert!(s.found >= 10, "{s:?}");
+    assert!(s.found >= 11, "{s:?}");
     assert!(s.parts <= 80, "{s:?}");
-    assert!(s.f1 >= 0.78, "{s:?}");
+    assert!(s.f1 >= 0.83, "{s:?}");
     check_parts(&det, &points);
 }
 
