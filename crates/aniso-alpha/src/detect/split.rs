@@ -234,7 +234,7 @@ impl Plan {
     /// repeat points many times.
     pub fn tiles(&self, points: &[[f64; 3]]) -> Vec<Tile> {
         let side = self.step.side;
-        let used: Vec<bool> = match &self.groups {
+        let mut used: Vec<bool> = match &self.groups {
             None => vec![true; points.len()],
             Some(groups) => {
                 let mut u = vec![false; points.len()];
@@ -246,6 +246,14 @@ impl Plan {
                 u
             }
         };
+        // Exact copies of a point are one point (as in `Detector::run`):
+        // only the first occurrence goes to the tiles. The triangulation
+        // would keep that one anyway, and `finish` labels every copy by its
+        // first occurrence; the copies would only cost the workers time.
+        let first = super::detection::first_occurrences(points);
+        for (i, u) in used.iter_mut().enumerate() {
+            *u &= first[i] as usize == i;
+        }
         let mut cells: Vec<[i64; 3]> = points
             .iter()
             .zip(&used)
@@ -629,6 +637,37 @@ mod tests {
         let (split, tiles) = split_run(&d, &pts, 2.5);
         assert!(tiles > 8, "{tiles} tiles");
         same(&split, &whole);
+    }
+
+    #[test]
+    fn copies_reach_no_tile_and_change_nothing() {
+        // The lines scene with a copy of every third point and two of
+        // every seventh: the tiles list first occurrences only, and the
+        // split run gives what the run gives (which itself gives every
+        // copy its first occurrence's labels).
+        let scene = synth::lines(1);
+        let n = scene.points.len();
+        let mut pts = scene.points.clone();
+        for i in (0..n).step_by(3) {
+            pts.push(scene.points[i]);
+        }
+        for i in (0..n).step_by(7) {
+            pts.extend([scene.points[i], scene.points[i]]);
+        }
+        let d = Detector::lines(1.0, 10.0, 4);
+        let plan = d.plan(&pts, 20.0).unwrap();
+        assert!(plan
+            .tiles(&pts)
+            .iter()
+            .all(|t| t.ids.iter().all(|&i| (i as usize) < n)));
+        let whole = d.run(&pts).unwrap();
+        assert!(whole.structures.len() >= 4);
+        let (split, tiles) = split_run(&d, &pts, 20.0);
+        assert!(tiles > 8, "{tiles} tiles");
+        same(&split, &whole);
+        // The automatic mode (modes' members include every copy) too.
+        let a = Detector::auto(StructureKind::Lines, &pts, &Given::default()).unwrap();
+        same(&split_run(&a, &pts, 20.0).0, &a.run(&pts).unwrap());
     }
 
     #[test]
