@@ -21,7 +21,7 @@
 //!   a polynomial of degree 6 in the coordinate differences, with
 //!   `|u × v|² = |u|²|v|² − (u·v)²` (Lagrange).
 
-use crate::geometry::{Point3, Sign};
+use crate::geometry::{cross, cross_permanent, dot, Point3, Sign};
 
 /// Sign of `(p − a)·(p − b)`: negative when `p` is strictly inside the
 /// ball with diameter `ab`, zero on its sphere, positive outside.
@@ -381,18 +381,8 @@ fn tet_radius2_exact(a: &Point3, b: &Point3, c: &Point3, d: &Point3) -> f64 {
 /// have cost more than about 10 bits.
 #[inline]
 pub(crate) fn cross_norm2(a: &Point3, b: &Point3, c: &Point3, u: &Point3, v: &Point3) -> f64 {
-    let n = [
-        u[1] * v[2] - u[2] * v[1],
-        u[2] * v[0] - u[0] * v[2],
-        u[0] * v[1] - u[1] * v[0],
-    ];
-    let p = [
-        (u[1] * v[2]).abs() + (u[2] * v[1]).abs(),
-        (u[2] * v[0]).abs() + (u[0] * v[2]).abs(),
-        (u[0] * v[1]).abs() + (u[1] * v[0]).abs(),
-    ];
-    let nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
-    let pp = p[0] * p[0] + p[1] * p[1] + p[2] * p[2];
+    let (n, p) = (cross(*u, *v), cross_permanent(*u, *v));
+    let (nn, pp) = (dot(n, n), dot(p, p));
     if nn >= 1e-6 * pp && pp > 0.0 {
         return nn;
     }

@@ -20,6 +20,7 @@
 use crate::alpha::exact::{edge_diametral_side, tet_radius2, triangle_diametral_side};
 use crate::alpha::triangle_rho_sorted;
 use crate::delaunay::{Triangulation, INFINITE};
+use crate::geometry::{cross, cross_permanent, dot, sub};
 
 /// Relative error bound used to certify the side of α on which a cell's
 /// circumradius lies from its plain floating-point evaluation: 1e-12 of
@@ -36,26 +37,13 @@ const CERTIFY: f64 = 1e-12;
 /// cells whose radius is within the bound of α.
 fn cell_radius(p: [&[f64; 3]; 4], alpha: f64) -> f64 {
     let [a, b, c, d] = p;
-    let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-    let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-    let w = [d[0] - a[0], d[1] - a[1], d[2] - a[2]];
-    let dot = |x: [f64; 3], y: [f64; 3]| x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
-    let cr = |x: [f64; 3], y: [f64; 3]| {
-        [
-            x[1] * y[2] - x[2] * y[1],
-            x[2] * y[0] - x[0] * y[2],
-            x[0] * y[1] - x[1] * y[0],
-        ]
-    };
-    let pc = |x: [f64; 3], y: [f64; 3]| {
-        [
-            (x[1] * y[2]).abs() + (x[2] * y[1]).abs(),
-            (x[2] * y[0]).abs() + (x[0] * y[2]).abs(),
-            (x[0] * y[1]).abs() + (x[1] * y[0]).abs(),
-        ]
-    };
-    let (cvw, cwu, cuv) = (cr(v, w), cr(w, u), cr(u, v));
-    let (pvw, pwu, puv) = (pc(v, w), pc(w, u), pc(u, v));
+    let (u, v, w) = (sub(*b, *a), sub(*c, *a), sub(*d, *a));
+    let (cvw, cwu, cuv) = (cross(v, w), cross(w, u), cross(u, v));
+    let (pvw, pwu, puv) = (
+        cross_permanent(v, w),
+        cross_permanent(w, u),
+        cross_permanent(u, v),
+    );
     let (uu, vv, ww) = (dot(u, u), dot(v, v), dot(w, w));
     let det = dot(u, cvw);
     let pdet = u[0].abs() * pvw[0] + u[1].abs() * pvw[1] + u[2].abs() * pvw[2];
@@ -102,22 +90,10 @@ fn cell_radius(p: [&[f64; 3]; 4], alpha: f64) -> f64 {
 /// permanent): 0 when the bound says nothing. Nearly collinear triangles,
 /// whose exact ρ needs expansion arithmetic, get a bound far above any α.
 fn circumradius_lower(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> f64 {
-    let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-    let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-    let e = [c[0] - b[0], c[1] - b[1], c[2] - b[2]];
-    let dot = |x: [f64; 3], y: [f64; 3]| x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
-    let cross = [
-        u[1] * v[2] - u[2] * v[1],
-        u[2] * v[0] - u[0] * v[2],
-        u[0] * v[1] - u[1] * v[0],
-    ];
-    let perm = [
-        (u[1] * v[2]).abs() + (u[2] * v[1]).abs(),
-        (u[2] * v[0]).abs() + (u[0] * v[2]).abs(),
-        (u[0] * v[1]).abs() + (u[1] * v[0]).abs(),
-    ];
+    let (u, v, e) = (sub(*b, *a), sub(*c, *a), sub(*c, *b));
+    let (n, perm) = (cross(u, v), cross_permanent(u, v));
     let lengths = (dot(u, u) * dot(v, v) * dot(e, e)).sqrt() * (1.0 - CERTIFY);
-    let cross = dot(cross, cross).sqrt() + CERTIFY * dot(perm, perm).sqrt();
+    let cross = dot(n, n).sqrt() + CERTIFY * dot(perm, perm).sqrt();
     let r = lengths / (2.0 * cross);
     if r.is_finite() {
         r

@@ -46,6 +46,19 @@ pub fn cross(a: Point3, b: Point3) -> Point3 {
     ]
 }
 
+/// The permanent of [`cross`]: `|a₁b₂| + |a₂b₁|` and so on per component,
+/// the size of the products each component of `a × b` subtracts, which
+/// bounds its rounding error (the error bounds of `alpha::exact` and
+/// `detect::faces`).
+#[inline]
+pub(crate) fn cross_permanent(a: Point3, b: Point3) -> Point3 {
+    [
+        (a[1] * b[2]).abs() + (a[2] * b[1]).abs(),
+        (a[2] * b[0]).abs() + (a[0] * b[2]).abs(),
+        (a[0] * b[1]).abs() + (a[1] * b[0]).abs(),
+    ]
+}
+
 /// The Euclidean norm `|a|`.
 #[inline]
 pub fn norm(a: Point3) -> f64 {

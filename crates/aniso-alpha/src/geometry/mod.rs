@@ -11,6 +11,7 @@ mod linear;
 pub mod predicates;
 mod wide;
 
+pub(crate) use linear::cross_permanent;
 pub use linear::{
     add, cross, det3, dot, mat_mul, norm, normalize, q_matrix, scale, sub, transform_point,
     transform_points, Mat3,
