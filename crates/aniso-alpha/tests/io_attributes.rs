@@ -7,38 +7,16 @@
 
 use std::path::{Path, PathBuf};
 
+mod common;
+use common::TempDir;
+
 use aniso_alpha::io::{
     read_points, read_points_bytes, write_labelled_cloud, Attribute, Labelled, PointCloud,
     ReadOptions, Values,
 };
 
-/// A scratch folder, removed with its content when dropped.
-struct TmpDir(PathBuf);
-
-impl std::ops::Deref for TmpDir {
-    type Target = Path;
-    fn deref(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl AsRef<Path> for TmpDir {
-    fn as_ref(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl Drop for TmpDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
-fn tmp_dir(name: &str) -> TmpDir {
-    let d = std::env::temp_dir().join(format!("aniso-attr-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    TmpDir(d)
+fn tmp_dir(name: &str) -> TempDir {
+    TempDir::new("attr", name)
 }
 
 const WITH_ATTRS: ReadOptions = ReadOptions {

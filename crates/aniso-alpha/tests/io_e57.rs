@@ -8,6 +8,9 @@
 
 use std::path::{Path, PathBuf};
 
+mod common;
+use common::TempDir;
+
 use aniso_alpha::io::{
     read_points, read_points_bytes, IoError, PointCloud, ReadOptions, ReadWarning, Values,
 };
@@ -209,39 +212,17 @@ fn write_scans(path: &Path, scans: &[Scan], xml: impl Fn(String) -> String) {
     w.finalize_customized_xml(|x| Ok(xml(x))).unwrap();
 }
 
-/// A scratch file in a folder of its own, both removed when dropped.
-struct TmpFile(PathBuf);
-
-impl std::ops::Deref for TmpFile {
-    type Target = Path;
-    fn deref(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl AsRef<Path> for TmpFile {
-    fn as_ref(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl Drop for TmpFile {
-    fn drop(&mut self) {
-        if let Some(d) = self.0.parent() {
-            let _ = std::fs::remove_dir_all(d);
-        }
-    }
-}
-
-fn tmp(name: &str) -> TmpFile {
-    let d = std::env::temp_dir().join(format!("aniso-e57-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    TmpFile(d.join(name))
+/// A scratch file in a folder of its own (removed when the folder is
+/// dropped).
+fn tmp(name: &str) -> (TempDir, PathBuf) {
+    let d = TempDir::new("e57", name);
+    let path = d.join(name);
+    (d, path)
 }
 
 #[test]
 fn scans_are_moved_by_their_poses_and_share_columns() {
-    let path = tmp("two_scans.e57");
+    let (_dir, path) = tmp("two_scans.e57");
     let h = std::f64::consts::FRAC_1_SQRT_2;
     let quarter_turn = Transform {
         rotation: Quaternion {
@@ -300,7 +281,7 @@ fn scans_are_moved_by_their_poses_and_share_columns() {
 
 #[test]
 fn a_lying_point_count_is_refused_before_allocating() {
-    let path = tmp("lying_count.e57");
+    let (_dir, path) = tmp("lying_count.e57");
     let pts = vec![[1.0, 0.0, 0.0]; 3];
     write_scans(&path, &[(pts, vec![1, 2, 3], false, None)], |x| {
         x.replace("recordCount=\"3\"", "recordCount=\"1000000000000000\"")
@@ -311,7 +292,7 @@ fn a_lying_point_count_is_refused_before_allocating() {
         "{e}"
     );
     // The oracle can fail: the same file, unchanged, reads.
-    let path = tmp("true_count.e57");
+    let (_dir, path) = tmp("true_count.e57");
     let pts = vec![[1.0, 0.0, 0.0]; 3];
     write_scans(&path, &[(pts, vec![1, 2, 3], false, None)], |x| {
         assert!(x.contains("recordCount=\"3\""), "{x}");

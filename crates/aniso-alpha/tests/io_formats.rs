@@ -1,17 +1,17 @@
 //! Readers and writers: round trips, fixtures written here, malformed input.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
+
+mod common;
+use common::TempDir;
 
 use aniso_alpha::io::{
     read_labels, read_pcd_bytes, read_ply_bytes, read_points, read_points_bytes, write_labels,
     write_obj, write_ply, ClassSet, IoError, Mesh, PlyEncoding, ReadOptions,
 };
 
-fn tmp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("aniso-io-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+fn tmp_dir(name: &str) -> TempDir {
+    TempDir::new("io", name)
 }
 
 fn awkward_points() -> Vec<[f64; 3]> {

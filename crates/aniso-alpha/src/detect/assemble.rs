@@ -609,6 +609,35 @@ fn same_primitive(a: Piece, b: Piece, angle_deg: f64, points: &[[f64; 3]]) -> bo
     near as f64 >= SAME_SHARE * small.seeds.len() as f64
 }
 
+/// The volume within distance t of a primitive, as a function of t: a
+/// slab 2t thick over a plane's area, a tube of radius t along a line's
+/// length. A plane's area: the footprint's cells (of side `cell`), which
+/// its members cover grown by one (generous: the region the scan could
+/// have found it in). A line's length: the span of its members (a line's
+/// footprint is one row of cells; its dilation also marks the rows beside
+/// it, which tripled the length before).
+fn near_volume(
+    fit: &Primitive,
+    foot: &Footprint,
+    cell: f64,
+    members: &[u32],
+    points: &[[f64; 3]],
+) -> impl Fn(f64) -> f64 {
+    let planar = matches!(fit, Primitive::Plane(_));
+    let extent = if planar {
+        foot.count() as f64 * cell * cell
+    } else {
+        line_span(fit, members, points)
+    };
+    move |t: f64| {
+        if planar {
+            2.0 * t * extent
+        } else {
+            std::f64::consts::PI * t * t * extent
+        }
+    }
+}
+
 /// Whether two parallel planar pieces that lie apart are one plane seen
 /// in two places: the plane fitted to both keeps, for each piece, at least
 /// [`SAME_SHARE`] of the points its own plane keeps within τ. Two pieces
@@ -811,18 +840,7 @@ pub(crate) fn assemble<S: Face>(
             if planar && 3.0 * c.fit.rms() < base {
                 continue;
             }
-            let extent = if planar {
-                c.foot.count() as f64 * c.cell * c.cell
-            } else {
-                line_span(&c.fit, &c.seeds, points)
-            };
-            let vol = |t: f64| {
-                if planar {
-                    2.0 * t * extent
-                } else {
-                    std::f64::consts::PI * t * t * extent
-                }
-            };
+            let vol = near_volume(&c.fit, &c.foot, c.cell, &c.seeds, points);
             // The radii tried: a wider tube may cost a line at most
             // MAX_WIDEN_BACKGROUND expected background points.
             let radii: Vec<f64> = CLAIM_RADII
@@ -1023,24 +1041,7 @@ pub(crate) fn assemble<S: Face>(
             // Footprint extent from the members (cells they occupy).
             let foot = Footprint::new(&p.fit, points, &p.members, c.cell);
             let Some(foot) = foot else { continue };
-            let planar = matches!(p.fit, Primitive::Plane(_));
-            // A plane's area: the cells its members cover, grown by one
-            // (generous: the region the scan could have found it in). A
-            // line's length: the span of its members (a line's footprint
-            // is one row of cells; its dilation also marks the rows beside
-            // it, which tripled the length before).
-            let extent = if planar {
-                foot.count() as f64 * c.cell * c.cell
-            } else {
-                line_span(&p.fit, &p.members, points)
-            };
-            let vol = |t: f64| {
-                if planar {
-                    2.0 * t * extent
-                } else {
-                    std::f64::consts::PI * t * t * extent
-                }
-            };
+            let vol = near_volume(&p.fit, &foot, c.cell, &p.members, points);
             // Local density in the shell (τ, 4τ] over the footprint.
             let outer = SHELL_RATIO * tau;
             let probe = Cand {
@@ -1390,26 +1391,26 @@ mod tests {
     use super::*;
     use crate::rng::SplitMix64;
 
-    /// Points on z = slope·(x − x0) + offset over [xa, xb] × [ya, yb],
-    /// jittered across by ±`noise` (uniform), on a grid of step 0.25.
-    #[allow(clippy::too_many_arguments)]
+    /// Half-width of the uniform jitter across the test pieces; τ is
+    /// twice it.
+    const NOISE: f64 = 0.03;
+    const TAU: f64 = 0.06;
+
+    /// Points on z = `height(x)` over [xa, xb] × [ya, yb], on a grid of
+    /// step 0.25, jittered across by ±[`NOISE`]: their ids.
     fn piece(
         out: &mut Vec<[f64; 3]>,
         rng: &mut SplitMix64,
         (xa, xb): (f64, f64),
         (ya, yb): (f64, f64),
-        slope: f64,
-        x0: f64,
-        offset: f64,
-        noise: f64,
+        height: impl Fn(f64) -> f64,
     ) -> Vec<u32> {
         let start = out.len() as u32;
         let (nx, ny) = (((xb - xa) / 0.25) as usize, ((yb - ya) / 0.25) as usize);
         for i in 0..=nx {
             for j in 0..=ny {
                 let (x, y) = (xa + 0.25 * i as f64, ya + 0.25 * j as f64);
-                let z = slope * (x - x0) + offset + noise * (2.0 * rng.uniform() - 1.0);
-                out.push([x, y, z]);
+                out.push([x, y, height(x) + NOISE * (2.0 * rng.uniform() - 1.0)]);
             }
         }
         (start..out.len() as u32).collect()
@@ -1417,6 +1418,15 @@ mod tests {
 
     fn fit(points: &[[f64; 3]], ids: &[u32]) -> Primitive {
         Primitive::Plane(fit_plane_indices(points, ids).unwrap())
+    }
+
+    /// A piece's plane, claim radius [`TAU`] and points.
+    fn as_piece<'a>(fit: &'a Primitive, seeds: &'a [u32]) -> Piece<'a> {
+        Piece {
+            fit,
+            tau: TAU,
+            seeds,
+        }
     }
 
     #[test]
@@ -1428,38 +1438,14 @@ mod tests {
         // fitted to both keeps them.
         let mut rng = SplitMix64::new(7);
         let mut pts = Vec::new();
-        let a = piece(
-            &mut pts,
-            &mut rng,
-            (0.0, 10.0),
-            (0.0, 10.0),
-            0.006,
-            5.0,
-            0.0,
-            0.03,
-        );
-        let b = piece(
-            &mut pts,
-            &mut rng,
-            (20.0, 30.0),
-            (0.0, 10.0),
-            -0.006,
-            25.0,
-            0.0,
-            0.03,
-        );
+        let a = piece(&mut pts, &mut rng, (0.0, 10.0), (0.0, 10.0), |x| {
+            0.006 * (x - 5.0)
+        });
+        let b = piece(&mut pts, &mut rng, (20.0, 30.0), (0.0, 10.0), |x| {
+            -0.006 * (x - 25.0)
+        });
         let (fa, fb) = (fit(&pts, &a), fit(&pts, &b));
-        let tau = 0.06;
-        let pa = Piece {
-            fit: &fa,
-            tau,
-            seeds: &a,
-        };
-        let pb = Piece {
-            fit: &fb,
-            tau,
-            seeds: &b,
-        };
+        let (pa, pb) = (as_piece(&fa, &a), as_piece(&fb, &b));
         assert!(!same_primitive(pa, pb, 10.0, &pts));
         assert!(joint_plane_keeps(pa, pb, &pts));
         assert!(joint_plane_keeps(pb, pa, &pts));
@@ -1471,38 +1457,10 @@ mod tests {
         // plane lies between them and keeps about half of each.
         let mut rng = SplitMix64::new(8);
         let mut pts = Vec::new();
-        let a = piece(
-            &mut pts,
-            &mut rng,
-            (0.0, 10.0),
-            (0.0, 10.0),
-            0.0,
-            0.0,
-            0.0,
-            0.03,
-        );
-        let b = piece(
-            &mut pts,
-            &mut rng,
-            (0.0, 10.0),
-            (12.0, 22.0),
-            0.0,
-            0.0,
-            0.3,
-            0.03,
-        );
+        let a = piece(&mut pts, &mut rng, (0.0, 10.0), (0.0, 10.0), |_| 0.0);
+        let b = piece(&mut pts, &mut rng, (0.0, 10.0), (12.0, 22.0), |_| 0.3);
         let (fa, fb) = (fit(&pts, &a), fit(&pts, &b));
-        let tau = 0.06;
-        let pa = Piece {
-            fit: &fa,
-            tau,
-            seeds: &a,
-        };
-        let pb = Piece {
-            fit: &fb,
-            tau,
-            seeds: &b,
-        };
+        let (pa, pb) = (as_piece(&fa, &a), as_piece(&fb, &b));
         assert!(!same_primitive(pa, pb, 10.0, &pts));
         assert!(!joint_plane_keeps(pa, pb, &pts));
         // The same two pieces in one plane are one.
@@ -1511,12 +1469,7 @@ mod tests {
             flat[v as usize][2] -= 0.3;
         }
         let fb = fit(&flat, &b);
-        let pb = Piece {
-            fit: &fb,
-            tau,
-            seeds: &b,
-        };
-        assert!(joint_plane_keeps(pa, pb, &flat));
+        assert!(joint_plane_keeps(pa, as_piece(&fb, &b), &flat));
     }
 
     #[test]

@@ -270,6 +270,20 @@ mod tests {
             .collect()
     }
 
+    /// `triangles_at` and `edges_at` give the interval complex's faces.
+    fn same_faces(ac: &AlphaComplex, tri: &Triangulation, alpha: f64, seed: u64) {
+        let mut a: Vec<[u32; 3]> = ac.triangles_at(alpha).collect();
+        a.sort_unstable();
+        let mut b = triangles_at(tri, alpha);
+        b.sort_unstable();
+        assert_eq!(a, b, "triangles, seed {seed}, alpha {alpha}");
+        let mut a: Vec<[u32; 2]> = ac.edges_at(alpha).collect();
+        a.sort_unstable();
+        let mut b = edges_at(tri, alpha);
+        b.sort_unstable();
+        assert_eq!(a, b, "edges, seed {seed}, alpha {alpha}");
+    }
+
     #[test]
     fn same_as_the_interval_complex() {
         for seed in 0..20u64 {
@@ -279,16 +293,7 @@ mod tests {
             let mut spectrum = ac.spectrum();
             spectrum.extend(spectrum.clone().windows(2).map(|w| 0.5 * (w[0] + w[1])));
             for &alpha in spectrum.iter().step_by(3) {
-                let mut a: Vec<[u32; 3]> = ac.triangles_at(alpha).collect();
-                a.sort_unstable();
-                let mut b = triangles_at(&tri, alpha);
-                b.sort_unstable();
-                assert_eq!(a, b, "triangles, seed {seed}, alpha {alpha}");
-                let mut a: Vec<[u32; 2]> = ac.edges_at(alpha).collect();
-                a.sort_unstable();
-                let mut b = edges_at(&tri, alpha);
-                b.sort_unstable();
-                assert_eq!(a, b, "edges, seed {seed}, alpha {alpha}");
+                same_faces(&ac, &tri, alpha, seed);
             }
         }
     }
@@ -405,16 +410,7 @@ mod tests {
             spectrum.extend(spectrum.clone().windows(2).map(|w| 0.5 * (w[0] + w[1])));
             spectrum.extend([0.5, 1.0, 4.0]);
             for &alpha in spectrum.iter().step_by(7) {
-                let mut a: Vec<[u32; 2]> = ac.edges_at(alpha).collect();
-                a.sort_unstable();
-                let mut b = edges_at(&tri, alpha);
-                b.sort_unstable();
-                assert_eq!(a, b, "edges, seed {seed}, alpha {alpha}");
-                let mut a: Vec<[u32; 3]> = ac.triangles_at(alpha).collect();
-                a.sort_unstable();
-                let mut b = triangles_at(&tri, alpha);
-                b.sort_unstable();
-                assert_eq!(a, b, "triangles, seed {seed}, alpha {alpha}");
+                same_faces(&ac, &tri, alpha, seed);
             }
         }
     }
