@@ -372,16 +372,15 @@ impl Footprint {
     /// Blocks of `b` × `b` cells (`b` along a line) holding a covered
     /// cell: each block's centre (3D, on the primitive) and the distance
     /// from it to the block's farthest corner, along the primitive.
-    fn blocks(&self, b: usize) -> Vec<([f64; 3], f64)> {
+    fn blocks(&self, b: usize) -> impl Iterator<Item = ([f64; 3], f64)> + '_ {
         let planar = self.axes[1] != [0.0; 3];
         let bj = if planar { b } else { self.dims[1] };
-        let mut out = Vec::new();
-        for i0 in (0..self.dims[0]).step_by(b) {
-            for j0 in (0..self.dims[1]).step_by(bj) {
+        (0..self.dims[0]).step_by(b).flat_map(move |i0| {
+            (0..self.dims[1]).step_by(bj).filter_map(move |j0| {
                 let (i1, j1) = ((i0 + b).min(self.dims[0]), (j0 + bj).min(self.dims[1]));
                 let any = (i0..i1).any(|i| (j0..j1).any(|j| self.bits[i * self.dims[1] + j]));
                 if !any {
-                    continue;
+                    return None;
                 }
                 let u = (self.lo[0] + i0 as i64) as f64 + 0.5 * (i1 - i0) as f64;
                 let v = (self.lo[1] + j0 as i64) as f64 + 0.5 * (j1 - j0) as f64;
@@ -394,10 +393,9 @@ impl Footprint {
                 } else {
                     self.cell * hu
                 };
-                out.push((centre, half));
-            }
-        }
-        out
+                Some((centre, half))
+            })
+        })
     }
 }
 
