@@ -21,6 +21,11 @@ Efficient RANSAC's wall time in the same run.
 aniso-alpha runs with no parameter at all. The peers get parameters: the
 CGAL defaults where they do well, and where they do not, values tuned by
 hand on that scan (listed in PEER_PARAMS; an advantage to the peers).
+
+CGAL's two scans carry the normals of their source files (`nx ny nz`):
+aniso-alpha reads them as `detect SCAN` does (and runs again with
+`--ignore-normals`), and the CGAL peers use them too (`cgal_shapes --k 0`)
+instead of estimating PCA normals.
 """
 import argparse
 import json
@@ -74,15 +79,25 @@ def simulated(name, tmp, seed=1):
     return a[:, :3], a[:, 3].astype(np.int64), path
 
 
-def read_ply(path):
+def read_ply(path, normals=False):
+    """A fixture: (points, labels), or (points, labels, normals or None)."""
     with open(path, "rb") as f:
         data = f.read()
     end = data.index(b"end_header\n") + len(b"end_header\n")
     header = data[:end].decode()
     n = int(header.split("element vertex ")[1].split()[0])
-    rec = np.frombuffer(data[end:], dtype=[("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("label", "<i4")], count=n)
+    types = {"float": "<f4", "double": "<f8", "int": "<i4"}
+    fields = [(line.split()[2], types[line.split()[1]]) for line in header.splitlines()
+              if line.startswith("property ")]
+    rec = np.frombuffer(data[end:], dtype=fields, count=n)
     xyz = np.stack([rec["x"], rec["y"], rec["z"]], axis=1).astype(np.float64)
-    return xyz, rec["label"].astype(np.int64)
+    labels = rec["label"].astype(np.int64)
+    if not normals:
+        return xyz, labels
+    nrm = None
+    if "nx" in rec.dtype.names:
+        nrm = np.stack([rec["nx"], rec["ny"], rec["nz"]], axis=1).astype(np.float64)
+    return xyz, labels, nrm
 
 
 def score(truth, pred, min_true=1000):
@@ -108,9 +123,9 @@ def score(truth, pred, min_true=1000):
                 found=found, big=big, parts=parts)
 
 
-def run_ours(binary, ply, out):
+def run_ours(binary, ply, out, extra=()):
     t = time.perf_counter()
-    subprocess.run([binary, "detect", ply, "--structure", "planes", "--part-labels", out, "--quiet"],
+    subprocess.run([binary, "detect", ply, "--structure", "planes", "--part-labels", out, "--quiet", *extra],
                    check=True, capture_output=True)
     return time.perf_counter() - t, np.loadtxt(out, dtype=np.int64)
 
@@ -170,19 +185,31 @@ def main():
             if name in SIM_VOXEL:
                 pts, truth, xyz = simulated(name, tmp)
                 ply = xyz
+                normals = None
             else:
                 ply = os.path.join(FIXTURES, name + ".ply")
-                pts, truth = read_ply(ply)
+                pts, truth, normals = read_ply(ply, normals=True)
                 xyz = os.path.join(tmp, name + ".xyz")
-                np.savetxt(xyz, pts, fmt="%.6f")
+                np.savetxt(xyz, pts if normals is None else np.c_[pts, normals], fmt="%.6f")
             out = os.path.join(tmp, name + ".labels")
             runs = {}
+            # A scan with normals: aniso-alpha reads them (as `detect
+            # SCAN` does), and also runs without them; the CGAL peers use
+            # them (`--k 0`) instead of PCA normals, as CGAL's examples do
+            # with a scan that has normals.
+            ours = [("aniso-alpha (auto)", ())]
+            peer_normals = {}
+            if normals is not None:
+                ours = [("aniso-alpha (auto, the scan's normals)", ()),
+                        ("aniso-alpha (auto, --ignore-normals)", ("--ignore-normals",))]
+                peer_normals = {"k": 0}
             for _ in range(a.repeat):
-                w, lab = run_ours(a.bin, ply, out)
-                runs.setdefault("aniso-alpha (auto)", []).append((w, lab, None))
+                for label, extra in ours:
+                    w, lab = run_ours(a.bin, ply, out, extra)
+                    runs.setdefault(label, []).append((w, lab, None))
                 if have_cgal:
                     for mode in ("ransac", "region"):
-                        w, lab, info = run_cgal(a.peer, mode, xyz, out, PEER_PARAMS[name][mode])
+                        w, lab, info = run_cgal(a.peer, mode, xyz, out, {**PEER_PARAMS[name][mode], **peer_normals})
                         runs.setdefault("CGAL " + ("Efficient RANSAC" if mode == "ransac" else "region growing"),
                                         []).append((w, lab, info))
                 if have_o3d:

@@ -5,9 +5,10 @@
 //       [--cluster-epsilon C] [--min-points M] [--normal-threshold T]
 //       [--max-angle DEG] [--probability P]
 //
-// POINTS.xyz: `x y z` per line (extra columns ignored). Normals are
+// POINTS.xyz: `x y z` per line, or `x y z nx ny nz`. Normals are
 // estimated with CGAL::pca_estimate_normals over K neighbours (timed
-// apart as "normals"). LABELS.txt: one integer per input point, the plane
+// apart as "normals"); with `--k 0`, the file's own normals (columns 4-6)
+// are used instead, as CGAL's examples do with a scan that has them. LABELS.txt: one integer per input point, the plane
 // id or -1. Prints one JSON line: n, planes, seconds of the normals and
 // of the detection, unassigned points.
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
@@ -67,15 +68,22 @@ int main(int argc, char** argv) {
     std::string line;
     while (std::getline(in, line)) {
       std::istringstream s(line);
-      double x, y, z;
-      if (s >> x >> y >> z) pts.push_back(Pwn(Point(x, y, z), Vector(0, 0, 0), pts.size()));
+      double x, y, z, nx = 0, ny = 0, nz = 0;
+      if (s >> x >> y >> z) {
+        if (k == 0 && !(s >> nx >> ny >> nz)) {
+          std::cerr << "--k 0 needs x y z nx ny nz per line\n";
+          return 2;
+        }
+        pts.push_back(Pwn(Point(x, y, z), Vector(nx, ny, nz), pts.size()));
+      }
     }
   }
   std::vector<long> labels(pts.size(), -1);
   CGAL::Real_timer tn, td;
   tn.start();
-  CGAL::pca_estimate_normals<CGAL::Sequential_tag>(
-      pts, k, CGAL::parameters::point_map(Point_map()).normal_map(Normal_map()));
+  if (k > 0)
+    CGAL::pca_estimate_normals<CGAL::Sequential_tag>(
+        pts, k, CGAL::parameters::point_map(Point_map()).normal_map(Normal_map()));
   tn.stop();
   long planes = 0;
   if (mode == "ransac") {
@@ -96,7 +104,7 @@ int main(int argc, char** argv) {
       for (std::size_t i : (*it)->indices_of_assigned_points()) labels[std::get<2>(pts[i])] = planes;
   } else if (mode == "region") {
     td.start();
-    Neighbors nq(pts, k, Point_map());
+    Neighbors nq(pts, k > 0 ? k : 12, Point_map());
     Region region(pts, eps > 0 ? eps : 1.0, max_angle,
                   std::size_t(min_points > 0 ? min_points : 50), Point_map(), Normal_map());
     Growing growing(pts, nq, region);

@@ -90,6 +90,10 @@ pub struct DetectArgs {
     /// Keep every part (no significance test: nb_c alone, as the paper)
     #[arg(long)]
     pub no_significance: bool,
+    /// Estimate every normal from its neighbourhood even when the input
+    /// gives normals (PLY nx ny nz, PCD normal_x normal_y normal_z)
+    #[arg(long)]
+    pub ignore_normals: bool,
     /// Triangulate in tiles of this side (input units) with halos: bounded
     /// memory, the same result
     #[arg(long, value_name = "SIZE", value_parser = parse_positive)]
@@ -157,6 +161,7 @@ fn kind_of(s: Structure) -> StructureKind {
 fn detector<'a>(
     args: &DetectArgs,
     points: &[[f64; 3]],
+    normals: Option<&[[f64; 3]]>,
     example: bool,
 ) -> Result<Detector<'a>, CliError> {
     let structure = args.structure.unwrap_or(Structure::Planes);
@@ -180,10 +185,14 @@ fn detector<'a>(
             StructureKind::Lines => Detector::lines(alpha, lambda3, nb_c),
             StructureKind::Planes => Detector::planes(alpha, lambda2, lambda3, nb_c),
         };
-        match args.sampler.unwrap_or(SamplerKind::Box) {
+        let d = match args.sampler.unwrap_or(SamplerKind::Box) {
             SamplerKind::Box => d.sampler(box_sampler),
             SamplerKind::Fibonacci => d.sampler(fib),
             SamplerKind::Data => d.data_orientations(points, m2),
+        };
+        match normals {
+            Some(n) => d.normals(n),
+            None => d,
         }
     } else {
         let given = Given {
@@ -192,7 +201,10 @@ fn detector<'a>(
             lambda3: args.lambda3,
             min_size: nb_c,
         };
-        let d = Detector::auto_with(kind, points, &given, m2)?;
+        let d = match normals {
+            Some(n) => Detector::auto_oriented(kind, points, n, &given, m2)?,
+            None => Detector::auto_with(kind, points, &given, m2)?,
+        };
         match args.sampler.unwrap_or(SamplerKind::Data) {
             SamplerKind::Data => d,
             SamplerKind::Box => d.sampler(box_sampler),
@@ -294,22 +306,49 @@ fn check_classify(args: &DetectArgs, labelled_output: bool) -> Result<(), CliErr
     Ok(())
 }
 
+/// What a run reads: the cloud, its normals, the example's ground truth
+/// and the name the summary and report give the input.
+struct Input {
+    cloud: PointCloud,
+    normals: Option<Vec<[f64; 3]>>,
+    truth: Option<Scene>,
+    name: String,
+}
+
 /// The points to run on: the input file's, or the built-in example's
-/// scene (generated, and written to `paths.scene`), with the scene as the
-/// ground truth and the name the summary and report give the input.
+/// scene (generated, and written to `paths.scene`), with the normals the
+/// input gives (unless `--ignore-normals`), the scene as the ground truth
+/// and the name the summary and report give the input.
 fn read_cloud(
     args: &DetectArgs,
     paths: &OutputPaths,
     timings: &mut Timings,
-) -> Result<(PointCloud, Option<Scene>, String), CliError> {
+) -> Result<Input, CliError> {
     match &args.input {
         Some(input) => {
+            let keep_attributes = paths.labelled_output || args.background_classes.is_some();
+            // PLY and PCD files may carry normals: read their attributes
+            // to find them.
+            let normals_here = !args.ignore_normals
+                && matches!(
+                    common::input_format(input),
+                    Some(io::Format::Ply | io::Format::Pcd)
+                );
             let options = ReadOptions {
-                attributes: paths.labelled_output || args.background_classes.is_some(),
+                attributes: keep_attributes || normals_here,
                 ..ReadOptions::default()
             };
-            let cloud = common::read_input(input, &options, timings)?;
-            Ok((cloud, None, input.display().to_string()))
+            let mut cloud = common::read_input(input, &options, timings)?;
+            let normals = if normals_here { cloud.normals() } else { None };
+            if !keep_attributes {
+                cloud.attributes = Vec::new();
+            }
+            Ok(Input {
+                cloud,
+                normals,
+                truth: None,
+                name: input.display().to_string(),
+            })
         }
         None => {
             let scene = timings.phase("synth", || SceneOptions::polyhedron().seed(1).generate())?;
@@ -321,7 +360,12 @@ fn read_cloud(
                 points: scene.points.clone(),
                 ..PointCloud::default()
             };
-            Ok((cloud, Some(scene), name))
+            Ok(Input {
+                cloud,
+                normals: None,
+                truth: Some(scene),
+                name,
+            })
         }
     }
 }
@@ -332,6 +376,7 @@ fn read_cloud(
 fn detect_points<'a>(
     args: &DetectArgs,
     points: &[[f64; 3]],
+    normals: Option<&[[f64; 3]]>,
     example: bool,
     timings: &mut Timings,
 ) -> Result<(Detector<'a>, Detection, f64), CliError> {
@@ -340,7 +385,7 @@ fn detect_points<'a>(
         None => CliError::msg(e.to_string()),
     };
     let start = Instant::now();
-    let detector = timings.phase("estimate", || detector(args, points, example))?;
+    let detector = timings.phase("estimate", || detector(args, points, normals, example))?;
     let n_orient = detector.orientation_count().map_err(|e| {
         let flags = match args.sampler {
             Some(SamplerKind::Fibonacci) => format!("--step {}", args.step),
@@ -502,7 +547,12 @@ fn write_report_and_views(
 pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
     let example = args.input.is_none();
     let paths = OutputPaths::prepare(args, example)?;
-    let (cloud, truth, name) = read_cloud(args, &paths, timings)?;
+    let Input {
+        cloud,
+        normals,
+        truth,
+        name,
+    } = read_cloud(args, &paths, timings)?;
     // --background-classes: the detection runs on the other points; ids
     // and meshes are mapped back to the input's points.
     let keep = match &args.input {
@@ -513,9 +563,14 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
         .as_ref()
         .map(|k| k.iter().map(|&i| cloud.points[i as usize]).collect());
     let points: &[[f64; 3]] = subset.as_deref().unwrap_or(&cloud.points);
+    let normals: Option<Vec<[f64; 3]>> = match (normals, &keep) {
+        (Some(n), Some(k)) => Some(k.iter().map(|&i| n[i as usize]).collect()),
+        (n, _) => n,
+    };
     let keep = keep.as_deref();
     let n_input = cloud.points.len();
-    let (detector, det, seconds) = detect_points(args, points, example, timings)?;
+    let (detector, det, seconds) =
+        detect_points(args, points, normals.as_deref(), example, timings)?;
 
     let run = Outcome {
         cloud: &cloud,
@@ -696,6 +751,12 @@ fn summary(
             "  orientations from the data: {} mode(s) of the local {}s, each with its own alpha and lambda (see --report)\n",
             modes.len(),
             if d.kind() == StructureKind::Planes { "normal" } else { "direction" }
+        ));
+    }
+    if let (StructureKind::Planes, Some(n)) = (d.kind(), d.normals_given()) {
+        o.push_str(&format!(
+            "  normals: the input's ({n} of {} usable; --ignore-normals to estimate them): a point joins a plane only if its normal is within 36.9 degrees of the plane's\n",
+            det.labels.len()
         ));
     }
     o.push_str(&format!(

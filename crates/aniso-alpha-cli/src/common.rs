@@ -259,6 +259,16 @@ pub fn read_input(
     Ok(cloud)
 }
 
+/// The format an input path will be read as (`--format`, or by
+/// extension), if known.
+pub fn input_format(path: &Path) -> Option<aio::Format> {
+    let options = ReadOptions {
+        format: FORMAT.get().copied(),
+        ..ReadOptions::default()
+    };
+    aio::Format::resolve(path, &options).ok()
+}
+
 /// How an input path is named in messages (`-` is standard input).
 pub fn display_input(path: &Path) -> String {
     if aio::is_stdin(path) {

@@ -546,3 +546,72 @@ fn detect_tile_gives_the_untiled_labels() {
     assert!(whole.0.lines().any(|l| l != "-1"), "no structure found");
     assert_eq!(run(Some("15"), "tiled"), whole);
 }
+
+#[test]
+fn detect_uses_the_inputs_normals() {
+    // A PLY wall z = 0 with `nx ny nz` and, on it, 100 points of a window
+    // frame's sides within 1 cm of the wall but facing along x. `detect`
+    // reads the normals: the frame's points stay out of the wall's part,
+    // and the report says where the normals came from. With
+    // `--ignore-normals` they join it (the check can fail).
+    let dir = TempDir::new("e2e", "normals");
+    let mut rng = SplitMix64::new(5);
+    let mut rows = Vec::new();
+    for i in 0..60 {
+        for j in 0..60 {
+            let x = i as f64 * 0.1 + 0.02 * (rng.uniform() - 0.5);
+            let y = j as f64 * 0.1 + 0.02 * (rng.uniform() - 0.5);
+            rows.push(format!("{x} {y} {} 0 0 1", 0.01 * (rng.uniform() - 0.5)));
+        }
+    }
+    for k in 0..100 {
+        let x = 3.0 + if k % 2 == 0 { -0.01 } else { 0.01 };
+        let y = 1.0 + 4.0 * rng.uniform();
+        rows.push(format!("{x} {y} {} 1 0 0", 0.015 * (rng.uniform() - 0.5)));
+    }
+    let ply = format!(
+        "ply\nformat ascii 1.0\nelement vertex {}\nproperty double x\nproperty double y\n\
+         property double z\nproperty float nx\nproperty float ny\nproperty float nz\nend_header\n{}\n",
+        rows.len(),
+        rows.join("\n")
+    );
+    let input = dir.file("wall.ply", ply.as_bytes());
+    let run = |extra: &[&str], name: &str| {
+        let (parts, report) = (
+            dir.path(&format!("{name}.parts")),
+            dir.path(&format!("{name}.json")),
+        );
+        let mut args = vec![
+            "detect",
+            input.to_str().unwrap(),
+            "--structure",
+            "planes",
+            "--part-labels",
+            parts.to_str().unwrap(),
+            "--report",
+            report.to_str().unwrap(),
+            "--quiet",
+        ];
+        args.extend(extra);
+        ok(&args);
+        let parts: Vec<i64> = std::fs::read_to_string(parts)
+            .unwrap()
+            .lines()
+            .map(|l| l.parse().unwrap())
+            .collect();
+        let report: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(report).unwrap()).unwrap();
+        // The wall's part: the first wall point's; the frame points in it.
+        let wall = parts[0];
+        assert!(wall >= 0);
+        assert!(parts[..3600].iter().filter(|&&p| p == wall).count() >= 3550);
+        let frame_in = parts[3600..].iter().filter(|&&p| p == wall).count();
+        (frame_in, report["parameters"]["normals"]["source"].clone())
+    };
+    let (frame_in, source) = run(&[], "with");
+    assert_eq!(frame_in, 0);
+    assert_eq!(source, "input");
+    let (frame_in, source) = run(&["--ignore-normals"], "without");
+    assert!(frame_in >= 80, "{frame_in}");
+    assert_eq!(source, "estimated");
+}

@@ -175,16 +175,29 @@ impl Params {
 /// CLI's explicit run (the paper's box sampler; lambda2 of planes defaults
 /// to lambda3); otherwise parameters and orientations from the data, the
 /// given ones kept ([`Detector::auto`]).
-pub(crate) fn detector_for(p: &Params, pts: &[[f64; 3]]) -> PyResult<Detector<'static>> {
+pub(crate) fn detector_for(
+    p: &Params,
+    pts: &[[f64; 3]],
+    normals: Option<&[[f64; 3]]>,
+) -> PyResult<Detector<'static>> {
     let g = &p.given;
     Ok(match (g.alpha, g.lambda3, g.min_size) {
-        (Some(alpha), Some(lambda3), Some(min_size)) => match p.kind {
-            StructureKind::Planes => {
-                Detector::planes(alpha, g.lambda2.unwrap_or(lambda3), lambda3, min_size)
+        (Some(alpha), Some(lambda3), Some(min_size)) => {
+            let d = match p.kind {
+                StructureKind::Planes => {
+                    Detector::planes(alpha, g.lambda2.unwrap_or(lambda3), lambda3, min_size)
+                }
+                StructureKind::Lines => Detector::lines(alpha, lambda3, min_size),
+            };
+            match normals {
+                Some(n) => d.normals(n),
+                None => d,
             }
-            StructureKind::Lines => Detector::lines(alpha, lambda3, min_size),
+        }
+        _ => match normals {
+            Some(n) => Detector::auto_oriented(p.kind, pts, n, g, 12).map_err(value_error)?,
+            None => Detector::auto(p.kind, pts, g).map_err(value_error)?,
         },
-        _ => Detector::auto(p.kind, pts, g).map_err(value_error)?,
     })
 }
 
@@ -193,7 +206,7 @@ pub(crate) fn detector_for(p: &Params, pts: &[[f64; 3]]) -> PyResult<Detector<'s
 /// paper's box sampler); otherwise [`Detector::auto`] estimates what is
 /// missing and scans the data orientation set.
 #[pyfunction]
-#[pyo3(signature = (points, structure, alpha = None, lambda2 = None, lambda3 = None, min_size = None, threads = None))]
+#[pyo3(signature = (points, structure, alpha = None, lambda2 = None, lambda3 = None, min_size = None, threads = None, normals = None))]
 #[allow(clippy::too_many_arguments)]
 fn detect<'py>(
     py: Python<'py>,
@@ -204,16 +217,21 @@ fn detect<'py>(
     lambda3: Option<f64>,
     min_size: Option<i64>,
     threads: Option<i64>,
+    normals: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<DetectOut<'py>> {
     let params = Params::new(structure, alpha, lambda2, lambda3, min_size)?;
     let points = Points::extract(points)?;
+    let normals = normals
+        .map(|n| Points::extract(n).map_err(|e| PyValueError::new_err(format!("normals: {e}"))))
+        .transpose()?;
     let threads = thread_count(threads)?;
     let pts = points.as_slice();
+    let normals = normals.as_ref().map(|n| n.as_slice());
     // The whole call (estimation included) runs on the pool of `detached`,
     // which the library's parallel loops use: no `Detector::threads`, which
     // would start a second pool.
     let (labels, parts, json) = detached(py, threads, |_| {
-        let detector = detector_for(&params, pts)?;
+        let detector = detector_for(&params, pts, normals)?;
         let det = detector.run(pts).map_err(value_error)?;
         let json = report::detection_json(&det, &detector);
         let parts = det.part_labels();

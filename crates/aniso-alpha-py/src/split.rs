@@ -47,7 +47,7 @@ pub fn plan(
     let threads = thread_count(threads)?;
     let pts = points.as_slice();
     let plan = detached(py, threads, |_| {
-        let detector = detector_for(&params, pts)?;
+        let detector = detector_for(&params, pts, None)?;
         detector.plan(pts, tile).map_err(value_error)
     })?;
     Ok(PyPlan { plan })

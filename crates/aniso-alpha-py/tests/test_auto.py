@@ -87,3 +87,41 @@ def test_estimation_does_not_depend_on_threads(planes_auto):
     np.testing.assert_array_equal(det.labels, ref.labels)
     np.testing.assert_array_equal(det.part_labels, ref.part_labels)
     assert det.parameters == ref.parameters and det.structures == ref.structures
+
+
+def wall_with_frame():
+    """A wall z = 0 (6 m, a 0.1 m grid, 5 mm of noise) with normals (0, 0, 1)
+    and, on it, 100 points of a window frame's sides within 1 cm of the
+    wall, facing along x; the wall's points come first."""
+    rng = np.random.default_rng(5)
+    g = np.arange(60) * 0.1
+    x, y = (a.ravel() for a in np.meshgrid(g, g))
+    wall = np.c_[x + rng.uniform(-0.01, 0.01, x.size), y + rng.uniform(-0.01, 0.01, x.size), rng.uniform(-0.005, 0.005, x.size)]
+    frame = np.c_[3.0 + np.where(np.arange(100) % 2 == 0, -0.01, 0.01), rng.uniform(1, 5, 100), rng.uniform(-0.0075, 0.0075, 100)]
+    normals = np.r_[np.tile([0.0, 0.0, 1.0], (len(wall), 1)), np.tile([1.0, 0.0, 0.0], (100, 1))]
+    return np.vstack([wall, frame]), normals
+
+
+def test_normals_keep_a_frame_out_of_its_wall():
+    pts, normals = wall_with_frame()
+    n_wall = len(pts) - 100
+
+    def frame_in_wall(det):
+        wall = np.bincount(det.part_labels[:n_wall][det.part_labels[:n_wall] >= 0]).argmax()
+        assert np.sum(det.part_labels[:n_wall] == wall) >= n_wall - 50
+        return int(np.sum(det.part_labels[n_wall:] == wall))
+
+    assert frame_in_wall(aa.detect(pts, "planes", normals=normals)) == 0
+    # Without them, the frame's points are within the wall's claim radius.
+    assert frame_in_wall(aa.detect(pts, "planes")) >= 80
+    # A list of lists works too; the sign of a normal does not matter.
+    det = aa.detect(pts, "planes", normals=(-normals).tolist())
+    assert frame_in_wall(det) == 0
+
+
+def test_normals_of_another_shape_are_a_value_error():
+    pts, normals = wall_with_frame()
+    with pytest.raises(ValueError, match="normals"):
+        aa.detect(pts, "planes", normals=normals[:10])
+    with pytest.raises(ValueError, match="normals"):
+        aa.detect(pts, "planes", normals=normals[:, :2])

@@ -89,6 +89,10 @@ pub fn parameters_json(d: &Detector<'_>) -> Value {
         },
         "elongation": d.elongation().map(num),
         "orientations": orientations,
+        "normals": match (kind, d.normals_given()) {
+            (StructureKind::Planes, Some(n)) => json!({"source": "input", "usable": n}),
+            _ => json!({"source": "estimated"}),
+        },
     });
     if let Some(e) = e {
         v["estimates"] = json!({

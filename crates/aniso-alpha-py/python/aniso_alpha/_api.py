@@ -165,6 +165,14 @@ def alpha_intervals(
         euler: three angles in radians (default 0, 0, 0).
         threads: threads to use (default: all cores); the result does not
             depend on it.
+        normals: optional array-like of shape (n, 3), the points' normals
+            (e.g. a scan's ``nx ny nz``, or Open3D's ``pcd.normals``; the
+            sign does not matter). For planes, a point then joins a plane
+            only if its normal is within 36.9 degrees of the plane's (window
+            frames and ledges stay out of a facade), and the data's
+            orientations come from them. Rows of zeros or NaN are missing
+            normals. Lines ignore them. As ``aniso-alpha detect`` does with
+            a PLY or PCD file that has normals.
 
     Raises:
         ValueError: wrong shape, NaN or infinite coordinates, an elongation
@@ -197,6 +205,7 @@ def detect(
     lambda3: Optional[float] = None,
     min_size: Optional[int] = None,
     threads: Optional[int] = None,
+    normals: Optional[ArrayLike] = None,
 ) -> Detection:
     """Finds lines or planes (and polyhedral surfaces) in ``points`` with
     anisotropic alpha-shapes (Bougleux, Melkemi & Elmoataz 2005), as
@@ -256,7 +265,7 @@ def detect(
     (2, True)
     """
     labels, part_labels, report = _native.detect(
-        points, structure, alpha, lambda2, lambda3, min_size, threads
+        points, structure, alpha, lambda2, lambda3, min_size, threads, normals
     )
     r = json.loads(report)
     return Detection(labels, part_labels, r["structures"], r["parameters"])

@@ -30,6 +30,7 @@ def detect(
     lambda3: Optional[float] = None,
     min_size: Optional[int] = None,
     threads: Optional[int] = None,
+    normals: Optional[ArrayLike] = None,
 ) -> Tuple[NDArray[np.int64], NDArray[np.int64], str]:
     """(labels, part_labels, JSON text of {"structures": [...], "parameters": {...}})."""
 

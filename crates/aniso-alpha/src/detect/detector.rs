@@ -37,7 +37,7 @@ use super::detection::{Detection, RunStats};
 use super::estimate::{Estimate, Given, ModeScan};
 
 use super::assemble::{assemble, Scale, Settings};
-use super::estimate::{estimate, mode_rotations};
+use super::estimate::{estimate, estimate_oriented, mode_rotations};
 use super::filter::{component_size_mask, FilterError};
 use super::orientations::{orientations, OrientationError, Sampler};
 use super::prune::CandidatePairs;
@@ -169,7 +169,30 @@ pub struct Detector<'a> {
     threads: Option<usize>,
     tile: Option<f64>,
     estimate: Option<Box<Estimate>>,
+    normals: Option<Normals>,
     progress: Option<&'a (dyn Fn(usize, usize) -> bool + Sync)>,
+}
+
+/// Normals given with the points, unit length (zero where a point's
+/// normal was missing, zero or not finite), shared by the clones of a
+/// detector.
+pub(crate) type Normals = std::sync::Arc<[[f32; 3]]>;
+
+/// The given normals as unit f32 vectors, [0, 0, 0] where a normal is not
+/// usable (non-finite or of length under 1e-6: files write 0 0 0 for
+/// "unknown").
+fn unit_normals(normals: &[[f64; 3]]) -> Normals {
+    normals
+        .iter()
+        .map(|n| {
+            let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+            if l.is_finite() && l > 1e-6 {
+                [(n[0] / l) as f32, (n[1] / l) as f32, (n[2] / l) as f32]
+            } else {
+                [0.0; 3]
+            }
+        })
+        .collect()
 }
 
 impl fmt::Debug for Detector<'_> {
@@ -184,6 +207,7 @@ impl fmt::Debug for Detector<'_> {
             .field("epsilon", &self.epsilon)
             .field("threads", &self.threads)
             .field("tile", &self.tile)
+            .field("normals", &self.normals.as_ref().map(|n| n.len()))
             .finish()
     }
 }
@@ -206,6 +230,7 @@ impl<'a> Detector<'a> {
             threads: None,
             tile: None,
             estimate: None,
+            normals: None,
             progress: None,
         }
     }
@@ -246,7 +271,42 @@ impl<'a> Detector<'a> {
         given: &Given,
         m2: u32,
     ) -> Result<Self, DetectError> {
+        Self::auto_impl(kind, points, None, given, m2)
+    }
+
+    /// [`Self::auto_with`] for points that come with normals (a scan's
+    /// `nx ny nz`), one per point: planes take each point's given normal
+    /// instead of the one its neighbourhood's PCA would estimate, for the
+    /// modes of the orientation set and their members, and a point joins
+    /// a plane only if its normal agrees with the plane's ([`Self::normals`]).
+    /// A normal of zero length or with a non-finite coordinate counts as
+    /// missing: that point's PCA normal is used, and it joins planes on
+    /// distance alone.
+    ///
+    /// # Errors
+    /// As [`Self::auto`], and a number of normals other than of points.
+    pub fn auto_oriented(
+        kind: StructureKind,
+        points: &[[f64; 3]],
+        normals: &[[f64; 3]],
+        given: &Given,
+        m2: u32,
+    ) -> Result<Self, DetectError> {
+        Self::auto_impl(kind, points, Some(normals), given, m2)
+    }
+
+    fn auto_impl(
+        kind: StructureKind,
+        points: &[[f64; 3]],
+        normals: Option<&[[f64; 3]]>,
+        given: &Given,
+        m2: u32,
+    ) -> Result<Self, DetectError> {
         check_points(points)?;
+        let normals = normals.map(unit_normals);
+        if let Some(n) = &normals {
+            check_normals(n, points.len())?;
+        }
         let probe = Detector {
             alpha: given.alpha.unwrap_or(1.0),
             lambda2: given.lambda2.unwrap_or(1.0),
@@ -255,7 +315,7 @@ impl<'a> Detector<'a> {
             ..Self::lines(1.0, 1.0, 1)
         };
         probe.check_values()?;
-        let e = estimate(kind, points, given, m2);
+        let e = estimate_oriented(kind, points, normals.as_deref(), given, m2);
         if ![e.alpha.value, e.lambda2.value, e.lambda3.value]
             .iter()
             .all(|v| v.is_finite())
@@ -279,7 +339,24 @@ impl<'a> Detector<'a> {
         };
         d.set = OrientationSet::Data(e.modes.clone());
         d.estimate = Some(Box::new(e));
+        d.normals = normals;
         Ok(d)
+    }
+
+    /// Normals given with the points, one per point (a scan's `nx ny nz`;
+    /// the sign does not matter): a point joins a plane only if its normal
+    /// is within 36.9° of the plane's (|n_p · n| ≥ 0.8), as in Efficient
+    /// RANSAC (`normal_threshold`, Easy3D's default; CGAL's is 0.9). Points of
+    /// a window frame or a ledge within a façade's claim radius, whose
+    /// normals are across it, then stay out of the façade. Zero or
+    /// non-finite normals count as missing (the point joins on distance
+    /// alone). Lines ignore normals. [`Self::auto_oriented`] also
+    /// builds the orientation set from them.
+    ///
+    /// [`Self::run`] fails if their number is not the number of points.
+    pub fn normals(mut self, normals: &[[f64; 3]]) -> Self {
+        self.normals = Some(unit_normals(normals));
+        self
     }
 
     /// The orientation sampler (default: the paper's box sampler,
@@ -394,6 +471,14 @@ impl<'a> Detector<'a> {
         &self.set
     }
 
+    /// With normals given ([`Self::normals`], [`Self::auto_oriented`]): how
+    /// many of them are usable (non-zero and finite).
+    pub fn normals_given(&self) -> Option<usize> {
+        self.normals
+            .as_ref()
+            .map(|n| n.iter().filter(|v| **v != [0.0; 3]).count())
+    }
+
     /// What [`Self::auto`] estimated, if it made this detector.
     pub fn estimate(&self) -> Option<&Estimate> {
         self.estimate.as_deref()
@@ -485,6 +570,9 @@ impl<'a> Detector<'a> {
     pub fn run(&self, points: &[[f64; 3]]) -> Result<Detection, DetectError> {
         self.check_values()?;
         check_points(points)?;
+        if let Some(n) = &self.normals {
+            check_normals(n, points.len())?;
+        }
         // Copies of a point are one point to every step (the triangulation
         // keeps one, the assembly labels first occurrences), but the
         // candidate pairs and the scans' point subsets would still visit
@@ -498,6 +586,9 @@ impl<'a> Detector<'a> {
                 .collect();
             let sub: Vec<[f64; 3]> = distinct.iter().map(|&i| points[i as usize]).collect();
             let mut on_distinct = self.clone();
+            if let Some(n) = &self.normals {
+                on_distinct.normals = Some(distinct.iter().map(|&i| n[i as usize]).collect());
+            }
             if let OrientationSet::Data(modes) = &mut on_distinct.set {
                 // The modes' members are input indices (the estimate ran
                 // on the whole cloud): each becomes its position's index
@@ -614,6 +705,7 @@ impl<'a> Detector<'a> {
             threads: self.threads,
             tile: self.tile,
             estimate: self.estimate.clone(),
+            normals: self.normals.clone(),
             progress: None,
         }
     }
@@ -753,6 +845,10 @@ impl<'a> Detector<'a> {
             scales,
             log10_epsilon: self.epsilon.map(f64::log10),
             widen_planes: matches!(self.set, OrientationSet::Data(_)),
+            normals: match self.kind {
+                StructureKind::Planes => self.normals.as_deref(),
+                StructureKind::Lines => None,
+            },
         };
         Ok(assemble::<S>(points, kept, kept_groups, &settings, stats)?.detection)
     }
@@ -838,6 +934,17 @@ fn elongation(kind: StructureKind, lambda2: f64, lambda3: f64) -> [f64; 3] {
 }
 
 /// Input checks: not empty, finite, in the range of exact arithmetic.
+/// One normal per point.
+fn check_normals(normals: &[[f32; 3]], points: usize) -> Result<(), DetectError> {
+    if normals.len() != points {
+        return Err(DetectError::BadParameter(format!(
+            "{} normals for {points} points",
+            normals.len()
+        )));
+    }
+    Ok(())
+}
+
 pub(crate) fn check_points(points: &[[f64; 3]]) -> Result<(), DetectError> {
     if points.is_empty() {
         return Err(DetectError::Empty);

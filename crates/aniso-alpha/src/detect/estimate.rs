@@ -312,7 +312,29 @@ pub fn mode_rotations(
 /// assert!(e.alpha.estimated && e.alpha.value > 0.0);
 /// ```
 pub fn estimate(kind: StructureKind, points: &[[f64; 3]], given: &Given, m2: u32) -> Estimate {
-    let shapes = shapes_for(points, kind);
+    estimate_oriented(kind, points, None, given, m2)
+}
+
+/// [`estimate`] for points with given unit normals (zero where missing):
+/// for planes, each point's axis is its given normal where it has one (the
+/// scan's normals, e.g. from the scanner's geometry or a finer fit than a
+/// 16-neighbour PCA); its spread, spacing and planarity stay those of its
+/// neighbourhood. Lines ignore normals.
+pub fn estimate_oriented(
+    kind: StructureKind,
+    points: &[[f64; 3]],
+    normals: Option<&[[f32; 3]]>,
+    given: &Given,
+    m2: u32,
+) -> Estimate {
+    let mut shapes = shapes_for(points, kind);
+    if let (StructureKind::Planes, Some(normals)) = (kind, normals) {
+        for (s, n) in shapes.iter_mut().zip(normals) {
+            if *n != [0.0; 3] {
+                s.normal = *n;
+            }
+        }
+    }
     let surface = match kind {
         StructureKind::Lines => Some(surface_points(
             &shapes,

@@ -117,6 +117,40 @@ impl std::fmt::Display for ReadWarning {
     }
 }
 
+/// Names under which files store per-point normals, as (x, y, z)
+/// attribute names: PLY's `nx ny nz` (CGAL, Open3D, PCL's PLY writer,
+/// CloudCompare) and PCD's `normal_x normal_y normal_z` (PCL).
+pub const NORMAL_NAMES: [[&str; 3]; 2] = [["nx", "ny", "nz"], ["normal_x", "normal_y", "normal_z"]];
+
+impl PointCloud {
+    /// The points' normals, when the file gives them and they were read
+    /// with [`ReadOptions::attributes`]: the attributes named as in
+    /// [`NORMAL_NAMES`] (case-insensitive), as read (not normalised; a
+    /// file's 0 0 0 for "unknown" stays zero).
+    pub fn normals(&self) -> Option<Vec<[f64; 3]>> {
+        let column = |name: &str| {
+            self.attributes
+                .iter()
+                .find(|a| a.name.eq_ignore_ascii_case(name))
+                .filter(|a| a.values.len() == self.points.len())
+        };
+        NORMAL_NAMES.iter().find_map(|[x, y, z]| {
+            let (x, y, z) = (column(x)?, column(y)?, column(z)?);
+            Some(
+                (0..self.points.len())
+                    .map(|i| {
+                        [
+                            x.values.get_f64(i),
+                            y.values.get_f64(i),
+                            z.values.get_f64(i),
+                        ]
+                    })
+                    .collect(),
+            )
+        })
+    }
+}
+
 /// How to read a point file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct ReadOptions {
