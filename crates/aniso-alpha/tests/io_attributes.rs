@@ -661,3 +661,32 @@ mod las_files {
         }
     }
 }
+
+#[test]
+fn normals_from_ply_and_pcd_attributes() {
+    // PLY's nx ny nz (any case, any numeric type) and PCD's normal_x
+    // normal_y normal_z; a file without them has none, and neither has a
+    // read without attributes.
+    let ply = b"ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n\
+property float z\nproperty double NX\nproperty double NY\nproperty double NZ\nend_header\n\
+0 0 0 0 0 1\n1 0 0 0.6 0.8 0\n";
+    let c = read_points_bytes(Path::new("n.ply"), ply, &WITH_ATTRS).unwrap();
+    assert_eq!(c.normals(), Some(vec![[0.0, 0.0, 1.0], [0.6, 0.8, 0.0]]));
+    let plain = read_points_bytes(Path::new("n.ply"), ply, &ReadOptions::default()).unwrap();
+    assert_eq!(plain.normals(), None);
+    let ascii = "1 2 3 0 1 0 0.25\n4 5 6 1 0 0 0.5\n";
+    let p = pcd(
+        "ascii",
+        "x y z normal_x normal_y normal_z curvature",
+        "4 4 4 4 4 4 4",
+        "F F F F F F F",
+        "1 1 1 1 1 1 1",
+        ascii.as_bytes(),
+    );
+    let c = read_points_bytes(Path::new("n.pcd"), &p, &WITH_ATTRS).unwrap();
+    assert_eq!(c.normals(), Some(vec![[0.0, 1.0, 0.0], [1.0, 0.0, 0.0]]));
+    let no = b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n\
+property float z\nproperty float nx\nend_header\n0 0 0 1\n";
+    let c = read_points_bytes(Path::new("n.ply"), no, &WITH_ATTRS).unwrap();
+    assert_eq!(c.normals(), None);
+}
