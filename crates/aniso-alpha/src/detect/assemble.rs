@@ -1553,6 +1553,23 @@ mod tests {
     }
 
     #[test]
+    fn two_small_patches_at_two_heights_are_not_one_plane() {
+        // Two flat patches a quarter metre across, 10 m apart and 2.5 m
+        // apart in height (the floors of two storeys): the plane fitted to
+        // both tilts 14° and keeps each within τ, so only its angle to the
+        // patches tells them apart. Without the angle test (90°) they would
+        // be one plane.
+        let mut rng = SplitMix64::new(9);
+        let mut pts = Vec::new();
+        let a = piece(&mut pts, &mut rng, (0.0, 0.25), (0.0, 0.25), |_| 0.0);
+        let b = piece(&mut pts, &mut rng, (10.0, 10.25), (0.0, 0.25), |_| 2.5);
+        let (fa, fb) = (fit(&pts, &a), fit(&pts, &b));
+        let (pa, pb) = (as_piece(&fa, &a), as_piece(&fb, &b));
+        assert!(!joint_plane_keeps(pa, pb, 10.0, &pts));
+        assert!(joint_plane_keeps(pa, pb, 90.0, &pts));
+    }
+
+    #[test]
     fn a_wall_set_back_by_five_tau_beside_another_stays_apart() {
         // A façade and a wall 30 cm behind it, side by side: the joint
         // plane lies between them and keeps about half of each.
