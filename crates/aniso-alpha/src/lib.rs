@@ -50,6 +50,7 @@ pub mod detect;
 pub mod eval;
 pub mod geometry;
 pub mod io;
+mod par;
 #[cfg(feature = "json")]
 pub mod report;
 pub mod rng;

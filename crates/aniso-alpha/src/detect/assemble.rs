@@ -39,6 +39,7 @@ use super::significance::{log10_n_tests, part_log10_nfa};
 use super::StructureKind;
 use crate::geometry::kdtree::KdTree;
 use crate::geometry::{dot, sub};
+use crate::par::map_ranges;
 use crate::unionfind::UnionFind;
 
 /// The scale of the candidates found by one group (mode) of orientations.
@@ -123,6 +124,9 @@ fn normal_agreement<'a>(
         })
     }
 }
+
+/// A part's outline polygon (a segment's two ends) and its mesh.
+type PartShape = (Vec<[f64; 3]>, Vec<[u32; 3]>);
 
 /// Ratio of the outer to the inner radius of the shell in which the local
 /// background density around a part is measured.
@@ -856,23 +860,30 @@ pub(crate) fn assemble<S: Face>(
     } else {
         settings.min_vertices
     };
-    let mut cands: Vec<Cand> = Vec::new();
-    for (g, ss) in &comp_simplices {
-        let scale = settings.scales[*g as usize];
-        let local: Vec<S> = ss.iter().map(|&s| kept[s as usize]).collect();
-        for (seeds, fit) in extract(points, &local, scale.tau, seed_min, settings.part_angle_deg) {
-            if let Some(foot) = Footprint::new(&fit, points, &seeds, scale.cell) {
-                cands.push(Cand {
-                    fit,
-                    tau: scale.tau,
-                    cell: scale.cell,
-                    seeds,
-                    foot,
-                });
-            }
-        }
-    }
-    let mut stamp = Stamps::new(n);
+    // Components are independent: extracted in parallel, in order.
+    let per_component = map_ranges(
+        comp_simplices.len(),
+        || (),
+        |_, k| {
+            let (g, ss) = &comp_simplices[k];
+            let scale = settings.scales[*g as usize];
+            let local: Vec<S> = ss.iter().map(|&s| kept[s as usize]).collect();
+            extract(points, &local, scale.tau, seed_min, settings.part_angle_deg)
+                .into_iter()
+                .filter_map(|(seeds, fit)| {
+                    let foot = Footprint::new(&fit, points, &seeds, scale.cell)?;
+                    Some(Cand {
+                        fit,
+                        tau: scale.tau,
+                        cell: scale.cell,
+                        seeds,
+                        foot,
+                    })
+                })
+                .collect::<Vec<Cand>>()
+        },
+    );
+    let mut cands: Vec<Cand> = per_component.into_iter().flatten().collect();
     // 2b. Claim radius from the noise (lines under the test): the radius
     // among CLAIM_RADII·τ whose tube makes the candidate least explicable
     // by chance.
@@ -883,70 +894,85 @@ pub(crate) fn assemble<S: Face>(
         let volume: f64 = (0..3).map(|k| (hi[k] - lo[k]).max(1e-300)).product();
         let rho_global = firsts.len() as f64 / volume;
         let log10_tests = log10_n_tests(firsts.len(), S::K) + (CLAIM_RADII.len() as f64).log10();
-        for c in cands.iter_mut() {
-            let base = c.tau;
-            let planar = matches!(c.fit, Primitive::Plane(_));
-            // A plane whose seeds' RMS is under τ/3 keeps 99% of a
-            // Gaussian spread within τ: nothing for a wider slab to gain.
-            if planar && 3.0 * c.fit.rms() < base {
-                continue;
-            }
-            let vol = near_volume(&c.fit, &c.foot, c.cell, &c.seeds, points);
-            // The radii tried: a wider tube may cost a line at most
-            // MAX_WIDEN_BACKGROUND expected background points.
-            let radii: Vec<f64> = CLAIM_RADII
-                .iter()
-                .enumerate()
-                .take_while(|&(i, &f)| {
-                    planar || i == 0 || rho_global * vol(f * base) <= MAX_WIDEN_BACKGROUND
-                })
-                .map(|(_, &f)| f * base)
-                .collect();
-            // One pass over the points near the candidate, out to the
-            // widest radius's shell; each radius then counts its own.
-            let reach = SHELL_RATIO * radii.last().copied().unwrap_or(base);
-            let mut near = Vec::new();
-            for_near(c, reach, points, &index, &mut stamp, &mut |_, d| {
-                near.push(d)
-            });
-            let mut best = (f64::INFINITY, base);
-            for &r in &radii {
-                let outer = SHELL_RATIO * r;
-                let residuals: Vec<f64> = near.iter().copied().filter(|&d| d <= r).collect();
-                let shell = near.iter().filter(|&&d| d > r && d <= outer).count();
-                let rho_local = (shell as f64 + 1.0) / (vol(outer) - vol(r)).max(1e-300);
-                let nfa = part_log10_nfa(
-                    &residuals,
-                    S::K,
-                    r,
-                    rho_local.max(rho_global),
-                    &vol,
-                    log10_tests,
-                );
-                if nfa < best.0 - WIDEN_GAIN {
-                    best = (nfa, r);
+        // Candidates in parallel, each range of them with its own stamps.
+        let taus = map_ranges(
+            cands.len(),
+            || Stamps::new(n),
+            |stamp, ci| {
+                let c = &cands[ci];
+                let base = c.tau;
+                let planar = matches!(c.fit, Primitive::Plane(_));
+                // A plane whose seeds' RMS is under τ/3 keeps 99% of a
+                // Gaussian spread within τ: nothing for a wider slab to gain.
+                if planar && 3.0 * c.fit.rms() < base {
+                    return base;
                 }
-            }
-            c.tau = best.1;
+                let vol = near_volume(&c.fit, &c.foot, c.cell, &c.seeds, points);
+                // The radii tried: a wider tube may cost a line at most
+                // MAX_WIDEN_BACKGROUND expected background points.
+                let radii: Vec<f64> = CLAIM_RADII
+                    .iter()
+                    .enumerate()
+                    .take_while(|&(i, &f)| {
+                        planar || i == 0 || rho_global * vol(f * base) <= MAX_WIDEN_BACKGROUND
+                    })
+                    .map(|(_, &f)| f * base)
+                    .collect();
+                // One pass over the points near the candidate, out to the
+                // widest radius's shell; each radius then counts its own.
+                let reach = SHELL_RATIO * radii.last().copied().unwrap_or(base);
+                let mut near = Vec::new();
+                for_near(c, reach, points, &index, stamp, &mut |_, d| near.push(d));
+                let mut best = (f64::INFINITY, base);
+                for &r in &radii {
+                    let outer = SHELL_RATIO * r;
+                    let residuals: Vec<f64> = near.iter().copied().filter(|&d| d <= r).collect();
+                    let shell = near.iter().filter(|&&d| d > r && d <= outer).count();
+                    let rho_local = (shell as f64 + 1.0) / (vol(outer) - vol(r)).max(1e-300);
+                    let nfa = part_log10_nfa(
+                        &residuals,
+                        S::K,
+                        r,
+                        rho_local.max(rho_global),
+                        &vol,
+                        log10_tests,
+                    );
+                    if nfa < best.0 - WIDEN_GAIN {
+                        best = (nfa, r);
+                    }
+                }
+                best.1
+            },
+        );
+        for (c, tau) in cands.iter_mut().zip(taus) {
+            c.tau = tau;
         }
     }
     // 3. Members: claims, merging of duplicates, resolution, refit, claims
     // again.
-    let claims_of = |cands: &[Cand], stamp: &mut Stamps| -> Vec<(u32, u32, f64)> {
-        // (point, candidate, distance)
-        let mut claims = Vec::new();
-        for (ci, c) in cands.iter().enumerate() {
-            let agrees = normal_agreement(&c.fit, settings.normals);
-            for_near(c, c.tau, points, &index, stamp, &mut |i, d| {
-                if agrees(i) {
-                    claims.push((i, ci as u32, d));
-                }
-            });
-        }
+    // (point, candidate, distance) of every claim; candidates in parallel,
+    // each range of them with its own stamps.
+    let claims_of = |cands: &[Cand]| -> Vec<(u32, u32, f64)> {
+        let per_cand = map_ranges(
+            cands.len(),
+            || Stamps::new(n),
+            |stamp, ci| {
+                let c = &cands[ci];
+                let agrees = normal_agreement(&c.fit, settings.normals);
+                let mut claims = Vec::new();
+                for_near(c, c.tau, points, &index, stamp, &mut |i, d| {
+                    if agrees(i) {
+                        claims.push((i, ci as u32, d));
+                    }
+                });
+                claims
+            },
+        );
+        let mut claims: Vec<(u32, u32, f64)> = per_cand.into_iter().flatten().collect();
         claims.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.cmp(&b.1)));
         claims
     };
-    let mut claims = claims_of(&cands, &mut stamp);
+    let mut claims = claims_of(&cands);
     // Merge candidates that are one primitive and share claimed points.
     loop {
         let mut uf = UnionFind::new(cands.len());
@@ -1016,7 +1042,7 @@ pub(crate) fn assemble<S: Face>(
             }
         }
         cands = next;
-        claims = claims_of(&cands, &mut stamp);
+        claims = claims_of(&cands);
     }
     let resolve = |claims: &[(u32, u32, f64)], nc: usize| -> Vec<Vec<u32>> {
         let mut members: Vec<Vec<u32>> = vec![Vec::new(); nc];
@@ -1048,7 +1074,7 @@ pub(crate) fn assemble<S: Face>(
             }
         }
     }
-    let claims = claims_of(&cands, &mut stamp);
+    let claims = claims_of(&cands);
     let members = resolve(&claims, cands.len());
     // Final parts: refit on members, drop the small ones.
     struct P {
@@ -1083,59 +1109,70 @@ pub(crate) fn assemble<S: Face>(
         let volume: f64 = (0..3).map(|k| (hi[k] - lo[k]).max(1e-300)).product();
         let rho_global = firsts.len().saturating_sub(in_parts) as f64 / volume;
         let log10_tests = log10_n_tests(firsts.len(), S::K);
-        for p in parts.iter_mut() {
-            let c = &cands[p.cand];
-            let residuals: Vec<f64> = p
-                .members
-                .iter()
-                .map(|&v| p.fit.distance(&points[v as usize]))
-                .collect();
-            let thick = residuals.iter().copied().fold(0.0, f64::max);
-            let tau = c.tau.max(thick);
-            // Footprint extent from the members (cells they occupy).
-            let foot = Footprint::new(&p.fit, points, &p.members, c.cell);
-            let Some(foot) = foot else { continue };
-            let vol = near_volume(&p.fit, &foot, c.cell, &p.members, points);
-            // Local density in the shell (τ, 4τ] over the footprint.
-            let outer = SHELL_RATIO * tau;
-            let probe = Cand {
-                fit: p.fit.clone(),
-                tau: outer,
-                cell: c.cell,
-                seeds: Vec::new(),
-                foot,
-            };
-            let mut shell = 0usize;
-            for_near(&probe, outer, points, &index, &mut stamp, &mut |_, d| {
-                if d > tau {
-                    shell += 1;
-                }
-            });
-            let rho_local = (shell as f64 + 1.0) / (vol(outer) - vol(tau)).max(1e-300);
-            let rho = rho_local.max(rho_global);
-            // The least-squares fit of a clean structure is pulled off it
-            // by the few background points its claim radius takes in (at
-            // 10× the paper's density, a wall of 20 exact points fits
-            // with an RMS of 0.3 α and its thin widths miss it). So the
-            // fit on the better half of the members (at least k + 2) is
-            // tried too, and the better of the two NFAs kept (two
-            // primitives per part: one more factor 2 in the tests).
-            let mut order: Vec<usize> = (0..residuals.len()).collect();
-            order.sort_unstable_by(|&a, &b| residuals[a].total_cmp(&residuals[b]));
-            let half = residuals.len().div_ceil(2).max(S::K + 2);
-            let core: Vec<u32> = order.iter().take(half).map(|&i| p.members[i]).collect();
-            let tests = log10_tests + std::f64::consts::LOG10_2;
-            let mut nfa = part_log10_nfa(&residuals, S::K, tau, rho, &vol, tests);
-            let core_fit = S::fit(points, &core);
-            if !matches!(core_fit, Primitive::None) {
-                let core_res: Vec<f64> = p
+        // Parts in parallel, each range of them with its own stamps.
+        let nfas = map_ranges(
+            parts.len(),
+            || Stamps::new(n),
+            |stamp, pi| -> Option<f64> {
+                let p = &parts[pi];
+                let c = &cands[p.cand];
+                let residuals: Vec<f64> = p
                     .members
                     .iter()
-                    .map(|&v| core_fit.distance(&points[v as usize]))
+                    .map(|&v| p.fit.distance(&points[v as usize]))
                     .collect();
-                nfa = nfa.min(part_log10_nfa(&core_res, S::K, tau, rho, &vol, tests));
+                let thick = residuals.iter().copied().fold(0.0, f64::max);
+                let tau = c.tau.max(thick);
+                // Footprint extent from the members (cells they occupy).
+                let foot = Footprint::new(&p.fit, points, &p.members, c.cell);
+                let foot = foot?;
+                let vol = near_volume(&p.fit, &foot, c.cell, &p.members, points);
+                // Local density in the shell (τ, 4τ] over the footprint.
+                let outer = SHELL_RATIO * tau;
+                let probe = Cand {
+                    fit: p.fit.clone(),
+                    tau: outer,
+                    cell: c.cell,
+                    seeds: Vec::new(),
+                    foot,
+                };
+                let mut shell = 0usize;
+                for_near(&probe, outer, points, &index, stamp, &mut |_, d| {
+                    if d > tau {
+                        shell += 1;
+                    }
+                });
+                let rho_local = (shell as f64 + 1.0) / (vol(outer) - vol(tau)).max(1e-300);
+                let rho = rho_local.max(rho_global);
+                // The least-squares fit of a clean structure is pulled off it
+                // by the few background points its claim radius takes in (at
+                // 10× the paper's density, a wall of 20 exact points fits
+                // with an RMS of 0.3 α and its thin widths miss it). So the
+                // fit on the better half of the members (at least k + 2) is
+                // tried too, and the better of the two NFAs kept (two
+                // primitives per part: one more factor 2 in the tests).
+                let mut order: Vec<usize> = (0..residuals.len()).collect();
+                order.sort_unstable_by(|&a, &b| residuals[a].total_cmp(&residuals[b]));
+                let half = residuals.len().div_ceil(2).max(S::K + 2);
+                let core: Vec<u32> = order.iter().take(half).map(|&i| p.members[i]).collect();
+                let tests = log10_tests + std::f64::consts::LOG10_2;
+                let mut nfa = part_log10_nfa(&residuals, S::K, tau, rho, &vol, tests);
+                let core_fit = S::fit(points, &core);
+                if !matches!(core_fit, Primitive::None) {
+                    let core_res: Vec<f64> = p
+                        .members
+                        .iter()
+                        .map(|&v| core_fit.distance(&points[v as usize]))
+                        .collect();
+                    nfa = nfa.min(part_log10_nfa(&core_res, S::K, tau, rho, &vol, tests));
+                }
+                Some(nfa)
+            },
+        );
+        for (p, nfa) in parts.iter_mut().zip(nfas) {
+            if let Some(nfa) = nfa {
+                p.log10_nfa = nfa;
             }
-            p.log10_nfa = nfa;
         }
         let before = parts.len();
         parts.retain(|p| p.log10_nfa <= log_eps);
@@ -1370,6 +1407,32 @@ pub(crate) fn assemble<S: Face>(
         })
         .collect();
     groups.sort_unstable_by(|a, b| b.0.cmp(&a.0).then(a.1.cmp(&b.1)));
+    // Each part's outline and mesh (a plane's 2D α-shape; a line's
+    // segment), the parts in parallel.
+    let mut shapes: Vec<PartShape> = map_ranges(
+        parts.len(),
+        || (),
+        |_, pi| {
+            let p = &parts[pi];
+            match &p.fit {
+                Primitive::Plane(f) => {
+                    let o = outline(points, &p.members, f, cands[p.cand].cell);
+                    (o.polygon, o.triangles)
+                }
+                Primitive::Line(f) => {
+                    let (mut t0, mut t1) = (f64::INFINITY, f64::NEG_INFINITY);
+                    for &v in &p.members {
+                        let t = dot(sub(points[v as usize], f.centroid), f.direction);
+                        t0 = t0.min(t);
+                        t1 = t1.max(t);
+                    }
+                    let at = |t: f64| [0, 1, 2].map(|k| f.centroid[k] + t * f.direction[k]);
+                    (vec![at(t0), at(t1)], Vec::new())
+                }
+                Primitive::None => (Vec::new(), Vec::new()),
+            }
+        },
+    );
     // Point → structure and part (global part numbering as in the report).
     let mut vstruct = vec![u32::MAX; n];
     let mut vpart = vec![u32::MAX; n];
@@ -1386,24 +1449,7 @@ pub(crate) fn assemble<S: Face>(
         let mut sparts: Vec<Part> = Vec::with_capacity(ps.len());
         for &pi in &ps {
             let p = &parts[pi as usize];
-            let c = &cands[p.cand];
-            let (outline_pts, mesh) = match &p.fit {
-                Primitive::Plane(f) => {
-                    let o = outline(points, &p.members, f, c.cell);
-                    (o.polygon, o.triangles)
-                }
-                Primitive::Line(f) => {
-                    let (mut t0, mut t1) = (f64::INFINITY, f64::NEG_INFINITY);
-                    for &v in &p.members {
-                        let t = dot(sub(points[v as usize], f.centroid), f.direction);
-                        t0 = t0.min(t);
-                        t1 = t1.max(t);
-                    }
-                    let at = |t: f64| [0, 1, 2].map(|k| f.centroid[k] + t * f.direction[k]);
-                    (vec![at(t0), at(t1)], Vec::new())
-                }
-                Primitive::None => (Vec::new(), Vec::new()),
-            };
+            let (outline_pts, mesh) = std::mem::take(&mut shapes[pi as usize]);
             sparts.push(Part {
                 simplices: Vec::new(),
                 vertices: p.members.clone(),
