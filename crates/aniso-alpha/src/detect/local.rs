@@ -329,7 +329,11 @@ pub fn local_shapes(points: &[[f64; 3]], kind: StructureKind) -> Vec<LocalShape>
             }));
         }
     }
-    map_points(n, |nb, i| {
+    // The points in tree order (each query then starts where the last one
+    // ended, in the cache), the results put back in input order.
+    let order = trees[0].order();
+    let in_tree_order = map_points(order.len(), |nb, t| {
+        let i = order[t] as usize;
         let q = &points[i];
         trees[0].nearest(q, NEIGHBOURS, nb);
         let spacing = nb
@@ -369,7 +373,12 @@ pub fn local_shapes(points: &[[f64; 3]], kind: StructureKind) -> Vec<LocalShape>
             }
         }
         best
-    })
+    });
+    let mut shapes = in_tree_order.clone();
+    for (t, &i) in order.iter().enumerate() {
+        shapes[i as usize] = in_tree_order[t];
+    }
+    shapes
 }
 
 #[cfg(test)]

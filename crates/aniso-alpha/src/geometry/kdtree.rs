@@ -137,6 +137,13 @@ impl KdTree {
         self.ids.is_empty()
     }
 
+    /// The indices of the tree's points in tree order: points close in
+    /// this order are close in space, so queries made in it reuse the
+    /// same nodes from the cache.
+    pub fn order(&self) -> &[u32] {
+        &self.ids
+    }
+
     fn is_leaf(&self, node: usize) -> bool {
         let c = 2 * node + 1;
         c >= self.range.len() || self.range[c] == (0, 0)
