@@ -101,8 +101,8 @@ pub fn outline(points: &[[f64; 3]], ids: &[u32], plane: &PlaneFit, r: f64) -> Ou
     // radius doubles until one is kept, up to the convex hull (r = ∞), so
     // every planar part of three non-collinear points has an outline.
     let mut triangles: Vec<[u32; 3]> = Vec::new();
-    let mut edges: Vec<(u32, u32)> = Vec::new(); // directed, of kept triangles
-    let mut pos: Vec<(u32, Point2<f64>)> = Vec::new();
+    // Per face index of the triangulation: kept.
+    let mut kept = vec![false; tri.num_all_faces()];
     let mut r2 = r * r;
     for attempt in 0..=OUTLINE_DOUBLINGS {
         if attempt == OUTLINE_DOUBLINGS {
@@ -112,10 +112,8 @@ pub fn outline(points: &[[f64; 3]], ids: &[u32], plane: &PlaneFit, r: f64) -> Ou
             let [a, b, cc] = f.vertices();
             let (pa, pb, pc) = (a.data().p, b.data().p, cc.data().p);
             if circumradius2(pa, pb, pc) <= r2 {
-                let t = [a.data().id, b.data().id, cc.data().id];
-                triangles.push(t);
-                edges.extend([(t[0], t[1]), (t[1], t[2]), (t[2], t[0])]);
-                pos.extend([(t[0], pa), (t[1], pb), (t[2], pc)]);
+                kept[f.fix().index()] = true;
+                triangles.push([a.data().id, b.data().id, cc.data().id]);
             }
         }
         if !triangles.is_empty() {
@@ -124,23 +122,29 @@ pub fn outline(points: &[[f64; 3]], ids: &[u32], plane: &PlaneFit, r: f64) -> Ou
         r2 *= 4.0;
     }
     triangles.sort_unstable();
-    pos.sort_by_key(|x| x.0);
-    pos.dedup_by_key(|x| x.0);
-    // Boundary: directed edges whose reverse is not an edge.
-    edges.sort_unstable();
-    let boundary: Vec<(u32, u32)> = edges
-        .iter()
-        .copied()
-        .filter(|&(a, b)| edges.binary_search(&(b, a)).is_err())
-        .collect();
+    // Boundary: the directed edges of kept triangles whose other side is
+    // not kept (another face or the outer one), read off the
+    // triangulation's topology in one pass; with the position of their
+    // first vertex. Sorted, they are few (the outline's length).
+    let mut edges: Vec<(u32, u32, Point2<f64>)> = Vec::new();
+    for f in tri.inner_faces().filter(|f| kept[f.fix().index()]) {
+        for e in f.adjacent_edges() {
+            let other = e.rev().face();
+            if !other.as_inner().is_some_and(|g| kept[g.fix().index()]) {
+                edges.push((e.from().data().id, e.to().data().id, e.from().data().p));
+            }
+        }
+    }
+    edges.sort_unstable_by(|x, y| (x.0, x.1).cmp(&(y.0, y.1)));
+    let at = |v: u32| -> Point2<f64> {
+        let k = edges.partition_point(|e| e.0 < v);
+        edges[k].2
+    };
+    let boundary: Vec<(u32, u32)> = edges.iter().map(|e| (e.0, e.1)).collect();
     // Chain into loops: each boundary vertex may start several edges (a
     // pinch); take them in order and mark used.
     let mut used = vec![false; boundary.len()];
     let start_of = |v: u32| boundary.partition_point(|e| e.0 < v);
-    let at = |v: u32| -> Point2<f64> {
-        let k = pos.partition_point(|x| x.0 < v);
-        pos[k].1
-    };
     let mut best: (f64, Vec<u32>) = (0.0, Vec::new());
     for e0 in 0..boundary.len() {
         if used[e0] {
@@ -202,6 +206,75 @@ mod tests {
             a += p[0] * q[1] - q[0] * p[1];
         }
         0.5 * a
+    }
+
+    /// The outline by brute force from the kept triangles: directed edges
+    /// whose reverse is no kept triangle's, chained from the smallest
+    /// (from, to) in order, the loop of largest area (the first on ties).
+    fn brute_outline(points: &[[f64; 3]], o: &Outline) -> Vec<[f64; 3]> {
+        let mut edges: Vec<(u32, u32)> = o
+            .triangles
+            .iter()
+            .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
+            .collect();
+        edges.sort_unstable();
+        let boundary: Vec<(u32, u32)> = edges
+            .iter()
+            .copied()
+            .filter(|&(a, b)| edges.binary_search(&(b, a)).is_err())
+            .collect();
+        let mut used = vec![false; boundary.len()];
+        let mut best: (f64, Vec<u32>) = (0.0, Vec::new());
+        for e0 in 0..boundary.len() {
+            if used[e0] {
+                continue;
+            }
+            let (mut lp, mut e) = (Vec::new(), e0);
+            loop {
+                used[e] = true;
+                lp.push(boundary[e].0);
+                let b = boundary[e].1;
+                match (0..boundary.len()).find(|&k| !used[k] && boundary[k].0 == b) {
+                    Some(k) => e = k,
+                    None => break,
+                }
+            }
+            let poly: Vec<[f64; 3]> = lp.iter().map(|&v| points[v as usize]).collect();
+            let a = area(&poly);
+            if a > best.0 {
+                best = (a, lp);
+            }
+        }
+        best.1.iter().map(|&v| points[v as usize]).collect()
+    }
+
+    #[test]
+    fn outline_equals_the_brute_force_boundary() {
+        // Random points on z = 0 with holes (a disc and a strip left
+        // empty), at several radii: the outline read off the
+        // triangulation's topology is the brute-force loop, vertex for
+        // vertex (the plane's axes may turn the coordinates, so compare
+        // in 2D up to rounding).
+        let mut rng = crate::rng::SplitMix64::new(40);
+        for (n, r) in [(300, 0.6), (2000, 0.3), (2000, 0.15), (5000, 0.1)] {
+            let mut pts = Vec::new();
+            while pts.len() < n {
+                let (x, y) = (10.0 * rng.uniform(), 10.0 * rng.uniform());
+                let hole = (x - 3.0).powi(2) + (y - 3.0).powi(2) < 2.0 || (6.0..6.5).contains(&x);
+                if !hole {
+                    pts.push([x, y, 0.0]);
+                }
+            }
+            let ids: Vec<u32> = (0..pts.len() as u32).collect();
+            let plane = fit_plane_indices(&pts, &ids).unwrap();
+            let o = outline(&pts, &ids, &plane, r);
+            let want = brute_outline(&pts, &o);
+            assert!(want.len() >= 3);
+            assert_eq!(o.polygon.len(), want.len(), "n {n} r {r}");
+            for (p, q) in o.polygon.iter().zip(&want) {
+                assert!((p[0] - q[0]).abs() < 1e-9 && (p[1] - q[1]).abs() < 1e-9);
+            }
+        }
     }
 
     #[test]
