@@ -135,7 +135,7 @@ pub fn outline(points: &[[f64; 3]], ids: &[u32], plane: &PlaneFit, r: f64) -> Ou
             }
         }
     }
-    edges.sort_unstable_by(|x, y| (x.0, x.1).cmp(&(y.0, y.1)));
+    edges.sort_unstable_by_key(|e| (e.0, e.1));
     let at = |v: u32| -> Point2<f64> {
         let k = edges.partition_point(|e| e.0 < v);
         edges[k].2
