@@ -127,3 +127,34 @@ fn a_normal_per_point_or_an_error() {
         Err(DetectError::BadParameter(m)) if m.contains("10 normals")
     ));
 }
+
+#[test]
+fn copies_keep_their_normals() {
+    // The run takes the distinct points (copies get their first
+    // occurrence's labels): the normals must follow them. A copy of every
+    // fifth point, its normal with it, appended: the frame still stays
+    // out of the wall, and every copy is labelled as its original.
+    let (mut points, mut normals, mut frame) = wall_with_frame();
+    let n = points.len();
+    for i in (0..n).step_by(5) {
+        points.push(points[i]);
+        normals.push(normals[i]);
+        frame.push(frame[i]);
+    }
+    let det = Detector::auto_oriented(
+        StructureKind::Planes,
+        &points,
+        &normals,
+        &Given::default(),
+        12,
+    )
+    .unwrap()
+    .run(&points)
+    .unwrap();
+    let (_, frame_in) = frame_points_in_wall(&det, &frame);
+    assert_eq!(frame_in, 0);
+    let parts = det.part_labels();
+    for (k, i) in (0..n).step_by(5).enumerate() {
+        assert_eq!(parts[n + k], parts[i]);
+    }
+}
