@@ -91,7 +91,7 @@ pub struct DetectArgs {
     #[arg(long)]
     pub no_significance: bool,
     /// Estimate every normal from its neighbourhood even when the input
-    /// gives normals (PLY nx ny nz, PCD normal_x normal_y normal_z)
+    /// gives normals (nx ny nz or normal_x normal_y normal_z in a PLY or PCD)
     #[arg(long)]
     pub ignore_normals: bool,
     /// Triangulate in tiles of this side (input units) with halos: bounded
