@@ -171,6 +171,12 @@ impl Params {
     }
 }
 
+/// The normals of a call (an array-like of shape (n, 3)); a `ValueError`
+/// naming them otherwise.
+pub(crate) fn extract_normals<'py>(n: &Bound<'py, PyAny>) -> PyResult<Points<'py>> {
+    Points::extract(n).map_err(|e| PyValueError::new_err(format!("normals: {e}")))
+}
+
 /// The detector of a call: with alpha, lambda3 and min_size all given, the
 /// CLI's explicit run (the paper's box sampler; lambda2 of planes defaults
 /// to lambda3); otherwise parameters and orientations from the data, the
@@ -221,9 +227,7 @@ fn detect<'py>(
 ) -> PyResult<DetectOut<'py>> {
     let params = Params::new(structure, alpha, lambda2, lambda3, min_size)?;
     let points = Points::extract(points)?;
-    let normals = normals
-        .map(|n| Points::extract(n).map_err(|e| PyValueError::new_err(format!("normals: {e}"))))
-        .transpose()?;
+    let normals = normals.map(extract_normals).transpose()?;
     let threads = thread_count(threads)?;
     let pts = points.as_slice();
     let normals = normals.as_ref().map(|n| n.as_slice());

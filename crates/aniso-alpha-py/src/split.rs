@@ -17,7 +17,7 @@ use pyo3::prelude::*;
 use crate::convert::{rows_to_numpy, Points};
 use crate::errors::value_error;
 use crate::run::{detached, thread_count};
-use crate::{detector_for, DetectOut, Params};
+use crate::{detector_for, extract_normals, DetectOut, Params};
 
 /// A split detection run (`aniso_alpha.distributed`); made by [`plan`].
 #[pyclass(frozen, name = "Plan", module = "aniso_alpha._native")]
@@ -29,7 +29,7 @@ pub struct PyPlan {
 /// parameters as `detect` would choose them (estimated from the data when
 /// alpha, lambda3 or min_size is missing), fixed for every tile.
 #[pyfunction]
-#[pyo3(signature = (points, structure, tile, alpha = None, lambda2 = None, lambda3 = None, min_size = None, threads = None))]
+#[pyo3(signature = (points, structure, tile, alpha = None, lambda2 = None, lambda3 = None, min_size = None, threads = None, normals = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn plan(
     py: Python<'_>,
@@ -41,13 +41,16 @@ pub fn plan(
     lambda3: Option<f64>,
     min_size: Option<i64>,
     threads: Option<i64>,
+    normals: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<PyPlan> {
     let params = Params::new(structure, alpha, lambda2, lambda3, min_size)?;
     let points = Points::extract(points)?;
+    let normals = normals.map(extract_normals).transpose()?;
     let threads = thread_count(threads)?;
     let pts = points.as_slice();
+    let normals = normals.as_ref().map(|n| n.as_slice());
     let plan = detached(py, threads, |_| {
-        let detector = detector_for(&params, pts, None)?;
+        let detector = detector_for(&params, pts, normals)?;
         detector.plan(pts, tile).map_err(value_error)
     })?;
     Ok(PyPlan { plan })

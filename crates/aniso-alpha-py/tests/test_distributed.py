@@ -174,3 +174,19 @@ def test_unaligned_points_are_read():
     un[...] = pts
     assert not un.flags.aligned
     np.testing.assert_array_equal(aa.delaunay(un), aa.delaunay(pts))
+
+
+def test_normals_equal_in_process(client):
+    # The scan's normals reach the estimate and the final step of the
+    # tiled run: the same result as aa.detect with them, and not the one
+    # without them (a window frame's sides on a wall, see test_auto).
+    from test_auto import wall_with_frame
+
+    pts, normals = wall_with_frame()
+    ref = aa.detect(pts, "planes", normals=normals)
+    det = distributed.detect(pts, "planes", tile=2.0, client=client, normals=normals)
+    assert_same(det, ref)
+    plain = aa.detect(pts, "planes")
+    assert not np.array_equal(plain.part_labels, ref.part_labels)
+    with pytest.raises(ValueError, match="normals"):
+        distributed.detect(pts, "planes", tile=2.0, client=client, normals=normals[:5])

@@ -75,6 +75,7 @@ def plan(
     lambda3: Optional[float] = None,
     min_size: Optional[int] = None,
     threads: Optional[int] = None,
+    normals: Optional[ArrayLike] = None,
 ) -> Plan:
     """The plan of a split run with tiles of side `tile`."""
 

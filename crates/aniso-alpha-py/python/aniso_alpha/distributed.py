@@ -98,6 +98,14 @@ def _default_tile(points: np.ndarray, halo: float, tiles_wanted: int) -> float:
     return side
 
 
+def _computed(a: Any) -> Any:
+    """A Dask array computed; anything else as it is (the native side
+    checks it)."""
+    if hasattr(a, "compute") and hasattr(a, "chunks"):
+        return a.compute()
+    return a
+
+
 def plan(
     points: ArrayLike,
     structure: str,
@@ -109,6 +117,7 @@ def plan(
     lambda3: Optional[float] = None,
     min_size: Optional[int] = None,
     threads: Optional[int] = None,
+    normals: Optional[ArrayLike] = None,
 ) -> "_native.Plan":
     """The plan of a tiled run over ``points`` (the parameters as
     :func:`aniso_alpha.detect` chooses them, and the tiles): what
@@ -123,7 +132,8 @@ def plan(
     if tile is not None and not (math.isfinite(tile) and tile > 0):
         raise ValueError(f"tile must be positive and finite, got {tile}")
     p = _native.plan(
-        pts, structure, tile if tile is not None else 1.0, alpha, lambda2, lambda3, min_size, threads
+        pts, structure, tile if tile is not None else 1.0, alpha, lambda2, lambda3, min_size, threads,
+        _computed(normals),
     )
     if tile is None:
         p = p.with_tile(_default_tile(pts, p.halo, 4 * max(1, int(workers))))
@@ -167,6 +177,7 @@ def detect(
     min_size: Optional[int] = None,
     threads: Optional[int] = None,
     task_threads: int = 1,
+    normals: Optional[ArrayLike] = None,
 ) -> Detection:
     """Finds lines or planes as :func:`aniso_alpha.detect` does, with the
     triangulations run as Dask tasks, tile by tile.
@@ -190,6 +201,10 @@ def detect(
             process (default: all cores).
         task_threads: threads of each tile task (default 1: Dask runs one
             task per worker thread).
+        normals: the points' normals, shape (n, 3), as
+            :func:`aniso_alpha.detect`'s ``normals`` (an array-like or a
+            Dask array); used on this process, by the estimate and the
+            final step (the tiles' triangulations do not need them).
 
     Returns:
         the :class:`~aniso_alpha.Detection` of :func:`aniso_alpha.detect`
@@ -237,6 +252,7 @@ def detect(
             lambda3=lambda3,
             min_size=min_size,
             threads=threads,
+            normals=normals,
         )
         outputs = _run(client, p, points, task_threads)
         labels, part_labels, report = p.finish(points, outputs, threads)

@@ -516,6 +516,14 @@ impl<'a> Detector<'a> {
         }
     }
 
+    /// One given normal per point, if normals are given.
+    pub(crate) fn check_normals_of(&self, points: &[[f64; 3]]) -> Result<(), DetectError> {
+        match &self.normals {
+            Some(n) => check_normals(n, points.len()),
+            None => Ok(()),
+        }
+    }
+
     pub(crate) fn check_values(&self) -> Result<(), DetectError> {
         let bad = |m: String| Err(DetectError::BadParameter(m));
         if !(self.alpha.is_finite() && self.alpha > 0.0) {
@@ -570,9 +578,7 @@ impl<'a> Detector<'a> {
     pub fn run(&self, points: &[[f64; 3]]) -> Result<Detection, DetectError> {
         self.check_values()?;
         check_points(points)?;
-        if let Some(n) = &self.normals {
-            check_normals(n, points.len())?;
-        }
+        self.check_normals_of(points)?;
         // Copies of a point are one point to every step (the triangulation
         // keeps one, the assembly labels first occurrences), but the
         // candidate pairs and the scans' point subsets would still visit

@@ -165,6 +165,7 @@ impl Detector<'_> {
         self.check_values()?;
         check_points(points)?;
         check_side(side)?;
+        self.check_normals_of(points)?;
         let detector = self.detached();
         let (jobs, _) = detector.scan_jobs()?;
         let halo = jobs.iter().map(halo_width).fold(0.0, f64::max);
