@@ -386,6 +386,12 @@ fn detect_points<'a>(
     };
     let start = Instant::now();
     let detector = timings.phase("estimate", || detector(args, points, normals, example))?;
+    if let Some(g) = detector.given_normals().filter(|g| !g.used) {
+        common::warn(format_args!(
+            "the input's normals disagree with its points: {}",
+            ignored_normals(g.agreement)
+        ));
+    }
     let n_orient = detector.orientation_count().map_err(|e| {
         let flags = match args.sampler {
             Some(SamplerKind::Fibonacci) => format!("--step {}", args.step),
@@ -710,6 +716,15 @@ fn trim(v: f64) -> String {
     }
 }
 
+/// Why the input's normals were not used.
+fn ignored_normals(agreement: f64) -> String {
+    format!(
+        "only {:.0}% of the locally planar points have their given normal within 25 degrees of \
+         their neighbourhood's (at least half must); normals estimated instead",
+        100.0 * agreement
+    )
+}
+
 fn summary(
     name: &str,
     det: &Detection,
@@ -757,6 +772,12 @@ fn summary(
         o.push_str(&format!(
             "  normals: the input's ({n} of {} usable; --ignore-normals to estimate them): a point joins a plane only if its normal is within 36.9 degrees of the plane's\n",
             det.labels.len()
+        ));
+    }
+    if let Some(g) = d.given_normals().filter(|g| !g.used) {
+        o.push_str(&format!(
+            "  normals: the input's were ignored: {}\n",
+            ignored_normals(g.agreement)
         ));
     }
     o.push_str(&format!(

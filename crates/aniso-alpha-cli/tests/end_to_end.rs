@@ -615,3 +615,47 @@ fn detect_uses_the_inputs_normals() {
     assert!(frame_in >= 80, "{frame_in}");
     assert_eq!(source, "estimated");
 }
+
+#[test]
+fn detect_ignores_normals_that_disagree_with_the_points() {
+    // Three perpendicular walls whose PLY gives every point the normal
+    // 0 0 1 (a placeholder): `detect` warns, estimates the normals, and
+    // says so in the report.
+    let dir = TempDir::new("e2e", "bad-normals");
+    let mut rng = SplitMix64::new(6);
+    let mut rows = Vec::new();
+    for i in 1..40 {
+        for j in 1..40 {
+            let (u, v) = (i as f64 * 0.1, j as f64 * 0.1);
+            let mut e = || 0.01 * (rng.uniform() - 0.5);
+            for p in [[u, v, e()], [e(), u, v], [u, e(), v]] {
+                rows.push(format!("{} {} {} 0 0 1", p[0], p[1], p[2]));
+            }
+        }
+    }
+    let ply = format!(
+        "ply\nformat ascii 1.0\nelement vertex {}\nproperty double x\nproperty double y\n\
+         property double z\nproperty float nx\nproperty float ny\nproperty float nz\nend_header\n{}\n",
+        rows.len(),
+        rows.join("\n")
+    );
+    let input = dir.file("corner.ply", ply.as_bytes());
+    let report = dir.path("r.json");
+    let o = ok(&[
+        "detect",
+        input.to_str().unwrap(),
+        "--structure",
+        "planes",
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(stderr.contains("normals disagree"), "{stderr}");
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(report).unwrap()).unwrap();
+    let n = &r["parameters"]["normals"];
+    assert_eq!(n["source"], "estimated");
+    assert_eq!(n["input_ignored"], true);
+    assert!(n["agreement"].as_f64().unwrap() < 0.5);
+    assert!(String::from_utf8_lossy(&o.stdout).contains("normals: the input's were ignored"));
+}

@@ -89,8 +89,17 @@ pub fn parameters_json(d: &Detector<'_>) -> Value {
         },
         "elongation": d.elongation().map(num),
         "orientations": orientations,
-        "normals": match (kind, d.normals_given()) {
-            (StructureKind::Planes, Some(n)) => json!({"source": "input", "usable": n}),
+        "normals": match (kind, d.normals_given(), d.given_normals()) {
+            (StructureKind::Planes, Some(n), g) => json!({
+                "source": "input",
+                "usable": n,
+                "agreement": g.map(|g| num(g.agreement)),
+            }),
+            (StructureKind::Planes, None, Some(g)) => json!({
+                "source": "estimated",
+                "input_ignored": true,
+                "agreement": num(g.agreement),
+            }),
             _ => json!({"source": "estimated"}),
         },
     });

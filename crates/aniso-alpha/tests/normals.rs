@@ -99,7 +99,9 @@ fn missing_normals_change_nothing() {
         })
         .collect();
     let d = Detector::auto_oriented(StructureKind::Planes, &points, &missing, &given, 12).unwrap();
-    assert_eq!(d.normals_given(), Some(0));
+    // None usable: none used.
+    assert_eq!(d.normals_given(), None);
+    assert!(!d.given_normals().unwrap().used);
     assert_eq!(d.run(&points).unwrap(), plain);
 }
 
@@ -157,4 +159,58 @@ fn copies_keep_their_normals() {
     for (k, i) in (0..n).step_by(5).enumerate() {
         assert_eq!(parts[n + k], parts[i]);
     }
+}
+
+/// Three perpendicular 6 m walls (a 0.1 m grid, 5 mm of noise) meeting
+/// at a corner.
+fn corner() -> Vec<[f64; 3]> {
+    let mut rng = SplitMix64::new(31);
+    let mut points = Vec::new();
+    for i in 1..60 {
+        for j in 1..60 {
+            let (u, v) = (i as f64 * 0.1, j as f64 * 0.1);
+            let mut e = || 0.01 * (rng.uniform() - 0.5);
+            points.push([u, v, e()]);
+            points.push([e(), u, v]);
+            points.push([u, e(), v]);
+        }
+    }
+    points
+}
+
+#[test]
+fn normals_that_disagree_with_the_points_are_ignored() {
+    // A placeholder 0 0 1 for every point (a tool's default), and normals
+    // shuffled from one point to another: a third or fewer of the planar
+    // points agree with their neighbourhood, so the normals are not used
+    // and the run is the run without them. The true normals are used.
+    let points = corner();
+    let given = Given::default();
+    let plain = Detector::auto(StructureKind::Planes, &points, &given)
+        .unwrap()
+        .run(&points)
+        .unwrap();
+    assert!(plain.num_parts() >= 2);
+    let placeholder = vec![[0.0, 0.0, 1.0]; points.len()];
+    let truth: Vec<[f64; 3]> = (0..points.len())
+        .map(|i| match i % 3 {
+            0 => [0.0, 0.0, 1.0],
+            1 => [1.0, 0.0, 0.0],
+            _ => [0.0, 1.0, 0.0],
+        })
+        .collect();
+    let shuffled: Vec<[f64; 3]> = (0..points.len())
+        .map(|i| truth[(i + 1) % points.len()])
+        .collect();
+    for bad in [&placeholder, &shuffled] {
+        let d = Detector::auto_oriented(StructureKind::Planes, &points, bad, &given, 12).unwrap();
+        let g = d.given_normals().unwrap();
+        assert!(!g.used && g.agreement < 0.5, "{g:?}");
+        assert_eq!(d.normals_given(), None);
+        assert_eq!(d.run(&points).unwrap(), plain);
+    }
+    let d = Detector::auto_oriented(StructureKind::Planes, &points, &truth, &given, 12).unwrap();
+    let g = d.given_normals().unwrap();
+    assert!(g.used && g.agreement > 0.9, "{g:?}");
+    assert_eq!(d.normals_given(), Some(points.len()));
 }

@@ -34,7 +34,7 @@
 //! ```
 
 use super::detection::{Detection, RunStats};
-use super::estimate::{Estimate, Given, ModeScan};
+use super::estimate::{Estimate, Given, GivenNormals, ModeScan};
 
 use super::assemble::{assemble, Scale, Settings};
 use super::estimate::{estimate, estimate_oriented, mode_rotations};
@@ -170,6 +170,7 @@ pub struct Detector<'a> {
     tile: Option<f64>,
     estimate: Option<Box<Estimate>>,
     normals: Option<Normals>,
+    given_normals: Option<GivenNormals>,
     progress: Option<&'a (dyn Fn(usize, usize) -> bool + Sync)>,
 }
 
@@ -231,6 +232,7 @@ impl<'a> Detector<'a> {
             tile: None,
             estimate: None,
             normals: None,
+            given_normals: None,
             progress: None,
         }
     }
@@ -281,7 +283,10 @@ impl<'a> Detector<'a> {
     /// a plane only if its normal agrees with the plane's ([`Self::normals`]).
     /// A normal of zero length or with a non-finite coordinate counts as
     /// missing: that point's PCA normal is used, and it joins planes on
-    /// distance alone.
+    /// distance alone. Normals that disagree with the points' geometry
+    /// (fewer than half of the locally planar points' within 25° of their
+    /// PCA normal, [`super::estimate::NORMALS_AGREEMENT_MIN`]) are not used
+    /// at all; [`Self::given_normals`] says so.
     ///
     /// # Errors
     /// As [`Self::auto`], and a number of normals other than of points.
@@ -315,7 +320,7 @@ impl<'a> Detector<'a> {
             ..Self::lines(1.0, 1.0, 1)
         };
         probe.check_values()?;
-        let e = estimate_oriented(kind, points, normals.as_deref(), given, m2);
+        let (e, given_normals) = estimate_oriented(kind, points, normals.as_deref(), given, m2);
         if ![e.alpha.value, e.lambda2.value, e.lambda3.value]
             .iter()
             .all(|v| v.is_finite())
@@ -339,7 +344,8 @@ impl<'a> Detector<'a> {
         };
         d.set = OrientationSet::Data(e.modes.clone());
         d.estimate = Some(Box::new(e));
-        d.normals = normals;
+        d.normals = normals.filter(|_| given_normals.is_some_and(|g| g.used));
+        d.given_normals = given_normals;
         Ok(d)
     }
 
@@ -477,6 +483,12 @@ impl<'a> Detector<'a> {
         self.normals
             .as_ref()
             .map(|n| n.iter().filter(|v| **v != [0.0; 3]).count())
+    }
+
+    /// For [`Self::auto_oriented`]: how the given normals agree with the
+    /// points' geometry, and whether they are used (planes only).
+    pub fn given_normals(&self) -> Option<GivenNormals> {
+        self.given_normals
     }
 
     /// What [`Self::auto`] estimated, if it made this detector.
@@ -712,6 +724,7 @@ impl<'a> Detector<'a> {
             tile: self.tile,
             estimate: self.estimate.clone(),
             normals: self.normals.clone(),
+            given_normals: self.given_normals,
             progress: None,
         }
     }

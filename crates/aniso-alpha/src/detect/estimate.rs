@@ -312,28 +312,69 @@ pub fn mode_rotations(
 /// assert!(e.alpha.estimated && e.alpha.value > 0.0);
 /// ```
 pub fn estimate(kind: StructureKind, points: &[[f64; 3]], given: &Given, m2: u32) -> Estimate {
-    estimate_oriented(kind, points, None, given, m2)
+    estimate_oriented(kind, points, None, given, m2).0
+}
+
+/// Share of the locally planar points whose given normal must lie within
+/// [`CONE_DEG`] of their neighbourhood's PCA normal for the given normals
+/// to be used: a majority. Normals that disagree with the points' own
+/// geometry (a tool's placeholder 0 0 1 everywhere, normals of another
+/// cloud, shuffled columns) would drive the modes and the claims wrong.
+/// Measured on the real scans that have normals, against the local shapes'
+/// normals (each point's most planar scale): 74% agree on CGAL's building,
+/// 97% on the ball. Normals that carry no information agree by chance: 9%
+/// for random directions (1 − cos 25°), about a third for one placeholder
+/// direction or shuffled normals on three perpendicular walls
+/// (`tests/normals.rs`).
+pub const NORMALS_AGREEMENT_MIN: f64 = 0.5;
+
+/// How the normals given with the points compare with the points' own
+/// geometry ([`estimate_oriented`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GivenNormals {
+    /// Of the locally planar points with a usable given normal, the share
+    /// whose given normal is within [`CONE_DEG`] of the PCA normal.
+    pub agreement: f64,
+    /// Whether they are used: `agreement` ≥ [`NORMALS_AGREEMENT_MIN`].
+    pub used: bool,
 }
 
 /// [`estimate`] for points with given unit normals (zero where missing):
 /// for planes, each point's axis is its given normal where it has one (the
 /// scan's normals, e.g. from the scanner's geometry or a finer fit than a
 /// 16-neighbour PCA); its spread, spacing and planarity stay those of its
-/// neighbourhood. Lines ignore normals.
+/// neighbourhood. Lines ignore normals. Normals that disagree with the
+/// points' geometry ([`NORMALS_AGREEMENT_MIN`]) are not used; the returned
+/// [`GivenNormals`] says which (`None` without normals, or for lines).
 pub fn estimate_oriented(
     kind: StructureKind,
     points: &[[f64; 3]],
     normals: Option<&[[f32; 3]]>,
     given: &Given,
     m2: u32,
-) -> Estimate {
+) -> (Estimate, Option<GivenNormals>) {
     let mut shapes = shapes_for(points, kind);
+    let mut check = None;
     if let (StructureKind::Planes, Some(normals)) = (kind, normals) {
-        for (s, n) in shapes.iter_mut().zip(normals) {
-            if *n != [0.0; 3] {
-                s.normal = *n;
+        let cos = CONE_DEG.to_radians().cos();
+        let (mut planar, mut agree) = (0usize, 0usize);
+        for (s, n) in shapes.iter().zip(normals) {
+            if *n != [0.0; 3] && s.planarity() >= SCORE_MIN {
+                planar += 1;
+                let d: f32 = (0..3).map(|k| s.normal[k] * n[k]).sum();
+                agree += usize::from(f64::from(d.abs()) >= cos);
             }
         }
+        let agreement = agree as f64 / planar.max(1) as f64;
+        let used = planar > 0 && agreement >= NORMALS_AGREEMENT_MIN;
+        if used {
+            for (s, n) in shapes.iter_mut().zip(normals) {
+                if *n != [0.0; 3] {
+                    s.normal = *n;
+                }
+            }
+        }
+        check = Some(GivenNormals { agreement, used });
     }
     let surface = match kind {
         StructureKind::Lines => Some(surface_points(
@@ -342,7 +383,10 @@ pub fn estimate_oriented(
         )),
         StructureKind::Planes => None,
     };
-    estimate_with(kind, points, &shapes, surface.as_deref(), given, m2)
+    (
+        estimate_with(kind, points, &shapes, surface.as_deref(), given, m2),
+        check,
+    )
 }
 
 /// The points of surfaces, for lines: a point whose neighbourhood, at the

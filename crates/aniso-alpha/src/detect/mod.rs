@@ -34,7 +34,7 @@ mod assemble;
 // (the main ones also at the crate root).
 pub use detection::{Detection, Part, Primitive, RunStats, Structure};
 pub use detector::{DetectError, Detector, Mat3, OrientationSet, LAMBDA_RANGE};
-pub use estimate::{Estimate, Given, ModeScan, Param};
+pub use estimate::{Estimate, Given, GivenNormals, ModeScan, Param};
 pub use split::{Members, Plan, SplitJob, Step, Tile, TileOutput};
 mod detection;
 mod detector;
