@@ -67,8 +67,9 @@ pub(crate) struct Settings<'n> {
     /// Whether a noisy plane's claim radius may widen (step 2b): with the
     /// data's orientations, whose α is the median noise of the cloud.
     pub widen_planes: bool,
-    /// Unit normals given with the points (zero where missing), for planes:
-    /// a point claims a plane only if |n_p · n| ≥ [`NORMAL_AGREEMENT_COS`].
+    /// Unit normals given with the points (zero where missing): a point
+    /// claims a plane only if |n_p · n| ≥ [`NORMAL_AGREEMENT_COS`]; lines
+    /// ignore them ([`normal_agreement`]).
     pub normals: Option<&'n [[f32; 3]]>,
 }
 
@@ -1302,7 +1303,10 @@ pub(crate) fn assemble<S: Face>(
                 groups[uf.find(p as u32) as usize].push(p);
             }
             let mut old: Vec<Option<P>> = parts.drain(..).map(Some).collect();
-            for g in groups.into_iter().filter(|g| !g.is_empty()) {
+            for (root, g) in groups.into_iter().enumerate() {
+                if g.is_empty() {
+                    continue;
+                }
                 if g.len() == 1 {
                     parts.push(old[g[0]].take().expect("each part is in one group"));
                     continue;
@@ -1325,12 +1329,10 @@ pub(crate) fn assemble<S: Face>(
                     .iter()
                     .map(|p| p.log10_nfa)
                     .fold(f64::INFINITY, f64::min);
-                let mut members: Vec<u32> = group
-                    .iter()
-                    .flat_map(|p| p.members.iter().copied())
-                    .collect();
-                members.sort_unstable();
-                let fit = S::fit(points, &members);
+                // The group's members (sorted) and their fit, as the
+                // merging above left them at its root.
+                let members = std::mem::take(&mut group_members[root]);
+                let fit = std::mem::replace(&mut group_fit[root], Primitive::None);
                 if matches!(fit, Primitive::None) {
                     // Not reached (each piece has a plane); the pieces stay.
                     parts.extend(group);

@@ -864,10 +864,7 @@ impl<'a> Detector<'a> {
             scales,
             log10_epsilon: self.epsilon.map(f64::log10),
             widen_planes: matches!(self.set, OrientationSet::Data(_)),
-            normals: match self.kind {
-                StructureKind::Planes => self.normals.as_deref(),
-                StructureKind::Lines => None,
-            },
+            normals: self.normals.as_deref(),
         };
         Ok(assemble::<S>(points, kept, kept_groups, &settings, stats)?.detection)
     }
@@ -952,7 +949,6 @@ fn elongation(kind: StructureKind, lambda2: f64, lambda3: f64) -> [f64; 3] {
     }
 }
 
-/// Input checks: not empty, finite, in the range of exact arithmetic.
 /// One normal per point.
 fn check_normals(normals: &[[f32; 3]], points: usize) -> Result<(), DetectError> {
     if normals.len() != points {
@@ -964,6 +960,7 @@ fn check_normals(normals: &[[f32; 3]], points: usize) -> Result<(), DetectError>
     Ok(())
 }
 
+/// Input checks: not empty, finite, in the range of exact arithmetic.
 pub(crate) fn check_points(points: &[[f64; 3]]) -> Result<(), DetectError> {
     if points.is_empty() {
         return Err(DetectError::Empty);
