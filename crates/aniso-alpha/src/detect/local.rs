@@ -260,21 +260,9 @@ fn to_f32(v: [f64; 3]) -> [f32; 3] {
 }
 
 /// Runs `f` over `0..n` (in parallel with the `parallel` feature), with a
-/// neighbour buffer per worker, and collects in order.
+/// neighbour buffer per worker's range, and collects in order.
 fn map_points<T: Send>(n: usize, f: impl Fn(&mut Vec<(f64, u32)>, usize) -> T + Sync) -> Vec<T> {
-    #[cfg(feature = "parallel")]
-    {
-        use rayon::prelude::*;
-        (0..n)
-            .into_par_iter()
-            .map_init(Vec::new, |nb, i| f(nb, i))
-            .collect()
-    }
-    #[cfg(not(feature = "parallel"))]
-    {
-        let mut nb = Vec::new();
-        (0..n).map(|i| f(&mut nb, i)).collect()
-    }
+    crate::par::map_ranges(n, Vec::new, f)
 }
 
 /// The shape of the neighbourhood `nb` (at least 3 points).
