@@ -65,34 +65,6 @@ pub fn canonical_sorted(tets: impl IntoIterator<Item = [u32; 4]>) -> Vec<[u32; 4
 #[allow(unused_imports)]
 pub use aniso_alpha::rng::SplitMix64 as Rng;
 
-/// A fresh folder `aniso-PREFIX-PID-NAME` in the system's temporary
-/// folder, removed with its content when dropped.
-pub struct TempDir(pub PathBuf);
-
-impl TempDir {
-    pub fn new(prefix: &str, name: &str) -> Self {
-        let d = std::env::temp_dir().join(format!("aniso-{prefix}-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).unwrap();
-        TempDir(d)
-    }
-}
-
-impl std::ops::Deref for TempDir {
-    type Target = std::path::Path;
-    fn deref(&self) -> &std::path::Path {
-        &self.0
-    }
-}
-
-impl AsRef<std::path::Path> for TempDir {
-    fn as_ref(&self) -> &std::path::Path {
-        &self.0
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
+mod tempdir;
+#[allow(unused_imports)]
+pub use tempdir::TempDir;
