@@ -328,8 +328,9 @@ fn read_cloud(
         Some(input) => {
             let keep_attributes = paths.labelled_output || args.background_classes.is_some();
             // PLY and PCD files may carry normals: read their attributes
-            // to find them.
+            // to find them (planes only: lines ignore normals).
             let normals_here = !args.ignore_normals
+                && args.structure != Some(Structure::Lines)
                 && matches!(
                     common::input_format(input),
                     Some(io::Format::Ply | io::Format::Pcd)
