@@ -158,12 +158,12 @@ fn kind_of(s: Structure) -> StructureKind {
 }
 
 /// Builds the detector: the example's, explicit parameters, or estimated.
-fn detector<'a>(
+fn detector(
     args: &DetectArgs,
     points: &[[f64; 3]],
     normals: Option<&[[f64; 3]]>,
     example: bool,
-) -> Result<Detector<'a>, CliError> {
+) -> Result<Detector, CliError> {
     let structure = args.structure.unwrap_or(Structure::Planes);
     let kind = kind_of(structure);
     let m2 = u32::try_from(args.m2).map_err(|_| CliError::msg("--m2 is too large"))?;
@@ -374,13 +374,13 @@ fn read_cloud(
 /// Builds the detector (phase "estimate") and runs it on `points` (phase
 /// "detect") behind a progress bar: the detector, its detection and the
 /// wall seconds of the two.
-fn detect_points<'a>(
+fn detect_points(
     args: &DetectArgs,
     points: &[[f64; 3]],
     normals: Option<&[[f64; 3]]>,
     example: bool,
     timings: &mut Timings,
-) -> Result<(Detector<'a>, Detection, f64), CliError> {
+) -> Result<(Detector, Detection, f64), CliError> {
     let in_file = |e: aniso_alpha::detect::DetectError| match &args.input {
         Some(p) => CliError::in_file(p, e),
         None => CliError::msg(e.to_string()),
@@ -402,12 +402,15 @@ fn detect_points<'a>(
     })?;
     warn_if_huge(points.len(), n_orient);
     let bar = common::progress(n_orient as u64, "orientations");
-    let tick = |done: usize, _total: usize| {
-        bar.set_position(done as u64);
-        true
+    let tick = {
+        let bar = bar.clone();
+        move |done: usize, _total: usize| {
+            bar.set_position(done as u64);
+            true
+        }
     };
     let det = timings
-        .phase("detect", || detector.clone().progress(&tick).run(points))
+        .phase("detect", || detector.clone().progress(tick).run(points))
         .map_err(in_file)?;
     let seconds = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
@@ -494,7 +497,7 @@ fn write_labels_and_meshes(
 fn report_json(
     name: &str,
     det: &Detection,
-    detector: &Detector<'_>,
+    detector: &Detector,
     seconds: f64,
     scores: Option<&Evaluation>,
 ) -> serde_json::Value {
@@ -729,7 +732,7 @@ fn ignored_normals(agreement: f64) -> String {
 fn summary(
     name: &str,
     det: &Detection,
-    d: &Detector<'_>,
+    d: &Detector,
     report: &serde_json::Value,
     seconds: f64,
 ) -> String {

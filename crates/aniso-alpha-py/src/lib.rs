@@ -185,7 +185,7 @@ pub(crate) fn detector_for(
     p: &Params,
     pts: &[[f64; 3]],
     normals: Option<&[[f64; 3]]>,
-) -> PyResult<Detector<'static>> {
+) -> PyResult<Detector> {
     let g = &p.given;
     Ok(match (g.alpha, g.lambda3, g.min_size) {
         (Some(alpha), Some(lambda3), Some(min_size)) => {

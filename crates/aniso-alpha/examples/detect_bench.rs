@@ -11,7 +11,7 @@ use aniso_alpha::eval::evaluate;
 use aniso_alpha::synth::{Scene, SceneOptions};
 use std::time::Instant;
 
-fn row(name: &str, scene: &Scene, det: Detector<'_>) {
+fn row(name: &str, scene: &Scene, det: Detector) {
     let t = Instant::now();
     let d = det.run(&scene.points).expect("detection");
     let s = t.elapsed().as_secs_f64();

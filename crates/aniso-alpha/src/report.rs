@@ -34,7 +34,7 @@ fn param(value: f64, estimated: bool, reason: &str) -> Value {
 
 /// The `parameters` object: every value used, whether it was estimated,
 /// and why.
-pub fn parameters_json(d: &Detector<'_>) -> Value {
+pub fn parameters_json(d: &Detector) -> Value {
     let kind = d.kind();
     let (l2, l3) = d.lambdas();
     let e = d.estimate();
@@ -186,7 +186,7 @@ pub fn structures_json(det: &Detection) -> Value {
 /// The whole report of a run: `parameters`, `orientations`, `stats`,
 /// `structures`, `parts` and `background_points` (the CLI adds the input's
 /// name, times and scores).
-pub fn detection_json(det: &Detection, d: &Detector<'_>) -> Value {
+pub fn detection_json(det: &Detection, d: &Detector) -> Value {
     let s = &det.stats;
     json!({
         "points": det.labels.len(),

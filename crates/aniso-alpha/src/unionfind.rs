@@ -1,6 +1,6 @@
 //! The crate's one union-find (disjoint sets over `0..n` as `u32`), used
 //! by the path filter and connected components ([`crate::detect::filter`]),
-//! the grouping of parts ([`crate::detect::assemble`]) and the optimal α of
+//! the grouping of candidates and parts (`detect::assemble`) and the optimal α of
 //! [`crate::alpha`].
 //!
 //! Which root a union keeps matters to callers that number or store
@@ -82,6 +82,18 @@ impl UnionFind {
         let r = self.find(x) as usize;
         self.size[r]
     }
+
+    /// The sets, indexed by root: the members of each (ascending) at its
+    /// root's index, nothing at the other indices.
+    pub(crate) fn sets(&mut self) -> Vec<Vec<u32>> {
+        let n = self.parent.len();
+        let mut sets: Vec<Vec<u32>> = vec![Vec::new(); n];
+        for x in 0..n as u32 {
+            let r = self.find(x);
+            sets[r as usize].push(x);
+        }
+        sets
+    }
 }
 
 #[cfg(test)]
@@ -101,6 +113,10 @@ mod tests {
         assert!(uf.union_min_root(4, 0)); // roots 4 and 3: 3 wins
         assert_eq!((uf.find(5), uf.size_of(5)), (3, 5));
         assert_eq!((uf.find(2), uf.size_of(2)), (2, 1));
+        assert_eq!(
+            uf.sets(),
+            [vec![], vec![], vec![2], vec![0, 1, 3, 4, 5], vec![], vec![]]
+        );
         uf.reset(2);
         assert_eq!((uf.find(1), uf.size_of(1)), (1, 1));
     }

@@ -159,21 +159,23 @@ fn pruning_is_exact() {
 
 #[test]
 fn progress_and_cancellation() {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::sync::Arc;
     let scene = SceneOptions::lines().seed(1).generate().unwrap();
-    let calls = std::sync::atomic::AtomicUsize::new(0);
-    let cb = |done: usize, total: usize| {
+    let calls = Arc::new(AtomicUsize::new(0));
+    let counter = Arc::clone(&calls);
+    let d = Detector::lines(1.0, 10.0, 4).progress(move |done: usize, total: usize| {
         assert!(done <= total);
-        calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        counter.fetch_add(1, Ordering::Relaxed);
         true
-    };
-    Detector::lines(1.0, 10.0, 4)
-        .progress(&cb)
-        .run(&scene.points)
-        .unwrap();
-    assert_eq!(calls.load(std::sync::atomic::Ordering::Relaxed), 162);
-    let stop = |done: usize, _| done < 5;
+    });
+    d.run(&scene.points).unwrap();
+    assert_eq!(calls.load(Ordering::Relaxed), 162);
+    // Clones share the callback.
+    d.clone().run(&scene.points).unwrap();
+    assert_eq!(calls.load(Ordering::Relaxed), 2 * 162);
     let r = Detector::lines(1.0, 10.0, 4)
-        .progress(&stop)
+        .progress(|done: usize, _| done < 5)
         .run(&scene.points);
     assert_eq!(r, Err(aniso_alpha::detect::DetectError::Cancelled));
 }

@@ -210,25 +210,6 @@ impl Detection {
     }
 }
 
-/// Per point, the index of the first point with the same coordinates
-/// (itself when no earlier point has them).
-pub(crate) fn first_occurrences(points: &[[f64; 3]]) -> Vec<u32> {
-    let mut first: Vec<u32> = (0..points.len() as u32).collect();
-    let mut idx = first.clone();
-    // A stable sort: each run of equal points starts with its first index.
-    idx.sort_by(|&a, &b| {
-        points[a as usize]
-            .partial_cmp(&points[b as usize])
-            .unwrap_or(std::cmp::Ordering::Equal)
-    });
-    for w in idx.windows(2) {
-        if points[w[1] as usize] == points[w[0] as usize] {
-            first[w[1] as usize] = first[w[0] as usize];
-        }
-    }
-    first
-}
-
 /// A point's position as a sort key: its coordinates' bits, −0 taken as 0
 /// (the same point to every step; NaN is refused before).
 pub(crate) fn position_key(p: &[f64; 3]) -> [u64; 3] {

@@ -356,25 +356,15 @@ pub fn estimate_oriented(
     let mut shapes = shapes_for(points, kind);
     let mut check = None;
     if let (StructureKind::Planes, Some(normals)) = (kind, normals) {
-        let cos = CONE_DEG.to_radians().cos();
-        let (mut planar, mut agree) = (0usize, 0usize);
-        for (s, n) in shapes.iter().zip(normals) {
-            if *n != [0.0; 3] && s.planarity() >= SCORE_MIN {
-                planar += 1;
-                let d: f32 = (0..3).map(|k| s.normal[k] * n[k]).sum();
-                agree += usize::from(f64::from(d.abs()) >= cos);
-            }
-        }
-        let agreement = agree as f64 / planar.max(1) as f64;
-        let used = planar > 0 && agreement >= NORMALS_AGREEMENT_MIN;
-        if used {
+        let given = normals_agreement(&shapes, normals);
+        if given.used {
             for (s, n) in shapes.iter_mut().zip(normals) {
                 if *n != [0.0; 3] {
                     s.normal = *n;
                 }
             }
         }
-        check = Some(GivenNormals { agreement, used });
+        check = Some(given);
     }
     let surface = match kind {
         StructureKind::Lines => Some(surface_points(
@@ -387,6 +377,31 @@ pub fn estimate_oriented(
         estimate_with(kind, points, &shapes, surface.as_deref(), given, m2),
         check,
     )
+}
+
+/// How given unit normals (zero where missing) agree with the geometry of
+/// `points`: the check of [`estimate_oriented`], for normals given to a
+/// detector with explicit parameters.
+pub(crate) fn check_normals_agreement(points: &[[f64; 3]], normals: &[[f32; 3]]) -> GivenNormals {
+    normals_agreement(&shapes_for(points, StructureKind::Planes), normals)
+}
+
+/// Of the locally planar points (planarity ≥ [`SCORE_MIN`]) with a usable
+/// given normal, the share whose normal is within [`CONE_DEG`] of their
+/// local shape's, and whether that reaches [`NORMALS_AGREEMENT_MIN`].
+fn normals_agreement(shapes: &[LocalShape], normals: &[[f32; 3]]) -> GivenNormals {
+    let cos = CONE_DEG.to_radians().cos();
+    let (mut planar, mut agree) = (0usize, 0usize);
+    for (s, n) in shapes.iter().zip(normals) {
+        if *n != [0.0; 3] && s.planarity() >= SCORE_MIN {
+            planar += 1;
+            let d: f32 = (0..3).map(|k| s.normal[k] * n[k]).sum();
+            agree += usize::from(f64::from(d.abs()) >= cos);
+        }
+    }
+    let agreement = agree as f64 / planar.max(1) as f64;
+    let used = planar > 0 && agreement >= NORMALS_AGREEMENT_MIN;
+    GivenNormals { agreement, used }
 }
 
 /// The points of surfaces, for lines: a point whose neighbourhood, at the

@@ -1,5 +1,8 @@
-//! Structure detection building blocks (paper §4): orientation sets,
-//! the path filter of non-significant structures, and least-squares fits.
+//! Structure detection (paper §4, docs/method.md §4): [`Detector`] and its
+//! result [`Detection`], the split run of [`Plan`] and [`Step`], and the
+//! building blocks a user may call alone.
+//!
+//! Public building blocks:
 //!
 //! * [`orientations`]: the paper's "box" sampler of rotations and a
 //!   near-uniform Fibonacci alternative (docs/method.md §4);
@@ -7,47 +10,56 @@
 //! * [`fit`]: least-squares lines and planes;
 //! * [`parts`]: splitting structures into straight/flat parts, and point
 //!   labelling;
-//! * [`faces`]: `F_{k,α}` at one α straight from a triangulation;
-//! * [`prune`]: exact removal of points isolated at distance 2α;
+//! * [`significance`]: the a-contrario test's numbers of false alarms;
 //! * [`local`], [`modes`], [`estimate`]: the local shape of the cloud, the
 //!   modes of its normals or directions, and the parameters and data
-//!   orientation set estimated from them (method doc §8);
-//! * `scan`: the orientation scan (per orientation `F_{k,α,Q}`, tiles with
-//!   halos, path filter, union);
-//! * `assemble`: structures and disjoint parts from the union, with
-//!   [`outline`] (outlines and meshes of planar parts) and [`significance`]
-//!   (the a-contrario test);
+//!   orientation set estimated from them (method doc §8).
+//!
+//! The pipeline (private; its types are re-exported here):
+//!
+//! * `detector`: the parameters ([`Detector`], [`DetectError`],
+//!   [`OrientationSet`]) and the run that chains the steps;
+//! * `regime`: the run-wide modes, decided once per run (lines or planes,
+//!   the significance test, orientations from a sampler or the data,
+//!   normals gating the claims);
+//! * `cloud`: what a run knows of its cloud, worked out once (copies, the
+//!   background's volume, the kd-tree of the distinct points);
+//! * `scan`: the orientation scan (per orientation `F_{k,α,Q}` with `faces`
+//!   after `prune`, tiles with halos, the path filter and its thresholds,
+//!   the union);
+//! * `assemble`: structures and disjoint parts from the union, stage by
+//!   stage, with `outline` (outlines and meshes of planar parts);
 //! * `detection`: the result types ([`Detection`], [`Structure`],
 //!   [`Part`], [`Primitive`], [`RunStats`]);
-//! * `detector`: the parameters and the run that chains the steps
-//!   ([`Detector`], [`DetectError`], [`OrientationSet`]);
 //! * `split`: the same run split into per-tile steps that can run
 //!   elsewhere (other processes or machines), and the step that gathers
 //!   them ([`Plan`], [`Step`], [`SplitJob`], [`Members`], [`Tile`],
 //!   [`TileOutput`]).
-//!
-//! The pipeline's modules (`detector`, `detection`, `split`, `scan`,
-//! `assemble`) are private; their types are re-exported here.
 
-mod assemble;
 // The pipeline's types, flat: `aniso_alpha::detect::{Detector, Part, …}`
 // (the main ones also at the crate root).
 pub use detection::{Detection, Part, Primitive, RunStats, Structure};
 pub use detector::{DetectError, Detector, Mat3, OrientationSet, LAMBDA_RANGE};
 pub use estimate::{Estimate, Given, GivenNormals, ModeScan, Param};
+pub use fit::{LineFit, PlaneFit};
+pub use orientations::{OrientationError, Sampler, MAX_ORIENTATIONS};
 pub use split::{Members, Plan, SplitJob, Step, Tile, TileOutput};
+
+mod assemble;
+mod cloud;
 mod detection;
 mod detector;
 pub mod estimate;
-pub mod faces;
+mod faces;
 pub mod filter;
 pub mod fit;
 pub mod local;
 pub mod modes;
 pub mod orientations;
-pub mod outline;
+mod outline;
 pub mod parts;
-pub mod prune;
+mod prune;
+mod regime;
 mod scan;
 pub mod significance;
 mod split;

@@ -18,12 +18,6 @@
 
 /// Marks the points that have another point within distance `radius`
 /// (inclusive). Points are `[f64; 3]` in the metric of interest.
-///
-/// ```
-/// use aniso_alpha::detect::prune::non_isolated;
-/// let p = [[0.0, 0.0, 0.0], [1.5, 0.0, 0.0], [10.0, 0.0, 0.0]];
-/// assert_eq!(non_isolated(&p, 2.0), vec![true, true, false]);
-/// ```
 pub fn non_isolated(points: &[[f64; 3]], radius: f64) -> Vec<bool> {
     let n = points.len();
     let mut keep = vec![false; n];
@@ -185,16 +179,6 @@ impl CandidatePairs {
         Some(CandidatePairs { pairs, n })
     }
 
-    /// Number of candidate pairs.
-    pub fn len(&self) -> usize {
-        self.pairs.len()
-    }
-
-    /// Whether there is no candidate pair.
-    pub fn is_empty(&self) -> bool {
-        self.pairs.is_empty()
-    }
-
     /// [`non_isolated`] in the metric `|Q·(p − q)|` (Q given by its rows),
     /// restricted to the candidate pairs: exact as long as every pair
     /// within `radius` under Q is a candidate.
@@ -288,6 +272,15 @@ impl CandidatePairs {
 mod tests {
     use super::*;
     use crate::rng::SplitMix64;
+
+    #[test]
+    fn a_far_point_is_isolated() {
+        let p = [[0.0, 0.0, 0.0], [1.5, 0.0, 0.0], [10.0, 0.0, 0.0]];
+        assert_eq!(non_isolated(&p, 2.0), vec![true, true, false]);
+        // The radius is inclusive.
+        assert_eq!(non_isolated(&p, 1.5), vec![true, true, false]);
+        assert_eq!(non_isolated(&p, 1.4), vec![false; 3]);
+    }
 
     #[test]
     fn matches_brute_force() {

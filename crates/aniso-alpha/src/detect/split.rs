@@ -50,8 +50,11 @@
 //! # Ok::<(), aniso_alpha::detect::DetectError>(())
 //! ```
 
+use super::assemble::Shape;
+use super::cloud::{Cloud, Copies};
 use super::detection::{Detection, RunStats};
 use super::detector::{check_points, DetectError, Detector, OrientationSet};
+use super::regime::Regime;
 use super::scan::{
     faces_of, filter_job, halo_width, prune_radius, pruned, tile_cell, Face, Job, Pruning,
 };
@@ -146,16 +149,20 @@ pub struct TileOutput {
 /// A detection split into tiles ([`Detector::plan`], module doc).
 #[derive(Debug, Clone)]
 pub struct Plan {
-    detector: Detector<'static>,
+    detector: Detector,
     step: Step,
     halo: f64,
     /// Per group, its members (global ids, ascending), or `None`: every
     /// point, one group.
     groups: Option<Vec<Vec<u32>>>,
     n: usize,
+    /// The run's modes, decided on the plan's cloud.
+    regime: Regime,
+    /// Which points of the plan's cloud are copies.
+    copies: Copies,
 }
 
-impl Detector<'_> {
+impl Detector {
     /// A split run over `points` with tiles of side `side` (module doc):
     /// the parameters and jobs of [`Self::run`], fixed now.
     ///
@@ -166,8 +173,7 @@ impl Detector<'_> {
         check_points(points)?;
         check_side(side)?;
         self.check_normals_of(points)?;
-        let detector = self.detached();
-        let (jobs, _) = detector.scan_jobs()?;
+        let (jobs, _) = self.scan_jobs(self.modes())?;
         let halo = jobs.iter().map(halo_width).fold(0.0, f64::max);
         let jobs: Vec<SplitJob> = jobs
             .iter()
@@ -177,20 +183,22 @@ impl Detector<'_> {
                 group: j.group,
             })
             .collect();
-        let groups = match detector.orientations() {
+        let groups = match self.orientations() {
             OrientationSet::Data(modes) => Some(modes.iter().map(|m| m.points.clone()).collect()),
             _ => None,
         };
         Ok(Plan {
             step: Step {
-                kind: detector.kind(),
+                kind: self.kind(),
                 side,
                 jobs,
             },
-            detector,
+            detector: self.clone(),
             halo,
             groups,
             n: points.len(),
+            regime: self.regime(points),
+            copies: Copies::of(points),
         })
     }
 }
@@ -214,7 +222,7 @@ impl Plan {
     }
 
     /// The detector whose run this is (its parameters, for the report).
-    pub fn detector(&self) -> &Detector<'static> {
+    pub fn detector(&self) -> &Detector {
         &self.detector
     }
 
@@ -251,9 +259,8 @@ impl Plan {
         // only the first occurrence goes to the tiles. The triangulation
         // would keep that one anyway, and `finish` labels every copy by its
         // first occurrence; the copies would only cost the workers time.
-        let first = super::detection::first_occurrences(points);
         for (i, u) in used.iter_mut().enumerate() {
-            *u &= first[i] as usize == i;
+            *u &= self.copies.is_first(i);
         }
         let mut cells: Vec<[i64; 3]> = points
             .iter()
@@ -345,7 +352,7 @@ impl Plan {
         }
     }
 
-    fn finish_k<S: Face>(
+    fn finish_k<S: Shape>(
         &self,
         points: &[[f64; 3]],
         outputs: Vec<TileOutput>,
@@ -366,7 +373,8 @@ impl Plan {
             }
         }
         drop(outputs);
-        let sf = self.detector.scan_filter(points, jobs.len());
+        let cloud = Cloud::new(points, &self.copies);
+        let sf = self.detector.scan_filter(&cloud, &self.regime, jobs.len());
         let one = |(mut faces, job): (Vec<S>, &SplitJob)| -> Result<(usize, Vec<S>), DetectError> {
             faces.sort_unstable();
             faces.dedup();
@@ -392,8 +400,9 @@ impl Plan {
             stats.filtered_simplices += faces.len() as u64;
             found.push((job.group, faces));
         }
-        let (_, scales) = self.detector.scan_jobs()?;
-        self.detector.finish_k(points, found, scales, stats)
+        let (_, scales) = self.detector.scan_jobs(self.detector.modes())?;
+        self.detector
+            .finish_k(&cloud, &self.regime, found, scales, stats, sf)
     }
 }
 
@@ -568,7 +577,7 @@ mod tests {
 
     /// Runs a plan tile by tile, each tile seeing only its own points (as a
     /// remote worker would), in reverse tile order.
-    fn split_run(d: &Detector<'_>, pts: &[[f64; 3]], side: f64) -> (Detection, usize) {
+    fn split_run(d: &Detector, pts: &[[f64; 3]], side: f64) -> (Detection, usize) {
         let plan = d.plan(pts, side).unwrap();
         let tiles = plan.tiles(pts);
         let n_tiles = tiles.len();

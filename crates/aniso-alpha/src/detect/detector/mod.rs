@@ -33,113 +33,25 @@
 //! # Ok::<(), aniso_alpha::detect::DetectError>(())
 //! ```
 
-use super::detection::{Detection, RunStats};
-use super::estimate::{Estimate, Given, GivenNormals, ModeScan};
+mod error;
+mod run;
 
-use super::assemble::{assemble, Scale, Settings};
-use super::estimate::{estimate, estimate_oriented, mode_rotations};
-use super::filter::{component_size_mask, FilterError};
-use super::orientations::{orientations, OrientationError, Sampler};
-use super::prune::CandidatePairs;
-use super::scan::{
-    run_job, union, Face, Job, JobResult, Pruning, ScanError, ScanFilter, RADIUS_SLACK,
-};
+pub use error::DetectError;
+
+use super::estimate::{check_normals_agreement, estimate, estimate_oriented, mode_rotations};
+use super::estimate::{Estimate, Given, GivenNormals, ModeScan};
+use super::orientations::{orientations, Sampler};
+use super::regime::Regime;
 pub use super::StructureKind;
-use crate::aniso::{Anisotropy, AnisotropyError};
 use std::fmt;
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Arc;
 
 /// A 3×3 matrix as rows.
 pub type Mat3 = crate::aniso::Mat3;
 
-pub use super::orientations::MAX_ORIENTATIONS;
-
 /// Range of λ accepted: beyond it the transformed coordinates leave the
 /// range where the arithmetic is exact for the inputs allowed.
 pub const LAMBDA_RANGE: (f64, f64) = (1e-3, 1e4);
-
-/// Candidate pairs for the pruning are found once for all orientations
-/// unless there would be more than this many per point (plus a constant):
-/// then each orientation grids its own transformed points.
-const PAIRS_PER_POINT: usize = 32;
-
-/// Error of a detection run.
-#[derive(Debug, Clone, PartialEq)]
-pub enum DetectError {
-    /// A parameter is out of range (the message says which).
-    BadParameter(String),
-    /// The input holds no point.
-    Empty,
-    /// A coordinate is NaN or infinite.
-    NonFinite {
-        /// Index of the point.
-        index: usize,
-    },
-    /// A coordinate's magnitude is above 1e50 or below 1e-30 (and not 0):
-    /// outside the range where the exact arithmetic is guaranteed after
-    /// the anisotropic transform. Rescale the data.
-    OutOfRange {
-        /// Index of the point.
-        index: usize,
-    },
-    /// The orientation sampler's parameters are invalid.
-    Orientations(OrientationError),
-    /// The anisotropy is invalid.
-    Anisotropy(AnisotropyError),
-    /// The run was cancelled by the progress callback.
-    Cancelled,
-    /// An internal invariant broke (a bug: please report it).
-    Internal(String),
-}
-
-impl fmt::Display for DetectError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            DetectError::BadParameter(m) => write!(f, "bad parameter: {m}"),
-            DetectError::Empty => write!(f, "no points"),
-            DetectError::NonFinite { index } => {
-                write!(f, "point {index} has a non-finite coordinate")
-            }
-            DetectError::OutOfRange { index } => write!(
-                f,
-                "point {index} has a coordinate outside 1e-30..1e50 in magnitude (or 0), \
-                 the range of exact arithmetic: rescale the data"
-            ),
-            DetectError::Orientations(e) => write!(f, "orientations: {e}"),
-            DetectError::Anisotropy(e) => write!(f, "anisotropy: {e}"),
-            DetectError::Cancelled => write!(f, "cancelled"),
-            DetectError::Internal(m) => write!(f, "internal error (a bug, please report): {m}"),
-        }
-    }
-}
-
-impl std::error::Error for DetectError {}
-
-impl From<OrientationError> for DetectError {
-    fn from(e: OrientationError) -> Self {
-        DetectError::Orientations(e)
-    }
-}
-impl From<AnisotropyError> for DetectError {
-    fn from(e: AnisotropyError) -> Self {
-        DetectError::Anisotropy(e)
-    }
-}
-impl From<FilterError> for DetectError {
-    fn from(e: FilterError) -> Self {
-        DetectError::Internal(format!("filter: {e}"))
-    }
-}
-impl From<ScanError> for DetectError {
-    fn from(e: ScanError) -> Self {
-        match e {
-            ScanError::Triangulation(t) => DetectError::Internal(format!(
-                "triangulation of the transformed points failed: {t}"
-            )),
-            ScanError::Filter(f) => f.into(),
-        }
-    }
-}
 
 /// The orientation set of a run.
 #[derive(Debug, Clone, PartialEq)]
@@ -153,10 +65,14 @@ pub enum OrientationSet {
     Data(Vec<ModeScan>),
 }
 
+/// A progress callback: called with (orientations done, total), returns
+/// whether to go on ([`Detector::progress`]).
+type Progress = Arc<dyn Fn(usize, usize) -> bool + Send + Sync>;
+
 /// Parameters of a detection run; build them with [`Detector::lines`],
 /// [`Detector::planes`] or [`Detector::auto`] and the builder methods.
 #[derive(Clone)]
-pub struct Detector<'a> {
+pub struct Detector {
     kind: StructureKind,
     alpha: f64,
     lambda2: f64,
@@ -171,13 +87,13 @@ pub struct Detector<'a> {
     estimate: Option<Box<Estimate>>,
     normals: Option<Normals>,
     given_normals: Option<GivenNormals>,
-    progress: Option<&'a (dyn Fn(usize, usize) -> bool + Sync)>,
+    progress: Option<Progress>,
 }
 
 /// Normals given with the points, unit length (zero where a point's
 /// normal was missing, zero or not finite), shared by the clones of a
 /// detector.
-pub(crate) type Normals = std::sync::Arc<[[f32; 3]]>;
+pub(crate) type Normals = Arc<[[f32; 3]]>;
 
 /// The given normals as unit f32 vectors, [0, 0, 0] where a normal is not
 /// usable (non-finite or of length under 1e-6: files write 0 0 0 for
@@ -196,7 +112,7 @@ fn unit_normals(normals: &[[f64; 3]]) -> Normals {
         .collect()
 }
 
-impl fmt::Debug for Detector<'_> {
+impl fmt::Debug for Detector {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.debug_struct("Detector")
             .field("kind", &self.kind)
@@ -213,7 +129,7 @@ impl fmt::Debug for Detector<'_> {
     }
 }
 
-impl<'a> Detector<'a> {
+impl Detector {
     /// Linear structures (k = 1): edges of `F_{1,α,Q}`, E = (1, 1, 1/λ₃),
     /// path filter `nb_c`. The paper's Fig. 12 uses α = 1, λ₃ = 10,
     /// nb_c = 4.
@@ -359,9 +275,14 @@ impl<'a> Detector<'a> {
     /// alone). Lines ignore normals. [`Self::auto_oriented`] also
     /// builds the orientation set from them.
     ///
-    /// [`Self::run`] fails if their number is not the number of points.
+    /// They pass the check of [`Self::auto_oriented`] when the run meets
+    /// the points: normals that disagree with the points' geometry (fewer
+    /// than half of the locally planar points' within 25° of their PCA
+    /// normal) gate nothing. [`Self::run`] fails if their number is not
+    /// the number of points.
     pub fn normals(mut self, normals: &[[f64; 3]]) -> Self {
         self.normals = Some(unit_normals(normals));
+        self.given_normals = None;
         self
     }
 
@@ -403,7 +324,7 @@ impl<'a> Detector<'a> {
     }
 
     /// Whether to drop isolated points before triangulating (default true;
-    /// exact, see [`super::prune`]).
+    /// exact: such points cannot be a vertex of `F_{k,α,Q}`, docs/method.md §4).
     pub fn prune(mut self, yes: bool) -> Self {
         self.prune = yes;
         self
@@ -440,9 +361,9 @@ impl<'a> Detector<'a> {
 
     /// A callback called after each orientation with (done, total); return
     /// `false` to cancel the run ([`DetectError::Cancelled`]). It is called
-    /// from worker threads.
-    pub fn progress(mut self, f: &'a (dyn Fn(usize, usize) -> bool + Sync)) -> Self {
-        self.progress = Some(f);
+    /// from worker threads, and shared by the detector's clones.
+    pub fn progress(mut self, f: impl Fn(usize, usize) -> bool + Send + Sync + 'static) -> Self {
+        self.progress = Some(Arc::new(f));
         self
     }
 
@@ -577,368 +498,40 @@ impl<'a> Detector<'a> {
         Ok(())
     }
 
-    /// Runs the detection on `points`.
-    ///
-    /// Exact copies of a point are one point: the run takes the distinct
-    /// points (in order of first occurrence) and gives every copy its
-    /// first occurrence's labels ([`Detection::first_occurrence`]), so a
-    /// cloud of many copies costs what its distinct points cost.
-    ///
-    /// # Errors
-    /// Bad parameters, empty input, non-finite coordinates, or a
-    /// cancellation by the progress callback.
-    pub fn run(&self, points: &[[f64; 3]]) -> Result<Detection, DetectError> {
-        self.check_values()?;
-        check_points(points)?;
-        self.check_normals_of(points)?;
-        // Copies of a point are one point to every step (the triangulation
-        // keeps one, the assembly labels first occurrences), but the
-        // candidate pairs and the scans' point subsets would still visit
-        // each copy: 200 copies of 1,000 points took over 100 s against
-        // 3.6 s for the 1,000. Run on the distinct points and give every
-        // copy its first occurrence's result.
-        let first = super::detection::first_occurrences(points);
-        if first.iter().enumerate().any(|(i, &f)| f as usize != i) {
-            let distinct: Vec<u32> = (0..points.len() as u32)
-                .filter(|&i| first[i as usize] == i)
-                .collect();
-            let sub: Vec<[f64; 3]> = distinct.iter().map(|&i| points[i as usize]).collect();
-            let mut on_distinct = self.clone();
-            if let Some(n) = &self.normals {
-                on_distinct.normals = Some(distinct.iter().map(|&i| n[i as usize]).collect());
-            }
-            if let OrientationSet::Data(modes) = &mut on_distinct.set {
-                // The modes' members are input indices (the estimate ran
-                // on the whole cloud): each becomes its position's index
-                // among the distinct points.
-                let mut at = vec![0u32; points.len()];
-                for (k, &i) in distinct.iter().enumerate() {
-                    at[i as usize] = k as u32;
-                }
-                for m in modes.iter_mut() {
-                    for v in &mut m.points {
-                        *v = at[first[*v as usize] as usize];
-                    }
-                    m.points.sort_unstable();
-                    m.points.dedup();
-                }
-            }
-            let det = on_distinct.run(&sub)?;
-            return Ok(expand_distinct(det, &distinct, first));
-        }
-        let go = || match self.kind {
-            StructureKind::Lines => self.run_k::<[u32; 2]>(points),
-            StructureKind::Planes => self.run_k::<[u32; 3]>(points),
-        };
-        #[cfg(feature = "parallel")]
-        if let Some(n) = self.threads {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(n)
-                .build()
-                .map_err(|e| DetectError::Internal(format!("thread pool: {e}")))?;
-            return pool.install(go);
-        }
-        go()
-    }
-
-    /// The jobs of the run and the scale of each group.
-    pub(crate) fn jobs<'p>(
-        &self,
-        modes: &'p [ModeScan],
-        rotations: &[Mat3],
-    ) -> Result<(Vec<Job<'p>>, Vec<Scale>), DetectError> {
-        let scale = |kind: StructureKind, alpha: f64, l2: f64, l3: f64| Scale {
-            tau: alpha,
-            cell: alpha
-                * match kind {
-                    StructureKind::Lines => l3,
-                    StructureKind::Planes => l2.max(l3),
-                },
-        };
-        if !modes.is_empty() {
-            let mut jobs = Vec::new();
-            let mut scales = Vec::new();
-            for (g, m) in modes.iter().enumerate() {
-                let e = elongation(self.kind, m.lambda2, m.lambda3);
-                for r in &m.rotations {
-                    jobs.push(Job {
-                        anisotropy: Anisotropy::from_matrix_rows(*r, e)?,
-                        alpha: m.alpha,
-                        ids: Some(&m.points),
-                        group: g as u32,
-                    });
-                }
-                scales.push(scale(self.kind, m.alpha, m.lambda2, m.lambda3));
-            }
-            return Ok((jobs, scales));
-        }
-        let e = self.elongation();
-        let jobs = rotations
-            .iter()
-            .map(|r| {
-                Ok(Job {
-                    anisotropy: Anisotropy::from_matrix_rows(*r, e)?,
-                    alpha: self.alpha,
-                    ids: None,
-                    group: 0,
-                })
-            })
-            .collect::<Result<Vec<_>, DetectError>>()?;
-        Ok((
-            jobs,
-            vec![scale(self.kind, self.alpha, self.lambda2, self.lambda3)],
-        ))
-    }
-
-    /// The jobs of a run over this detector's orientation set (checked
-    /// against [`MAX_ORIENTATIONS`]) and the scale of each group.
-    pub(crate) fn scan_jobs(&self) -> Result<(Vec<Job<'_>>, Vec<Scale>), DetectError> {
-        let (modes, rotations): (&[ModeScan], Vec<Mat3>) = match &self.set {
-            OrientationSet::Data(m) => (m.as_slice(), Vec::new()),
-            _ => (&[], self.orientation_set()?),
-        };
-        let (jobs, scales) = self.jobs(modes, &rotations)?;
-        if jobs.len() > MAX_ORIENTATIONS {
-            return Err(DetectError::BadParameter(format!(
-                "{} orientations: at most {MAX_ORIENTATIONS} (coarser --m1, fewer --m2, or a larger --step)",
-                jobs.len()
-            )));
-        }
-        Ok((jobs, scales))
-    }
-
-    /// A copy of this detector without its progress callback (so that it
-    /// can outlive the callback, e.g. in a [`super::split::Plan`]).
-    pub(crate) fn detached(&self) -> Detector<'static> {
-        Detector {
-            kind: self.kind,
-            alpha: self.alpha,
-            lambda2: self.lambda2,
-            lambda3: self.lambda3,
-            nb_c: self.nb_c,
-            set: self.set.clone(),
-            prune: self.prune,
-            part_angle_deg: self.part_angle_deg,
-            epsilon: self.epsilon,
-            threads: self.threads,
-            tile: self.tile,
-            estimate: self.estimate.clone(),
-            normals: self.normals.clone(),
-            given_normals: self.given_normals,
-            progress: None,
-        }
-    }
-
-    fn run_k<S: Face>(&self, points: &[[f64; 3]]) -> Result<Detection, DetectError> {
-        let (jobs, scales) = self.scan_jobs()?;
-        let modes: &[ModeScan] = match &self.set {
+    /// The modes of a data orientation set (none for a sampler or explicit
+    /// rotations).
+    pub(crate) fn modes(&self) -> &[ModeScan] {
+        match &self.set {
             OrientationSet::Data(m) => m.as_slice(),
             _ => &[],
-        };
-        // Candidate pairs for the pruning, once for all orientations over
-        // every point (unless there are too many).
-        let lmax = self
-            .elongation()
-            .iter()
-            .map(|&x| 1.0 / x)
-            .fold(1.0, f64::max);
-        let cands = if self.prune && modes.is_empty() {
-            let radius = 2.0 * self.alpha * (1.0 + RADIUS_SLACK);
-            CandidatePairs::new(
-                points,
-                radius * lmax * (1.0 + RADIUS_SLACK),
-                PAIRS_PER_POINT * points.len() + 1024,
-            )
-        } else {
-            None
-        };
-        let pruning = match (&cands, self.prune) {
-            (Some(c), _) => Pruning::Pairs(c),
-            (None, true) => Pruning::Grid,
-            (None, false) => Pruning::Off,
-        };
-        let done = AtomicUsize::new(0);
-        let cancelled = AtomicBool::new(false);
-        let total = jobs.len();
-        let sf = self.scan_filter(points, total);
-        let one = |job: &Job<'_>| -> Result<JobResult<S>, DetectError> {
-            if cancelled.load(Ordering::Relaxed) {
-                return Err(DetectError::Cancelled);
-            }
-            let r = run_job::<S>(points, job, &pruning, self.tile, sf)?;
-            let d = done.fetch_add(1, Ordering::Relaxed) + 1;
-            if let Some(cb) = self.progress {
-                if !cb(d, total) {
-                    cancelled.store(true, Ordering::Relaxed);
-                }
-            }
-            Ok(r)
-        };
-        #[cfg(feature = "parallel")]
-        let per: Vec<Result<JobResult<S>, DetectError>> = {
-            use rayon::prelude::*;
-            jobs.par_iter().map(one).collect()
-        };
-        #[cfg(not(feature = "parallel"))]
-        let per: Vec<Result<JobResult<S>, DetectError>> = jobs.iter().map(one).collect();
-        if cancelled.load(Ordering::Relaxed) {
-            return Err(DetectError::Cancelled);
-        }
-        let mut stats = RunStats {
-            orientations: total,
-            ..RunStats::default()
-        };
-        let mut found: Vec<(u32, Vec<S>)> = Vec::with_capacity(per.len());
-        for (r, job) in per.into_iter().zip(&jobs) {
-            let r = r?;
-            stats.triangulated_points += r.triangulated as u64;
-            stats.raw_simplices += r.raw as u64;
-            stats.filtered_simplices += r.faces.len() as u64;
-            found.push((job.group, r.faces));
-        }
-        self.finish_k(points, found, scales, stats)
-    }
-
-    /// The path filter's threshold in the scan of `orientations`
-    /// orientations of `points`: nb_c, or for lines under the significance
-    /// test a shorter one from the measured background
-    /// (docs/method.md §4, `detect::assemble::scan_min_size`).
-    pub(crate) fn scan_min_size(&self, points: &[[f64; 3]], orientations: usize) -> u32 {
-        self.scan_filter(points, orientations).nb_c
-    }
-
-    /// The path filter of each orientation of a scan of `orientations`
-    /// orientations of `points`: [`Self::scan_min_size`], and for lines
-    /// under the significance test the straightness at which chains are
-    /// followed through ramifications (`detect::assemble::straight_cos`).
-    pub(crate) fn scan_filter(&self, points: &[[f64; 3]], orientations: usize) -> ScanFilter {
-        let chance = super::assemble::ChanceScale::measure(
-            points,
-            self.alpha,
-            self.elongation(),
-            orientations,
-        );
-        let significance = self.epsilon.is_some();
-        ScanFilter {
-            nb_c: super::assemble::scan_min_size(self.kind, self.nb_c, significance, chance),
-            straight_cos: super::assemble::straight_cos(
-                self.kind,
-                significance,
-                matches!(self.set, OrientationSet::Data(_)),
-                chance,
-            ),
         }
     }
 
-    /// The steps after the scan: the union of the jobs' filtered simplices
-    /// (`found`: per job, its group and its simplices), the component
-    /// filter and the assembly. `stats` holds the scan's figures.
-    pub(crate) fn finish_k<S: Face>(
-        &self,
-        points: &[[f64; 3]],
-        found: Vec<(u32, Vec<S>)>,
-        scales: Vec<Scale>,
-        mut stats: RunStats,
-    ) -> Result<Detection, DetectError> {
-        let total = stats.orientations;
-        let (all, groups) = union(found);
-        stats.union_simplices = all.len();
-        let keep = component_size_mask(&all, self.scan_min_size(points, total))?;
-        let mut kept = Vec::with_capacity(all.len());
-        let mut kept_groups = Vec::with_capacity(all.len());
-        for ((s, g), k) in all.into_iter().zip(groups).zip(keep) {
-            if k {
-                kept.push(s);
-                kept_groups.push(g);
+    /// The regime of a run over `points` ([`Regime`]): the structure kind,
+    /// the significance test, where the orientations come from, and the
+    /// normals that gate the claims of planes. Normals given with
+    /// [`Self::normals`] pass here the agreement check that
+    /// [`Self::auto_oriented`] applied when it made the detector
+    /// ([`check_normals_agreement`]): normals that disagree with the points'
+    /// geometry gate nothing.
+    pub(crate) fn regime(&self, points: &[[f64; 3]]) -> Regime {
+        let gate = match (self.kind, &self.normals) {
+            (StructureKind::Planes, Some(n)) => {
+                let used = match self.given_normals {
+                    Some(g) => g.used,
+                    None => check_normals_agreement(points, n).used,
+                };
+                used.then(|| n.clone())
             }
-        }
-        stats.kept_simplices = kept.len();
-        let min_vertices = match self.kind {
-            StructureKind::Lines => self.nb_c as usize + 1,
-            StructureKind::Planes => (self.nb_c as usize / 2).max(4),
+            _ => None,
         };
-        let settings = Settings {
-            kind: self.kind,
-            part_angle_deg: self.part_angle_deg,
-            min_vertices,
-            scales,
-            log10_epsilon: self.epsilon.map(f64::log10),
-            widen_planes: matches!(self.set, OrientationSet::Data(_)),
-            normals: self.normals.as_deref(),
-        };
-        Ok(assemble::<S>(points, kept, kept_groups, &settings, stats)?.detection)
+        Regime::new(
+            self.kind,
+            self.epsilon,
+            matches!(self.set, OrientationSet::Data(_)),
+            gate,
+        )
     }
-
-    /// The anisotropic α-shape `F_{k,α,Q}(P)` of one orientation (rows of
-    /// R), before the path filter: sorted simplices of input indices,
-    /// ascending within each. This is what [`Self::run`] computes for each
-    /// orientation of a sampler, and a way to look at one of them.
-    ///
-    /// # Errors
-    /// As [`Self::run`].
-    pub fn orientation_faces(
-        &self,
-        points: &[[f64; 3]],
-        rotation: &Mat3,
-    ) -> Result<Vec<Vec<u32>>, DetectError> {
-        self.check_values()?;
-        check_points(points)?;
-        let job = Job {
-            anisotropy: Anisotropy::from_matrix_rows(*rotation, self.elongation())?,
-            alpha: self.alpha,
-            ids: None,
-            group: 0,
-        };
-        let pruning = if self.prune {
-            Pruning::Grid
-        } else {
-            Pruning::Off
-        };
-        let mut out: Vec<Vec<u32>> = match self.kind {
-            StructureKind::Lines => {
-                super::scan::raw_faces::<[u32; 2]>(points, &job, &pruning, self.tile)?
-                    .0
-                    .iter()
-                    .map(|f| f.to_vec())
-                    .collect()
-            }
-            StructureKind::Planes => {
-                super::scan::raw_faces::<[u32; 3]>(points, &job, &pruning, self.tile)?
-                    .0
-                    .iter()
-                    .map(|f| f.to_vec())
-                    .collect()
-            }
-        };
-        out.sort_unstable();
-        Ok(out)
-    }
-}
-
-/// The detection of a cloud with copies from that of its distinct points
-/// (`distinct`: their input indices, ascending; `first`: per input point,
-/// its first occurrence). Indices map through `distinct`, which keeps
-/// their order, so every sorted list stays sorted.
-fn expand_distinct(mut det: Detection, distinct: &[u32], first: Vec<u32>) -> Detection {
-    let to_input = |v: &mut u32| *v = distinct[*v as usize];
-    for s in &mut det.simplices {
-        s.iter_mut().for_each(to_input);
-    }
-    for st in &mut det.structures {
-        st.vertices.iter_mut().for_each(to_input);
-        for p in &mut st.parts {
-            p.vertices.iter_mut().for_each(to_input);
-            p.mesh.iter_mut().flatten().for_each(to_input);
-        }
-    }
-    // Label of each distinct point, by its input index.
-    let mut by_input = vec![-1i64; first.len()];
-    for (k, &i) in distinct.iter().enumerate() {
-        by_input[i as usize] = det.labels[k];
-    }
-    det.labels = first.iter().map(|&f| by_input[f as usize]).collect();
-    det.first_occurrence = first;
-    det
 }
 
 /// The elongation E for λ₂, λ₃.

@@ -26,11 +26,17 @@
 //! The path filter is not local (a path can cross tiles): it runs on the
 //! job's gathered simplices. The union is a set, sorted; each simplex keeps
 //! the smallest group (mode) id of the jobs that found it. The result does
-//! not depend on the thread count.
+//! not depend on the thread count. The path filter and its thresholds
+//! (measured from the background for lines under the significance test)
+//! are in `path_filter`.
+
+mod path_filter;
+
+pub(crate) use path_filter::{filter_job, ChanceScale, ScanFilter, LINE_SCAN_MIN};
 
 use super::detection::Primitive;
 use super::faces::{edges_at, triangles_at};
-use super::filter::{filter, filter_mask, FilterError, Simplex};
+use super::filter::{FilterError, Simplex};
 use super::fit::{fit_line_indices, fit_plane_indices};
 use super::parts::{linear_parts, planar_parts, PartsError};
 use super::prune::{non_isolated, CandidatePairs};
@@ -307,44 +313,6 @@ pub(crate) fn raw_faces<S: Face>(
     Ok((faces, triangulated))
 }
 
-/// The path filter of one orientation: its threshold, and for lines
-/// under the significance test the straightness at which a chain is
-/// followed through a ramification (docs/method.md §4).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct ScanFilter {
-    /// The path filter's nb_c.
-    pub nb_c: u32,
-    /// `Some(c)`: edges only; at a vertex of degree ≥ 3 the two edges
-    /// whose directions (in the orientation's metric) make a cosine ≤ −c
-    /// stay joined and the others are cut loose ([`straight_filter`]).
-    /// `None`: the paper's filter.
-    pub straight_cos: Option<f64>,
-}
-
-/// The filter of one job's raw faces (sorted, distinct), in its metric.
-pub(crate) fn filter_job<S: Face>(
-    faces: &[S],
-    points: &[[f64; 3]],
-    anisotropy: &crate::aniso::Anisotropy,
-    sf: ScanFilter,
-) -> Result<Vec<S>, ScanError> {
-    match sf.straight_cos {
-        Some(c) if S::VERTICES == 2 => {
-            let edges: Vec<[u32; 2]> = faces
-                .iter()
-                .map(|f| [f.as_ref()[0], f.as_ref()[1]])
-                .collect();
-            let keep = straight_filter(&edges, points, anisotropy, sf.nb_c, c)?;
-            Ok(faces
-                .iter()
-                .zip(keep)
-                .filter_map(|(&f, k)| k.then_some(f))
-                .collect())
-        }
-        _ => filter(faces, sf.nb_c).map_err(ScanError::Filter),
-    }
-}
-
 /// One job: raw faces, then the path filter.
 pub(crate) fn run_job<S: Face>(
     points: &[[f64; 3]],
@@ -373,130 +341,4 @@ pub(crate) fn union<S: Face>(per_job: Vec<(u32, Vec<S>)>) -> (Vec<S>, Vec<u32>) 
     all.sort_unstable();
     all.dedup_by(|b, a| a.0 == b.0);
     all.into_iter().unzip()
-}
-
-/// The path filter on edges with *good continuation*; the verdict per
-/// edge (true = kept). At a vertex where three or more edges meet, the
-/// two edges that continue each other most straightly (their directions
-/// from the vertex, in the metric Q of the orientation, make the most
-/// negative cosine), if that cosine is at most `−straight_cos`, stay
-/// joined there, and every other edge there is cut loose: it ends at a
-/// copy of the vertex. Then the path filter of docs/method.md §3 runs on
-/// the edges so rewired. A chain with stray points hung on it (spurs, or
-/// fans of triangles' edges to a point beside it) is then one path, and
-/// the strays short pieces that the filter deletes; without it the
-/// ramifications cut the chain into pieces shorter than nb_c, and the
-/// filter deletes the chain with the strays (issue 14: two lines in five
-/// lost at 10× the paper's background). Where no pair is straight enough
-/// the vertex stays a ramification, as in the paper.
-pub(crate) fn straight_filter(
-    edges: &[[u32; 2]],
-    points: &[[f64; 3]],
-    q: &crate::aniso::Anisotropy,
-    nb_c: u32,
-    straight_cos: f64,
-) -> Result<Vec<bool>, ScanError> {
-    use crate::geometry::{dot, sub};
-    // Incidences (vertex, edge, end), grouped by vertex.
-    let mut inc: Vec<(u32, u32, u8)> = Vec::with_capacity(2 * edges.len());
-    for (i, e) in edges.iter().enumerate() {
-        inc.push((e[0], i as u32, 0));
-        inc.push((e[1], i as u32, 1));
-    }
-    inc.sort_unstable();
-    let mut rewired: Vec<[u32; 2]> = edges.to_vec();
-    // Copies of vertices get ids after every input index; the filter only
-    // looks at ids.
-    let mut copies = points.len() as u64;
-    let mut dirs: Vec<[f64; 3]> = Vec::new();
-    for here in inc.chunk_by(|a, b| a.0 == b.0) {
-        if here.len() < 3 {
-            continue;
-        }
-        let pv = q.transform_point(points[here[0].0 as usize]);
-        dirs.clear();
-        dirs.extend(here.iter().map(|&(_, e, end)| {
-            let w = edges[e as usize][1 - end as usize];
-            let d = sub(q.transform_point(points[w as usize]), pv);
-            let n = dot(d, d).sqrt().max(f64::MIN_POSITIVE);
-            d.map(|c| c / n)
-        }));
-        let mut best = (f64::INFINITY, 0, 0);
-        for a in 0..dirs.len() {
-            for b in a + 1..dirs.len() {
-                let c = dot(dirs[a], dirs[b]);
-                if c < best.0 {
-                    best = (c, a, b);
-                }
-            }
-        }
-        if best.0 > -straight_cos {
-            continue;
-        }
-        for (j, &(_, e, end)) in here.iter().enumerate() {
-            if j != best.1 && j != best.2 {
-                if copies >= u64::from(u32::MAX) {
-                    return Err(ScanError::Filter(FilterError::TooManySimplices(
-                        edges.len(),
-                    )));
-                }
-                rewired[e as usize][end as usize] = copies as u32;
-                copies += 1;
-            }
-        }
-    }
-    filter_mask(&rewired, nb_c).map_err(ScanError::Filter)
-}
-
-#[cfg(test)]
-mod straight_tests {
-    use super::*;
-
-    /// A chain of ten points along x with a stray point beside its middle,
-    /// joined to four chain points (a fan of triangles' edges).
-    fn chain_with_fan() -> (Vec<[f64; 3]>, Vec<[u32; 2]>) {
-        let mut points: Vec<[f64; 3]> = (0..10).map(|i| [i as f64, 0.0, 0.0]).collect();
-        points.push([4.5, 0.5, 0.0]);
-        let mut edges: Vec<[u32; 2]> = (0..9).map(|i| [i, i + 1]).collect();
-        edges.extend([[3, 10], [4, 10], [5, 10], [6, 10]]);
-        (points, edges)
-    }
-
-    #[test]
-    fn a_fan_no_longer_shreds_a_chain() {
-        let (points, edges) = chain_with_fan();
-        // The paper's filter: the fan's ramifications cut the chain into
-        // pieces of one to three edges, all deleted at nb_c = 4.
-        assert!(filter(&edges, 4).unwrap().is_empty());
-        // Good continuation: the chain is one path, the fan goes.
-        let q = crate::aniso::Anisotropy::euclidean();
-        let keep = straight_filter(&edges, &points, &q, 4, 0.866).unwrap();
-        assert_eq!(keep, [vec![true; 9], vec![false; 4]].concat());
-    }
-
-    #[test]
-    fn a_turn_sharper_than_allowed_stays_a_ramification() {
-        // A chain bent by 90° at vertex 3, with a spur there: no pair at
-        // vertex 3 is straight, so it stays a ramification and the short
-        // pieces go, as in the paper's filter.
-        let points = vec![
-            [0.0, 0.0, 0.0],
-            [1.0, 0.0, 0.0],
-            [2.0, 0.0, 0.0],
-            [3.0, 0.0, 0.0],
-            [3.0, 1.0, 0.0],
-            [3.0, 2.0, 0.0],
-            [3.0, 3.0, 0.0],
-            [2.0, -1.0, 0.0],
-        ];
-        let edges = [[0, 1], [1, 2], [2, 3], [3, 4], [4, 5], [5, 6], [3, 7]];
-        let q = crate::aniso::Anisotropy::euclidean();
-        let keep = straight_filter(&edges, &points, &q, 4, 0.866).unwrap();
-        let paper = filter_mask(&edges, 4).unwrap();
-        assert_eq!(keep, paper);
-        // With any turn allowed, the straightest pair (the spur and the
-        // leg it continues best) is followed instead.
-        let loose = straight_filter(&edges, &points, &q, 4, -1.0).unwrap();
-        assert_ne!(loose, paper);
-    }
 }

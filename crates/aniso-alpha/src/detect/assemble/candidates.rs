@@ -1,0 +1,269 @@
+//! Stages 1 and 2 of the assembly (docs/method.md §4): candidate
+//! primitives, component by component within each group (the simplices
+//! found by one mode's orientations), at that group's scale, each with its
+//! footprint. Per group, because a component of the whole union can join
+//! a noisy wall (large α) to a clean roof (small α) along their common
+//! edge.
+
+use super::super::detection::Primitive;
+use super::super::filter::{components, FilterError};
+use super::super::regime::Regime;
+use super::super::scan::{Face, LINE_SCAN_MIN};
+use super::{Candidate, Footprint, Settings};
+use crate::par::map_ranges;
+
+/// At most this many pieces of a component (the largest) give a
+/// candidate besides the whole component's fit.
+const MAX_PIECES: usize = 64;
+
+/// The candidates of the cleaned union `kept`, whose simplices were found
+/// by the groups `group`: per component of each group, the greedy
+/// extraction ([`extract`]) at the group's scale, with footprints.
+pub(super) fn find<S: Face>(
+    points: &[[f64; 3]],
+    kept: &[S],
+    group: &[u32],
+    settings: &Settings,
+    regime: &Regime,
+) -> Result<Vec<Candidate>, FilterError> {
+    let comps = group_components(kept, group, settings.scales.len())?;
+    // Short lines start from the scan's shortest pieces (three points);
+    // a part still needs min_vertices points once its claims have joined
+    // its pieces.
+    let seed_min = if regime.keeps_short_lines() {
+        settings.min_vertices.min(LINE_SCAN_MIN as usize + 1)
+    } else {
+        settings.min_vertices
+    };
+    // Components are independent: extracted in parallel, in order.
+    let per_component = map_ranges(
+        comps.len(),
+        || (),
+        |_, k| {
+            let (g, ss) = &comps[k];
+            let scale = settings.scales[*g as usize];
+            let local: Vec<S> = ss.iter().map(|&s| kept[s as usize]).collect();
+            extract(points, &local, scale.tau, seed_min, settings.part_angle_deg)
+                .into_iter()
+                .filter_map(|(seeds, fit)| {
+                    let foot = Footprint::new(&fit, points, &seeds, scale.cell)?;
+                    Some(Candidate {
+                        fit,
+                        tau: scale.tau,
+                        cell: scale.cell,
+                        seeds,
+                        foot,
+                    })
+                })
+                .collect::<Vec<Candidate>>()
+        },
+    );
+    Ok(per_component.into_iter().flatten().collect())
+}
+
+/// The connected components of each group's simplices: (group, indices
+/// into `kept`), group by group, components in the order
+/// [`components`] numbers them.
+fn group_components<S: Face>(
+    kept: &[S],
+    group: &[u32],
+    n_groups: usize,
+) -> Result<Vec<(u32, Vec<u32>)>, FilterError> {
+    let mut by_group: Vec<Vec<u32>> = vec![Vec::new(); n_groups];
+    for (s, &g) in group.iter().enumerate() {
+        by_group[g as usize].push(s as u32);
+    }
+    let mut out: Vec<(u32, Vec<u32>)> = Vec::new();
+    for (g, ss) in by_group.iter().enumerate() {
+        if ss.is_empty() {
+            continue;
+        }
+        let local: Vec<S> = ss.iter().map(|&s| kept[s as usize]).collect();
+        let comp = components(&local)?;
+        let n_comp = comp.iter().map(|&c| c as usize + 1).max().unwrap_or(0);
+        let mut parts: Vec<Vec<u32>> = vec![Vec::new(); n_comp];
+        for (k, &c) in comp.iter().enumerate() {
+            parts[c as usize].push(ss[k]);
+        }
+        out.extend(parts.into_iter().map(|p| (g as u32, p)));
+    }
+    Ok(out)
+}
+
+/// Greedy extraction of straight/flat primitives from one connected
+/// component `local` (module doc of `assemble`, step 1): their inlier
+/// vertices (within `tol`) and fits, while the best candidate covers at
+/// least `min_vertices` new vertices.
+fn extract<S: Face>(
+    points: &[[f64; 3]],
+    local: &[S],
+    tol: f64,
+    min_vertices: usize,
+    angle: f64,
+) -> Vec<(Vec<u32>, Primitive)> {
+    let mut out = Vec::new();
+    let mut verts: Vec<u32> = local.iter().flat_map(|s| s.as_ref().to_vec()).collect();
+    verts.sort_unstable();
+    verts.dedup();
+    if verts.len() < min_vertices {
+        return out;
+    }
+    let mut cands = piece_fits(points, local, &verts, angle);
+    let inliers = |fit: &Primitive| -> Vec<u32> {
+        verts
+            .iter()
+            .copied()
+            .filter(|&v| fit.distance(&points[v as usize]) <= tol)
+            .collect()
+    };
+    let mut covered = vec![false; verts.len()];
+    loop {
+        let mut best: Option<(usize, usize)> = None; // (new inliers, candidate)
+        for (ci, c) in cands.iter().enumerate() {
+            let new = verts
+                .iter()
+                .zip(&covered)
+                .filter(|(&v, &cov)| !cov && c.distance(&points[v as usize]) <= tol)
+                .count();
+            if best.is_none_or(|b| new > b.0) {
+                best = Some((new, ci));
+            }
+        }
+        let Some((new, ci)) = best else { break };
+        if new < min_vertices {
+            break;
+        }
+        let mut fit = cands.swap_remove(ci);
+        for _ in 0..2 {
+            let refit = S::fit(points, &inliers(&fit));
+            if matches!(refit, Primitive::None) {
+                break;
+            }
+            fit = refit;
+        }
+        let inl = inliers(&fit);
+        let mut gained = 0;
+        for (k, &v) in verts.iter().enumerate() {
+            if !covered[k] && inl.binary_search(&v).is_ok() {
+                covered[k] = true;
+                gained += 1;
+            }
+        }
+        if gained < min_vertices || inl.len() < min_vertices {
+            break;
+        }
+        out.push((inl, fit));
+    }
+    out
+}
+
+/// The candidate primitives of a component with the vertices `verts`: the
+/// fits of its pieces of like-oriented simplices ([`Face::parts`]) with at
+/// least two simplices' worth of points, the largest [`MAX_PIECES`], and
+/// the fit of the whole component. (A failure of the pieces, which needs a
+/// NaN point, leaves the component in one piece.)
+fn piece_fits<S: Face>(
+    points: &[[f64; 3]],
+    local: &[S],
+    verts: &[u32],
+    angle: f64,
+) -> Vec<Primitive> {
+    let part = S::parts(points, local, angle).unwrap_or_else(|_| vec![0; local.len()]);
+    let n_parts = part.iter().map(|&p| p as usize + 1).max().unwrap_or(0);
+    let mut pv: Vec<Vec<u32>> = vec![Vec::new(); n_parts];
+    for (s, &p) in local.iter().zip(&part) {
+        pv[p as usize].extend_from_slice(s.as_ref());
+    }
+    let mut by_size: Vec<(usize, usize)> = pv
+        .iter_mut()
+        .enumerate()
+        .map(|(i, v)| {
+            v.sort_unstable();
+            v.dedup();
+            (v.len(), i)
+        })
+        .collect();
+    by_size.sort_unstable_by(|a, b| b.0.cmp(&a.0).then(a.1.cmp(&b.1)));
+    let mut cands: Vec<Primitive> = by_size
+        .iter()
+        .take(MAX_PIECES)
+        .filter(|&&(sz, _)| sz >= S::K + 2)
+        .map(|&(_, i)| S::fit(points, &pv[i]))
+        .collect();
+    cands.push(S::fit(points, verts));
+    cands
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::detect::assemble::Scale;
+    use crate::detect::StructureKind;
+
+    /// Edges along two perpendicular lines meeting at the origin (an L),
+    /// eleven points each, and a separate chain of four points far away.
+    fn l_shape() -> (Vec<[f64; 3]>, Vec<[u32; 2]>) {
+        let mut pts: Vec<[f64; 3]> = (0..11).map(|i| [i as f64, 0.0, 0.0]).collect();
+        pts.extend((1..11).map(|i| [0.0, i as f64, 0.0]));
+        pts.extend((0..4).map(|i| [50.0 + i as f64, 50.0, 0.0]));
+        let mut edges: Vec<[u32; 2]> = (0..10).map(|i| [i, i + 1]).collect();
+        edges.push([0, 11]);
+        edges.extend((11..20).map(|i| [i, i + 1]));
+        edges.extend((21..24).map(|i| [i, i + 1]));
+        (pts, edges)
+    }
+
+    #[test]
+    fn an_l_gives_its_two_legs() {
+        let (pts, edges) = l_shape();
+        let legs = extract(&pts, &edges[..20], 0.1, 5, 10.0);
+        assert_eq!(legs.len(), 2);
+        // Each leg's inliers: its eleven points (the corner in both).
+        let mut sizes: Vec<usize> = legs.iter().map(|(s, _)| s.len()).collect();
+        sizes.sort_unstable();
+        assert_eq!(sizes, [11, 11]);
+        assert!(legs.iter().all(|(_, f)| f.rms() < 1e-9));
+        // Too few vertices: nothing.
+        assert!(extract(&pts, &edges[..3], 0.1, 5, 10.0).is_empty());
+    }
+
+    #[test]
+    fn candidates_come_per_component_and_group_at_their_scale() {
+        let (pts, edges) = l_shape();
+        // The L in group 0, the far chain in group 1.
+        let group: Vec<u32> = (0..edges.len()).map(|i| u32::from(i >= 20)).collect();
+        let settings = Settings {
+            part_angle_deg: 10.0,
+            min_vertices: 4,
+            scales: vec![
+                Scale {
+                    tau: 0.1,
+                    cell: 2.0,
+                },
+                Scale {
+                    tau: 0.2,
+                    cell: 3.0,
+                },
+            ],
+        };
+        let regime = Regime::new(StructureKind::Lines, None, false, None);
+        let cands = find(&pts, &edges, &group, &settings, &regime).unwrap();
+        assert_eq!(cands.len(), 3);
+        assert_eq!(cands[2].seeds, [21, 22, 23, 24]);
+        assert_eq!((cands[2].tau, cands[2].cell), (0.2, 3.0));
+        assert!(cands[..2].iter().all(|c| c.tau == 0.1 && c.cell == 2.0));
+        // Short lines under the test start from three points: the chain's
+        // first three edges alone are a candidate then, not otherwise.
+        let short = Regime::new(StructureKind::Lines, Some(1.0), false, None);
+        let three = [[21, 22], [22, 23]];
+        assert_eq!(
+            find(&pts, &three, &[1, 1], &settings, &short)
+                .unwrap()
+                .len(),
+            1
+        );
+        assert!(find(&pts, &three, &[1, 1], &settings, &regime)
+            .unwrap()
+            .is_empty());
+    }
+}

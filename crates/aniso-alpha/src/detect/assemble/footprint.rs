@@ -1,0 +1,335 @@
+//! A candidate's footprint (docs/method.md §4, step 2): the cells that its
+//! points occupy on its plane (2D) or along its line (1D), grown by one
+//! cell, and the query of the points near a primitive and over its
+//! footprint ([`for_near`]) that the claims, the claims' widening and the
+//! significance test's background share.
+
+use super::super::detection::Primitive;
+use crate::geometry::kdtree::KdTree;
+use crate::geometry::{dot, sub};
+
+/// The cells a candidate covers on its plane (2D) or along its line (1D).
+#[derive(Debug, Clone)]
+pub(crate) struct Footprint {
+    /// The primitive's centroid.
+    origin: [f64; 3],
+    /// The plane's two axes, or the line's direction and zero.
+    axes: [[f64; 3]; 2],
+    /// The cell side.
+    pub(super) cell: f64,
+    /// The first cell of the grid (with one cell of margin).
+    lo: [i64; 2],
+    /// The grid's size in cells, margin included (a line's grid is one
+    /// cell wide across, plus the margin).
+    dims: [usize; 2],
+    /// Per cell (row-major): covered.
+    bits: Vec<bool>,
+}
+
+/// Largest number of cells of one footprint; beyond it the cell is
+/// doubled (a coarser footprint, never a failure).
+const MAX_CELLS: usize = 1 << 24;
+
+impl Footprint {
+    /// The footprint's frame on a primitive: its centroid and axes (a
+    /// line's direction and zero).
+    fn frame(fit: &Primitive) -> Option<([f64; 3], [[f64; 3]; 2])> {
+        match fit {
+            Primitive::Plane(f) => Some((f.centroid, f.axes)),
+            Primitive::Line(f) => Some((f.centroid, [f.direction, [0.0; 3]])),
+            Primitive::None => None,
+        }
+    }
+
+    /// The cell of `p`'s projection.
+    fn coords(&self, p: &[f64; 3]) -> [i64; 2] {
+        let w = sub(*p, self.origin);
+        [
+            (dot(w, self.axes[0]) / self.cell).floor() as i64,
+            (dot(w, self.axes[1]) / self.cell).floor() as i64,
+        ]
+    }
+
+    /// The cells of side `cell` (doubled until there are at most
+    /// [`MAX_CELLS`]) that `seeds` occupy on `fit`, grown by one; `None`
+    /// without seeds or without a primitive.
+    pub(super) fn new(
+        fit: &Primitive,
+        points: &[[f64; 3]],
+        seeds: &[u32],
+        cell: f64,
+    ) -> Option<Self> {
+        let (origin, axes) = Self::frame(fit)?;
+        let mut cell = cell;
+        loop {
+            let mut f = Footprint {
+                origin,
+                axes,
+                cell,
+                lo: [0; 2],
+                dims: [0; 2],
+                bits: Vec::new(),
+            };
+            let cs: Vec<[i64; 2]> = seeds
+                .iter()
+                .map(|&v| f.coords(&points[v as usize]))
+                .collect();
+            if cs.is_empty() {
+                return None;
+            }
+            let mut lo = [i64::MAX; 2];
+            let mut hi = [i64::MIN; 2];
+            for c in &cs {
+                for k in 0..2 {
+                    lo[k] = lo[k].min(c[k]);
+                    hi[k] = hi[k].max(c[k]);
+                }
+            }
+            // One cell of margin for the dilation.
+            let lo = [lo[0] - 1, lo[1] - 1];
+            let dims = [(hi[0] + 2 - lo[0]) as usize, (hi[1] + 2 - lo[1]) as usize];
+            if dims[0].saturating_mul(dims[1]) > MAX_CELLS {
+                cell *= 2.0;
+                continue;
+            }
+            let mut marked = vec![false; dims[0] * dims[1]];
+            for c in &cs {
+                marked[(c[0] - lo[0]) as usize * dims[1] + (c[1] - lo[1]) as usize] = true;
+            }
+            // Dilate by one cell (8-neighbourhood; along a line, 2).
+            let mut bits = marked.clone();
+            for i in 0..dims[0] {
+                for j in 0..dims[1] {
+                    if !marked[i * dims[1] + j] {
+                        continue;
+                    }
+                    for di in -1i64..=1 {
+                        for dj in -1i64..=1 {
+                            let (a, b) = (i as i64 + di, j as i64 + dj);
+                            if a >= 0 && b >= 0 && (a as usize) < dims[0] && (b as usize) < dims[1]
+                            {
+                                bits[a as usize * dims[1] + b as usize] = true;
+                            }
+                        }
+                    }
+                }
+            }
+            f.lo = lo;
+            f.dims = dims;
+            f.bits = bits;
+            return Some(f);
+        }
+    }
+
+    /// Whether `p`'s projection falls in a covered cell.
+    pub(super) fn contains(&self, p: &[f64; 3]) -> bool {
+        let c = self.coords(p);
+        let (a, b) = (c[0] - self.lo[0], c[1] - self.lo[1]);
+        a >= 0
+            && b >= 0
+            && (a as usize) < self.dims[0]
+            && (b as usize) < self.dims[1]
+            && self.bits[a as usize * self.dims[1] + b as usize]
+    }
+
+    /// Number of covered cells.
+    pub(super) fn count(&self) -> usize {
+        self.bits.iter().filter(|&&b| b).count()
+    }
+
+    /// Blocks of `b` × `b` cells (`b` along a line) holding a covered
+    /// cell: each block's centre (3D, on the primitive) and the distance
+    /// from it to the block's farthest corner, along the primitive.
+    fn blocks(&self, b: usize) -> impl Iterator<Item = ([f64; 3], f64)> + '_ {
+        let planar = self.axes[1] != [0.0; 3];
+        let bj = if planar { b } else { self.dims[1] };
+        (0..self.dims[0]).step_by(b).flat_map(move |i0| {
+            (0..self.dims[1]).step_by(bj).filter_map(move |j0| {
+                let (i1, j1) = ((i0 + b).min(self.dims[0]), (j0 + bj).min(self.dims[1]));
+                let any = (i0..i1).any(|i| (j0..j1).any(|j| self.bits[i * self.dims[1] + j]));
+                if !any {
+                    return None;
+                }
+                let u = (self.lo[0] + i0 as i64) as f64 + 0.5 * (i1 - i0) as f64;
+                let v = (self.lo[1] + j0 as i64) as f64 + 0.5 * (j1 - j0) as f64;
+                let centre = [0, 1, 2].map(|k| {
+                    self.origin[k] + self.cell * (u * self.axes[0][k] + v * self.axes[1][k])
+                });
+                let (hu, hv) = (0.5 * (i1 - i0) as f64, 0.5 * (j1 - j0) as f64);
+                let half = if planar {
+                    self.cell * (hu * hu + hv * hv).sqrt()
+                } else {
+                    self.cell * hu
+                };
+                Some((centre, half))
+            })
+        })
+    }
+}
+
+/// Per-point marks that tell whether a query already reported a point,
+/// without clearing between queries.
+pub(super) struct Stamps {
+    v: Vec<u32>,
+    mark: u32,
+}
+
+impl Stamps {
+    /// Marks for `n` points.
+    pub(super) fn new(n: usize) -> Self {
+        Stamps {
+            v: vec![0; n],
+            mark: 0,
+        }
+    }
+    /// A mark no point carries yet.
+    fn next(&mut self) -> u32 {
+        if self.mark == u32::MAX {
+            self.v.iter_mut().for_each(|x| *x = 0);
+            self.mark = 0;
+        }
+        self.mark += 1;
+        self.mark
+    }
+}
+
+/// Calls `f(point, distance)` for every point of `index` within `radius`
+/// of the primitive `fit` and over its footprint `foot` (each once).
+pub(super) fn for_near(
+    fit: &Primitive,
+    foot: &Footprint,
+    radius: f64,
+    points: &[[f64; 3]],
+    index: &KdTree,
+    stamps: &mut Stamps,
+    f: &mut dyn FnMut(u32, f64),
+) {
+    let mark = stamps.next();
+    let stamp = &mut stamps.v;
+    // One ball per block of cells about 2·radius wide (one cell while the
+    // radius is under half a cell): with a radius many cells wide, a ball
+    // per cell would visit each point once per cell within its reach.
+    let b = ((2.0 * radius / foot.cell).ceil() as usize).max(1);
+    for (centre, half) in foot.blocks(b) {
+        let r = (half * half + radius * radius).sqrt();
+        index.within(&centre, r, |i| {
+            if stamp[i as usize] == mark {
+                return;
+            }
+            let p = &points[i as usize];
+            let d = fit.distance(p);
+            if d <= radius && foot.contains(p) {
+                stamp[i as usize] = mark;
+                f(i, d);
+            }
+        });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::detect::fit::{fit_line_indices, fit_plane_indices};
+    use crate::rng::SplitMix64;
+
+    #[test]
+    fn a_footprint_is_the_seeds_cells_grown_by_one() {
+        // Seeds at x = 0.5, 1.5, 8.5 on the x axis: cells of side 1 from
+        // their centroid 3.5, along the fitted direction (±x). Covered are
+        // their cells and the next ones: x within 1.5 of 1 or of 8.5,
+        // rounded to the cells (either sign of the direction covers
+        // [−0.5, 2.5] and [7.5, 9.5], and neither x < −1.5, (3.5, 6.5] nor
+        // x > 10.5).
+        let pts: Vec<[f64; 3]> = [0.5, 1.5, 8.5].iter().map(|&x| [x, 0.0, 0.0]).collect();
+        let fit = Primitive::Line(fit_line_indices(&pts, &[0, 1, 2]).unwrap());
+        let foot = Footprint::new(&fit, &pts, &[0, 1, 2], 1.0).unwrap();
+        let along = |x: f64| foot.contains(&[x, 0.0, 0.0]);
+        for x in [-0.4, 0.5, 2.4, 7.6, 8.5, 9.4] {
+            assert!(along(x), "{x}");
+        }
+        for x in [-1.6, 3.6, 5.0, 6.4, 10.6] {
+            assert!(!along(x), "{x}");
+        }
+        // A line's footprint is along it: a point beside it projects in.
+        assert!(foot.contains(&[0.5, 5.0, -3.0]));
+        // Seven cells along, and the growth marks the rows beside them (a
+        // line's length is taken from its points' span, not its cells).
+        assert_eq!(foot.count(), 21);
+        assert!(Footprint::new(&fit, &pts, &[], 1.0).is_none());
+        assert!(Footprint::new(&Primitive::None, &pts, &[0], 1.0).is_none());
+    }
+
+    #[test]
+    fn too_many_cells_double_the_cell() {
+        // Two seeds 1e5 cells apart on a plane would need 1e10 cells.
+        let pts = [[0.0, 0.0, 0.0], [1e5, 1e5, 0.0], [1e5, 0.0, 0.0]];
+        let fit = Primitive::Plane(fit_plane_indices(&pts, &[0, 1, 2]).unwrap());
+        let foot = Footprint::new(&fit, &pts, &[0, 1, 2], 1.0).unwrap();
+        assert!(foot.cell >= 16.0, "{}", foot.cell);
+        assert!(foot.dims[0] * foot.dims[1] <= MAX_CELLS);
+        assert!(pts.iter().all(|p| foot.contains(p)));
+    }
+
+    #[test]
+    fn near_points_by_blocks_are_the_brute_force_set() {
+        // A plane and a line candidate among random points; for radii from
+        // a tenth of a cell to ten cells (one ball per cell, then blocks),
+        // `for_near` reports each point within the radius and over the
+        // footprint exactly once.
+        let mut rng = SplitMix64::new(21);
+        let pts: Vec<[f64; 3]> = (0..4000)
+            .map(|_| {
+                [
+                    10.0 * rng.uniform(),
+                    10.0 * rng.uniform(),
+                    2.0 * rng.uniform() - 1.0,
+                ]
+            })
+            .collect();
+        let seeds_plane: Vec<u32> = (0..4000u32)
+            .filter(|&i| {
+                let p = pts[i as usize];
+                p[2].abs() < 0.2 && (p[0] < 4.0 || p[1] > 6.0)
+            })
+            .collect();
+        let seeds_line: Vec<u32> = (0..4000u32)
+            .filter(|&i| {
+                let p = pts[i as usize];
+                p[2].abs() < 0.3 && (p[1] - 5.0).abs() < 0.3 && p[0] < 7.0
+            })
+            .collect();
+        let index = KdTree::new(&pts, None);
+        let mut stamps = Stamps::new(pts.len());
+        for (seeds, line) in [(&seeds_plane, false), (&seeds_line, true)] {
+            let fit = if line {
+                Primitive::Line(fit_line_indices(&pts, seeds).unwrap())
+            } else {
+                Primitive::Plane(fit_plane_indices(&pts, seeds).unwrap())
+            };
+            let foot = Footprint::new(&fit, &pts, seeds, 0.3).unwrap();
+            for radius in [0.03, 0.1, 0.3, 0.7, 1.5, 3.0] {
+                let mut got = Vec::new();
+                for_near(
+                    &fit,
+                    &foot,
+                    radius,
+                    &pts,
+                    &index,
+                    &mut stamps,
+                    &mut |i, d| got.push((i, d)),
+                );
+                got.sort_by_key(|a| a.0);
+                let want: Vec<(u32, f64)> = (0..pts.len() as u32)
+                    .filter_map(|i| {
+                        let p = &pts[i as usize];
+                        let d = fit.distance(p);
+                        (d <= radius && foot.contains(p)).then_some((i, d))
+                    })
+                    .collect();
+                assert_eq!(got, want, "line {line}, radius {radius}");
+                // (not vacuous: from 0.3 on, dozens of points at least)
+                assert!(radius < 0.3 || want.len() > 20, "{}", want.len());
+            }
+        }
+    }
+}
