@@ -213,4 +213,10 @@ fn normals_that_disagree_with_the_points_are_ignored() {
     let g = d.given_normals().unwrap();
     assert!(g.used && g.agreement > 0.9, "{g:?}");
     assert_eq!(d.normals_given(), Some(points.len()));
+    // Normals given to a detector made otherwise ([`Detector::normals`])
+    // pass the same check when it runs: the placeholder gates nothing.
+    let explicit = Detector::auto(StructureKind::Planes, &points, &given)
+        .unwrap()
+        .normals(&placeholder);
+    assert_eq!(explicit.run(&points).unwrap(), plain);
 }

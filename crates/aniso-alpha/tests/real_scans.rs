@@ -232,20 +232,19 @@ fn building_planes_from_the_data() {
     // reads them) and without (`--ignore-normals`).
     //
     // With them: 11 of the 11 labelled planes of >= 1,000 points, F1
-    // 0.907 (stop 24): window frames and ledges within a facade's claim
-    // radius, whose normals run across it, stay out of it.
+    // 0.907: window frames and ledges within a facade's claim radius,
+    // whose normals run across it, stay out of it.
     //
-    // Without: 11/11, F1 0.847. Before stop 23: 9/11, F1 0.817. A wall
-    // whose two pieces, 29 m apart, fit planes 0.37 m apart was two parts
-    // until the part merging tested the plane fitted to both pieces
-    // (`assemble::joint_plane_keeps`); a facade that the labels count as
-    // one plane, 1.5 m deep, lost half its points until a noisy plane's
-    // claim radius could widen.
+    // Without: 11/11, F1 0.847. A wall whose two pieces, 29 m apart, fit
+    // planes 0.37 m apart is one part through the plane fitted to both
+    // pieces (`assemble::same::joint_plane_keeps`); a facade that the
+    // labels count as one plane, 1.5 m deep, keeps its points because a
+    // noisy plane's claim radius widens (`assemble::widen`).
     //
-    // Both: no part is a plane tilted through the floors of two storeys.
-    // Pairwise merging once chained small horizontal patches 5 m apart in
-    // height into one part with an RMS of 2.3 m; the parts' largest RMS is
-    // 0.4-0.7 m (the facade across its recesses).
+    // Both: no part is a plane tilted through the floors of two storeys
+    // (pairwise merging would chain small horizontal patches 5 m apart in
+    // height into one part with an RMS of 2.3 m); the parts' largest RMS
+    // is 0.4-0.7 m (the facade across its recesses).
     let (points, truth, normals) = fixture_with_normals("building.ply");
     let truth = truth.unwrap();
     let normals = normals.expect("the building keeps its normals");

@@ -72,7 +72,7 @@ fn cell_radius(p: [&[f64; 3]; 4], alpha: f64) -> f64 {
     // circumcircle, so r ≥ R_face = |e1|·|e2|·|e3| / (2·|e1 × e2|), and
     // for such a face |e1 × e2| is tiny even with its error bound: the
     // cell is certified out of F_α without the exact radius (whose
-    // expansion arithmetic was 60% of a detection of lines on exactly
+    // expansion arithmetic takes 60% of a detection of lines on exactly
     // collinear points).
     let lo = [(b, c), (c, d), (d, b)]
         .iter()

@@ -246,22 +246,7 @@ mod tests {
         }
         let members: Vec<u32> = (start..pts.len() as u32).collect();
         let fit = Primitive::Plane(fit_plane_indices(pts, &members).unwrap());
-        let foot = super::super::Footprint::new(&fit, pts, &members, 1.0).unwrap();
-        let c = Candidate {
-            fit: fit.clone(),
-            tau: 0.05,
-            cell: 1.0,
-            seeds: members.clone(),
-            foot,
-        };
-        let d = Draft {
-            members,
-            fit,
-            cand,
-            pieces: Vec::new(),
-            log10_nfa: -(cand as f64),
-        };
-        (d, c)
+        Draft::with_candidate(pts, members, fit, cand, (0.05, 1.0))
     }
 
     #[test]

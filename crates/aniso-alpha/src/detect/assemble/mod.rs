@@ -103,6 +103,36 @@ pub(crate) struct Draft {
     log10_nfa: f64,
 }
 
+#[cfg(test)]
+impl Draft {
+    /// For the stages' tests: a part of `members` with the primitive `fit`
+    /// (and log₁₀ NFA −`cand`), and its candidate, number `cand`, of claim
+    /// radius `tau` and footprint cell `cell`.
+    fn with_candidate(
+        points: &[[f64; 3]],
+        members: Vec<u32>,
+        fit: Primitive,
+        cand: usize,
+        (tau, cell): (f64, f64),
+    ) -> (Draft, Candidate) {
+        let c = Candidate {
+            foot: Footprint::new(&fit, points, &members, cell).expect("a footprint"),
+            fit: fit.clone(),
+            tau,
+            cell,
+            seeds: members.clone(),
+        };
+        let d = Draft {
+            members,
+            fit,
+            cand,
+            pieces: Vec::new(),
+            log10_nfa: -(cand as f64),
+        };
+        (d, c)
+    }
+}
+
 /// The assembly (module doc) of the cleaned union `kept` of `cloud`, whose
 /// simplices were found by the groups `group`; `stats` holds the scan's
 /// figures.

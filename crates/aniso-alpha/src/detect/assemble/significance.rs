@@ -120,24 +120,9 @@ mod tests {
 
     /// A part of the points `members` of `pts` fitted as a line, with its
     /// candidate (τ 0.5, cell 5).
-    fn line_part(pts: &[[f64; 3]], members: Vec<u32>) -> (Draft, Candidate) {
+    fn line_part(pts: &[[f64; 3]], members: Vec<u32>, cand: usize) -> (Draft, Candidate) {
         let fit = Primitive::Line(fit_line_indices(pts, &members).unwrap());
-        let foot = Footprint::new(&fit, pts, &members, 5.0).unwrap();
-        let cand = Candidate {
-            fit: fit.clone(),
-            tau: 0.5,
-            cell: 5.0,
-            seeds: members.clone(),
-            foot,
-        };
-        let part = Draft {
-            members,
-            fit,
-            cand: 0,
-            pieces: Vec::new(),
-            log10_nfa: f64::NEG_INFINITY,
-        };
-        (part, cand)
+        Draft::with_candidate(pts, members, fit, cand, (0.5, 5.0))
     }
 
     #[test]
@@ -154,10 +139,9 @@ mod tests {
         pts.extend([[10.0, 10.0, 10.0], [13.0, 10.2, 10.0], [16.0, 9.9, 10.1]]);
         let copies = Copies::none(pts.len());
         let cloud = Cloud::new(&pts, &copies);
-        let (line, cand_line) = line_part(&pts, (n..n + 30).collect());
-        let (triple, cand_triple) = line_part(&pts, (n + 30..n + 33).collect());
+        let (line, cand_line) = line_part(&pts, (n..n + 30).collect(), 0);
+        let (triple, cand_triple) = line_part(&pts, (n + 30..n + 33).collect(), 1);
         let mut parts = vec![line, triple];
-        parts[1].cand = 1;
         let rejected = reject::<[u32; 2]>(&mut parts, &[cand_line, cand_triple], &cloud, 0.0);
         assert_eq!(rejected, 1);
         assert_eq!(parts.len(), 1);

@@ -213,21 +213,7 @@ mod tests {
     /// candidate (number `cand`).
     fn part(pts: &[[f64; 3]], members: Vec<u32>, cand: usize) -> (Draft, Candidate) {
         let fit = Primitive::Line(fit_line_indices(pts, &members).unwrap());
-        let c = Candidate {
-            fit: fit.clone(),
-            tau: 0.1,
-            cell: 1.0,
-            foot: super::super::Footprint::new(&fit, pts, &members, 1.0).unwrap(),
-            seeds: members.clone(),
-        };
-        let d = Draft {
-            fit,
-            members,
-            cand,
-            pieces: Vec::new(),
-            log10_nfa: -(cand as f64),
-        };
-        (d, c)
+        Draft::with_candidate(pts, members, fit, cand, (0.1, 1.0))
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! The structure detector (paper §4.3, method doc §4): its parameters, and
-//! the run that chains the steps: the orientation scan (`detect::scan`),
-//! the union and its clean-up, and the assembly of structures and parts
-//! (`detect::assemble`).
+//! (in `run`) the run that chains the steps: the run's regime and cloud
+//! context once, the orientation scan (`detect::scan`), the union and its
+//! clean-up, and the assembly of structures and parts (`detect::assemble`).
 //!
 //! Parameters come from the user ([`Detector::lines`],
 //! [`Detector::planes`]) or from the data ([`Detector::auto`], method doc
@@ -15,12 +15,14 @@
 //! union is sorted.
 //!
 //! After the scan, on the union (set semantics): whole connected components
-//! with fewer than `nb_c` simplices are dropped (the path filter is *not*
-//! re-applied: for k = 2 the union holds triangles of different
-//! triangulations of one plane, which the path filter would shred); then
-//! the assembly splits components into disjoint straight or flat parts with
-//! fitted lines and planes, outlines and segments, tests their
-//! significance, groups them into structures, and labels every point.
+//! with fewer simplices than the scan's path-filter threshold (nb_c, or
+//! for lines under the significance test the shorter one measured from
+//! the background) are dropped (the path filter is *not* re-applied: for
+//! k = 2 the union holds triangles of different triangulations of one
+//! plane, which the path filter would shred); then the assembly splits
+//! components into disjoint straight or flat parts with fitted lines and
+//! planes, outlines and segments, tests their significance, groups them
+//! into structures, and labels every point.
 //!
 //! ```
 //! use aniso_alpha::detect::Detector;
@@ -572,4 +574,49 @@ pub(crate) fn check_points(points: &[[f64; 3]]) -> Result<(), DetectError> {
         return Err(DetectError::OutOfRange { index });
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::SplitMix64;
+
+    /// Three perpendicular walls (a 0.1 grid, 5 mm of noise) meeting at a
+    /// corner, and their true normals.
+    fn corner() -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
+        let mut rng = SplitMix64::new(5);
+        let (mut points, mut normals) = (Vec::new(), Vec::new());
+        for i in 1..30 {
+            for j in 1..30 {
+                let (u, v) = (i as f64 * 0.1, j as f64 * 0.1);
+                let mut e = || 0.01 * (rng.uniform() - 0.5);
+                points.extend([[u, v, e()], [e(), u, v], [u, e(), v]]);
+                normals.extend([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
+            }
+        }
+        (points, normals)
+    }
+
+    #[test]
+    fn explicit_normals_gate_the_claims_only_if_they_agree_with_the_points() {
+        let (points, truth) = corner();
+        let planes = Detector::planes(0.05, 4.0, 4.0, 20);
+        let gate = |d: &Detector| d.regime(&points).claim_normals().map(<[_]>::len);
+        assert_eq!(gate(&planes.clone().normals(&truth)), Some(points.len()));
+        // One placeholder direction: a third of the planar points agree.
+        let placeholder = vec![[0.0, 0.0, 1.0]; points.len()];
+        assert_eq!(gate(&planes.clone().normals(&placeholder)), None);
+        assert_eq!(gate(&planes), None);
+        // Lines ignore normals.
+        let lines = Detector::lines(0.05, 4.0, 4).normals(&truth);
+        assert_eq!(gate(&lines), None);
+        // The verdict of `auto_oriented` is kept, and new normals are
+        // checked again.
+        let given = Given::default();
+        let auto =
+            Detector::auto_oriented(StructureKind::Planes, &points, &truth, &given, 12).unwrap();
+        assert!(auto.given_normals().is_some_and(|g| g.used));
+        assert_eq!(gate(&auto), Some(points.len()));
+        assert_eq!(gate(&auto.normals(&placeholder)), None);
+    }
 }

@@ -248,6 +248,41 @@ pub(crate) fn straight_filter(
 #[cfg(test)]
 mod straight_tests {
     use super::*;
+    use crate::detect::StructureKind;
+
+    #[test]
+    fn short_lines_take_their_threshold_from_the_background() {
+        // The paper's lines scene: 1,550 points, 162 orientations.
+        let chance = |x: f64| ChanceScale {
+            points: 1550.0,
+            orientations: 162.0,
+            per_ellipsoid: x,
+        };
+        let lines = Regime::new(StructureKind::Lines, Some(1.0), false, None);
+        // At the paper's density, paths of two edges (25 by chance) and
+        // turns up to 60°.
+        let sf = ScanFilter::new(&lines, 4, chance(0.01));
+        assert_eq!((sf.nb_c, sf.straight_cos), (2, Some(0.5)));
+        // At 10×, the user's nb_c (three edges: 251 by chance) and 18°.
+        let sf = ScanFilter::new(&lines, 4, chance(0.1));
+        assert_eq!(sf.nb_c, 4);
+        assert!((sf.straight_cos.unwrap() - 0.95).abs() < 1e-12);
+        // The data's orientations: short paths, no straight chains.
+        let data = Regime::new(StructureKind::Lines, Some(1.0), true, None);
+        let sf = ScanFilter::new(&data, 4, chance(0.01));
+        assert_eq!((sf.nb_c, sf.straight_cos), (2, None));
+        // Planes, and lines without the test: the paper's filter.
+        for kind in [StructureKind::Planes, StructureKind::Lines] {
+            let paper = Regime::new(
+                kind,
+                (kind == StructureKind::Planes).then_some(1.0),
+                false,
+                None,
+            );
+            let sf = ScanFilter::new(&paper, 4, chance(0.01));
+            assert_eq!((sf.nb_c, sf.straight_cos), (4, None));
+        }
+    }
 
     /// A chain of ten points along x with a stray point beside its middle,
     /// joined to four chain points (a fan of triangles' edges).
@@ -260,7 +295,7 @@ mod straight_tests {
     }
 
     #[test]
-    fn a_fan_no_longer_shreds_a_chain() {
+    fn a_fan_does_not_shred_a_chain() {
         let (points, edges) = chain_with_fan();
         // The paper's filter: the fan's ramifications cut the chain into
         // pieces of one to three edges, all deleted at nb_c = 4.
