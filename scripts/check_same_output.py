@@ -47,21 +47,11 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 REAL = os.path.join(ROOT, "crates", "aniso-alpha", "tests", "fixtures", "real")
 
-VARIANTS = {
-    "base": [],
-    "jitter05": ["--jitter-d", "0.05"],
-    "jitter10": ["--jitter-d", "0.1"],
-    "random": ["--random-sampling"],
-    "bg3": ["--density", "0.03"],
-    "bg10": ["--density", "0.1"],
-    "crossing": ["--crossing"],
-}
-KINDS = ["lines", "planes", "polyhedron"]
-PAPER = {
-    "lines": ["--structure", "lines", "--alpha", "1", "--lambda3", "10", "--min-size", "4"],
-    "planes": ["--structure", "planes", "--alpha", "1", "--lambda2", "4", "--lambda3", "8",
-               "--min-size", "20"],
-}
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+# The variants of the robustness table (short name -> long name), how each
+# makes a scene, and the paper's explicit parameters.
+from eval_robustness import KINDS, PAPER, SHORT, variant_args  # noqa: E402
+
 # Voxel side (m) to which each simulated scan is thinned (scripts/bench_real.py).
 SIM_VOXEL = {"room": 0.03, "house": 0.08}
 # Explicit parameters for the real scans over the data's orientations: the
@@ -75,14 +65,8 @@ TIMING_FIELDS = ("seconds", "timings")
 
 
 def synth_args(kind, variant):
-    """`synth` options of a variant, or None where the variant does not apply."""
-    a = list(VARIANTS[variant])
-    if variant == "crossing":
-        if kind == "polyhedron":
-            return None
-        if kind == "planes":
-            a = ["--structures", "2", "--crossing"]
-    return a
+    """`synth` options of a variant (short name), or None where it does not apply."""
+    return variant_args(SHORT[variant], kind)
 
 
 def make_scene(binary, work, kind, variant, seed):
@@ -120,7 +104,7 @@ def cases(args, work):
     out = []
     for seed in args.seeds:
         for kind in KINDS:
-            for variant in VARIANTS:
+            for variant in SHORT:
                 if synth_args(kind, variant) is None:
                     continue
                 scene = make_scene(args.base, work, kind, variant, seed)
