@@ -52,8 +52,27 @@
 //! 5. **nb_c** = [`NB_C_AUTO`]: the path filter then only cuts spurs and
 //!    fins of a few simplices; what is chance is decided by the
 //!    significance test ([`super::significance`]).
+//! 6. **Sparse structures: the scale ladder.** The local shapes describe a
+//!    cloud whose points mostly lie on dense structures. Where structures
+//!    are sparse against their background (the paper's own scenes: lines
+//!    of ten points spaced like the background's nearest neighbours), a
+//!    structure point's neighbourhood is mostly background, the few points
+//!    that look structured do so by chance, and their modes are not the
+//!    structures' directions. So when the structure-like members of the
+//!    modes are fewer than [`EXPLAINED_MIN`] of the points that can be
+//!    structure (for lines, those not on surfaces), the run scans instead
+//!    a [`Ladder`]: the Fibonacci sampler at [`LADDER_STEP_DEG`] over those
+//!    points, λ = [`LAMBDA_MAX`], and the α of each of
+//!    [`LADDER_LEVELS`] (reach C_REACH·d·level, d the median
+//!    nearest-neighbour distance). Each level is assembled apart up to the
+//!    significance test, and the parts are kept across levels by the
+//!    exclusion principle (`assemble::select`): the significance test, not
+//!    an estimate, chooses the scale of each structure. The levels share
+//!    each rotation's triangulation (the Delaunay tetrahedralization of
+//!    Q·P does not depend on α).
 //!
-//! Explicit values override the estimates (for every mode).
+//! Explicit values override the estimates (for every mode); with α or λ
+//! given, no ladder.
 
 use super::detection::{distinct_count, position_key};
 use super::local::{local_shapes, LocalShape};

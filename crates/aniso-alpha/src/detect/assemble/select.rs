@@ -125,3 +125,68 @@ fn rest_of<S: Shape>(
     }
     one.pop()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::detect::cloud::Copies;
+    use crate::detect::fit::fit_line_indices;
+    use crate::detect::StructureKind;
+    use crate::rng::SplitMix64;
+
+    /// A part of the points `members` fitted as a line, its candidate
+    /// numbered `cand` (τ 0.5, cell 5), with log₁₀ NFA `nfa`.
+    fn line_part(
+        pts: &[[f64; 3]],
+        members: Vec<u32>,
+        cand: usize,
+        nfa: f64,
+    ) -> (Draft, super::super::Candidate) {
+        let fit = Primitive::Line(fit_line_indices(pts, &members).unwrap());
+        let (mut d, c) = Draft::with_candidate(pts, members, fit, cand, (0.5, 5.0));
+        d.log10_nfa = nfa;
+        (d, c)
+    }
+
+    #[test]
+    fn the_most_significant_part_wins_and_what_a_chance_part_keeps_is_tested_again() {
+        // 2,000 background points in a 100-unit cube and 30 aligned points.
+        let mut rng = SplitMix64::new(5);
+        let mut pts: Vec<[f64; 3]> = (0..2000)
+            .map(|_| [0, 1, 2].map(|_| 100.0 * rng.uniform()))
+            .collect();
+        let n = pts.len() as u32;
+        pts.extend((0..30).map(|i| [20.0 + 2.0 * i as f64, 50.0, 50.0]));
+        let copies = Copies::none(pts.len());
+        let cloud = Cloud::new(&pts, &copies);
+        let regime = Regime::new(StructureKind::Lines, Some(1.0), false, None);
+        let line: Vec<u32> = (n..n + 30).collect();
+        // The line, found at a fine level.
+        let (a, ca) = line_part(&pts, line.clone(), 0, -40.0);
+        // The same line at a coarser level, less significant, with two of
+        // its points missing: a majority is taken, it goes.
+        let (b, cb) = line_part(&pts, line[2..].to_vec(), 1, -30.0);
+        // A chance part of a coarse level that crossed the line: 12 of
+        // its points and 12 background ones. What it keeps is background,
+        // not significant on its own: it goes too.
+        let mut mixed: Vec<u32> = line[..12].to_vec();
+        mixed.extend(0..12u32);
+        mixed.sort_unstable();
+        let (c, cc) = line_part(&pts, mixed, 2, -5.0);
+        let parts = exclusion::<[u32; 2]>(vec![c, b, a], &[ca, cb, cc], &cloud, &regime, 5);
+        assert_eq!(parts.len(), 1);
+        assert_eq!(parts[0].members, line);
+        assert_eq!(parts[0].cand, 0);
+        // Without the test, the chance part's rest stays (it is checked
+        // only for its size).
+        let (a, ca) = line_part(&pts, line.clone(), 0, -40.0);
+        let mut mixed: Vec<u32> = line[..12].to_vec();
+        mixed.extend(0..12u32);
+        mixed.sort_unstable();
+        let (c, cc) = line_part(&pts, mixed, 1, -5.0);
+        let paper = Regime::new(StructureKind::Lines, None, false, None);
+        let parts = exclusion::<[u32; 2]>(vec![c, a], &[ca, cc], &cloud, &paper, 5);
+        assert_eq!(parts.len(), 2);
+        assert_eq!(parts[1].members, (0..12).collect::<Vec<u32>>());
+    }
+}
