@@ -35,7 +35,7 @@ mod path_filter;
 pub(crate) use path_filter::{filter_job, ChanceScale, ScanFilter, LINE_SCAN_MIN};
 
 use super::detection::Primitive;
-use super::faces::{edges_at, triangles_at};
+use super::faces::{edges_at, edges_at_levels, triangles_at};
 use super::filter::{FilterError, Simplex};
 use super::fit::{fit_line_indices, fit_plane_indices};
 use super::parts::{linear_parts, planar_parts, PartsError};
@@ -54,6 +54,10 @@ pub(crate) trait Face: Simplex + AsRef<[u32]> + Send + Sync + 'static {
     const K: usize;
     /// `F_{k,α}` of a triangulation.
     fn at(tri: &Triangulation, alpha: f64) -> Vec<Self>;
+    /// `F_{k,α}` of a triangulation at each α of `alphas`.
+    fn at_levels(tri: &Triangulation, alphas: &[f64]) -> Vec<Vec<Self>> {
+        alphas.iter().map(|&a| Self::at(tri, a)).collect()
+    }
     /// The simplex of the given vertices, sorted.
     fn sorted(v: impl Iterator<Item = u32>) -> Self;
     /// Straight or flat parts of a set of simplices.
@@ -66,6 +70,9 @@ impl Face for [u32; 2] {
     const K: usize = 1;
     fn at(tri: &Triangulation, alpha: f64) -> Vec<Self> {
         edges_at(tri, alpha)
+    }
+    fn at_levels(tri: &Triangulation, alphas: &[f64]) -> Vec<Vec<Self>> {
+        edges_at_levels(tri, alphas)
     }
     fn sorted(mut v: impl Iterator<Item = u32>) -> Self {
         let mut s = [v.next().unwrap_or(0), v.next().unwrap_or(0)];
@@ -199,10 +206,10 @@ pub(crate) fn faces_at<S: Face>(
         q.extend(sentinels(lo, hi, top));
         tri = Triangulation::new(&q).map_err(ScanError::Triangulation)?;
     }
-    Ok(alphas
-        .iter()
-        .map(|&alpha| {
-            S::at(&tri, alpha)
+    Ok(S::at_levels(&tri, alphas)
+        .into_iter()
+        .map(|faces| {
+            faces
                 .into_iter()
                 .filter(|f| f.as_ref().iter().all(|&v| v < n_real))
                 .map(|f| S::sorted(f.as_ref().iter().map(|&v| map[v as usize])))
