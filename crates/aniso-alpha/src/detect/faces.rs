@@ -171,79 +171,107 @@ pub fn triangles_at(tri: &Triangulation, alpha: f64) -> Vec<[u32; 3]> {
 
 /// The edges of `F_{1,α}`: input-index pairs, ascending within each.
 pub fn edges_at(tri: &Triangulation, alpha: f64) -> Vec<[u32; 2]> {
-    let mut out = Vec::new();
+    edges_at_levels(tri, &[alpha]).pop().unwrap_or_default()
+}
+
+/// [`edges_at`] at each α of `alphas`, in one pass over the edges: an
+/// edge's ring of tets and its Gabriel test do not depend on α.
+pub(crate) fn edges_at_levels(tri: &Triangulation, alphas: &[f64]) -> Vec<Vec<[u32; 2]>> {
+    let mut out = vec![Vec::new(); alphas.len()];
     if tri.dimension() < 3 {
         return out;
     }
-    let r = cell_radii(tri, alpha);
+    let top = alphas.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let radii: Vec<Vec<f64>> = alphas.iter().map(|&a| cell_radii(tri, a)).collect();
     let mut ring: Vec<u32> = Vec::new();
     for e in tri.edges() {
         let [a, b] = e.vertices;
         let (pa, pb) = (tri.point(a), tri.point(b));
         let d = [pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]];
         let rho = 0.5 * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-        if rho > alpha {
+        if rho > top {
             continue;
         }
         ring.clear();
         ring.extend(tri.edge_ring(&e));
-        let amax = ring.iter().map(|&t| r[t as usize]).fold(0.0, f64::max);
-        if alpha > amax {
-            continue;
-        }
-        // Gabriel: no vertex of an incident tet strictly inside the
-        // diametral sphere.
-        let gabriel = ring.iter().all(|&t| {
-            tri.tet(t)
-                .iter()
-                .filter(|&&w| w != a && w != b && w != INFINITE)
-                .all(|&w| !edge_diametral_side(pa, pb, tri.point(w)).is_negative())
-        });
-        let inside = gabriel || {
-            // α_min = min over incident triangles of their α_min: the
-            // triangle between consecutive ring tets.
-            (0..ring.len()).any(|k| {
-                let t = ring[k];
-                let n = ring[(k + 1) % ring.len()];
-                let v = tri.tet(t);
-                // The face of t shared with n: opposite the vertex of t not
-                // in n.
-                let Some(i) = (0..4).find(|&i| {
-                    tri.neighbor(t, i).0 == n && {
-                        let o = v[i];
-                        o != a && o != b
-                    }
-                }) else {
-                    return false;
-                };
-                let (nn, j) = tri.neighbor(t, i);
-                if FACE[i].iter().any(|&k| v[k] == INFINITE) {
-                    return false;
-                }
-                // α_min(triangle) ≤ α: an incident tet of radius ≤ α, or
-                // Gabriel with ρ ≤ α (then `triangle_in`'s α_max condition
-                // holds too: α < both radii here).
-                let (r0, r1) = (r[t as usize], r[nn as usize]);
-                if r0.min(r1) <= alpha {
-                    return true;
-                }
-                // The face as seen from the smaller tet id, as the interval
-                // complex numbers it (the rounding of ρ depends on the order).
-                let sides = if t < nn {
-                    [(t, i), (nn, j)]
-                } else {
-                    [(nn, j), (t, i)]
-                };
-                triangle_in(tri, &r, sides, alpha)
-            })
-        };
-        if inside {
-            let mut s = [tri.input_index(a), tri.input_index(b)];
-            s.sort_unstable();
-            out.push(s);
+        let mut gabriel: Option<bool> = None;
+        for (l, (&alpha, r)) in alphas.iter().zip(&radii).enumerate() {
+            if rho > alpha {
+                continue;
+            }
+            let amax = ring.iter().map(|&t| r[t as usize]).fold(0.0, f64::max);
+            if alpha > amax {
+                continue;
+            }
+            // Gabriel: no vertex of an incident tet strictly inside the
+            // diametral sphere.
+            let g = *gabriel.get_or_insert_with(|| edge_gabriel(tri, &ring, a, b));
+            if g || smallest_triangle_in(tri, r, &ring, a, b, alpha) {
+                let mut s = [tri.input_index(a), tri.input_index(b)];
+                s.sort_unstable();
+                out[l].push(s);
+            }
         }
     }
     out
+}
+
+/// Whether the edge `ab` is Gabriel: no vertex of a tet of its `ring`
+/// strictly inside its diametral sphere (exact).
+fn edge_gabriel(tri: &Triangulation, ring: &[u32], a: u32, b: u32) -> bool {
+    let (pa, pb) = (tri.point(a), tri.point(b));
+    ring.iter().all(|&t| {
+        tri.tet(t)
+            .iter()
+            .filter(|&&w| w != a && w != b && w != INFINITE)
+            .all(|&w| !edge_diametral_side(pa, pb, tri.point(w)).is_negative())
+    })
+}
+
+/// Whether a triangle incident to the edge `ab` (between consecutive tets
+/// of its `ring`) is in F_α: then the edge's α_min, the smallest α_min of
+/// its triangles when it is not Gabriel, is at most α.
+fn smallest_triangle_in(
+    tri: &Triangulation,
+    r: &[f64],
+    ring: &[u32],
+    a: u32,
+    b: u32,
+    alpha: f64,
+) -> bool {
+    (0..ring.len()).any(|k| {
+        let t = ring[k];
+        let n = ring[(k + 1) % ring.len()];
+        let v = tri.tet(t);
+        // The face of t shared with n: opposite the vertex of t not in n.
+        let Some(i) = (0..4).find(|&i| {
+            tri.neighbor(t, i).0 == n && {
+                let o = v[i];
+                o != a && o != b
+            }
+        }) else {
+            return false;
+        };
+        let (nn, j) = tri.neighbor(t, i);
+        if FACE[i].iter().any(|&k| v[k] == INFINITE) {
+            return false;
+        }
+        // α_min(triangle) ≤ α: an incident tet of radius ≤ α, or Gabriel
+        // with ρ ≤ α (then `triangle_in`'s α_max condition holds too: α <
+        // both radii here).
+        let (r0, r1) = (r[t as usize], r[nn as usize]);
+        if r0.min(r1) <= alpha {
+            return true;
+        }
+        // The face as seen from the smaller tet id, as the interval
+        // complex numbers it (the rounding of ρ depends on the order).
+        let sides = if t < nn {
+            [(t, i), (nn, j)]
+        } else {
+            [(nn, j), (t, i)]
+        };
+        triangle_in(tri, r, sides, alpha)
+    })
 }
 
 #[cfg(test)]
@@ -294,6 +322,12 @@ mod tests {
             spectrum.extend(spectrum.clone().windows(2).map(|w| 0.5 * (w[0] + w[1])));
             for &alpha in spectrum.iter().step_by(3) {
                 same_faces(&ac, &tri, alpha, seed);
+            }
+            // Every α at once gives each α's edges.
+            let alphas: Vec<f64> = spectrum.iter().copied().step_by(5).collect();
+            let at_once = edges_at_levels(&tri, &alphas);
+            for (&alpha, edges) in alphas.iter().zip(&at_once) {
+                assert_eq!(edges, &edges_at(&tri, alpha), "seed {seed}, alpha {alpha}");
             }
         }
     }

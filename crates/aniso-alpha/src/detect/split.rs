@@ -53,7 +53,7 @@
 use super::assemble::Shape;
 use super::cloud::{Cloud, Copies};
 use super::detection::{Detection, RunStats};
-use super::detector::{check_points, DetectError, Detector, OrientationSet};
+use super::detector::{check_points, filter_of, DetectError, Detector, OrientationSet};
 use super::regime::Regime;
 use super::scan::{
     faces_of, filter_job, halo_width, prune_radius, pruned, tile_cell, Face, Job, Pruning,
@@ -183,9 +183,14 @@ impl Detector {
                 group: j.group,
             })
             .collect();
-        let groups = match self.orientations() {
-            OrientationSet::Data(modes) => Some(modes.iter().map(|m| m.points.clone()).collect()),
-            _ => None,
+        let groups = match (self.ladder(), self.orientations()) {
+            (Some(l), _) => {
+                (l.points.len() < points.len()).then(|| vec![l.points.clone(); l.alphas.len()])
+            }
+            (None, OrientationSet::Data(modes)) => {
+                Some(modes.iter().map(|m| m.points.clone()).collect())
+            }
+            (None, _) => None,
         };
         Ok(Plan {
             step: Step {
@@ -374,12 +379,15 @@ impl Plan {
         }
         drop(outputs);
         let cloud = Cloud::new(points, &self.copies);
-        let sf = self.detector.scan_filter(&cloud, &self.regime, jobs.len());
+        let sf = self.detector.scan_filters(&cloud, &self.regime, jobs.len());
         let one = |(mut faces, job): (Vec<S>, &SplitJob)| -> Result<(usize, Vec<S>), DetectError> {
             faces.sort_unstable();
             faces.dedup();
             let raw = faces.len();
-            Ok((raw, filter_job(&faces, points, &job.anisotropy, sf)?))
+            Ok((
+                raw,
+                filter_job(&faces, points, &job.anisotropy, filter_of(&sf, job.group))?,
+            ))
         };
         #[cfg(feature = "parallel")]
         let filtered: Vec<Result<(usize, Vec<S>), DetectError>> = {
@@ -402,7 +410,7 @@ impl Plan {
         }
         let (_, scales) = self.detector.scan_jobs(self.detector.modes())?;
         self.detector
-            .finish_k(&cloud, &self.regime, found, scales, stats, sf)
+            .finish_k(&cloud, &self.regime, found, scales, stats, &sf)
     }
 }
 

@@ -81,6 +81,18 @@ impl Claims {
         Claims(claims)
     }
 
+    /// The claims of several runs' candidates, the candidates of run i
+    /// numbered from `offsets[i]` on.
+    pub(super) fn joined(runs: Vec<Claims>, offsets: &[u32]) -> Self {
+        let mut all: Vec<Claim> = runs
+            .into_iter()
+            .zip(offsets)
+            .flat_map(|(c, &o)| c.0.into_iter().map(move |(p, c, d)| (p, c + o, d)))
+            .collect();
+        all.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.cmp(&b.1)));
+        Claims(all)
+    }
+
     /// The claims of each claimed point, point after point.
     fn by_point(&self) -> impl Iterator<Item = &[Claim]> {
         self.0.chunk_by(|a, b| a.0 == b.0)

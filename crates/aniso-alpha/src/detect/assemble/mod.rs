@@ -40,6 +40,7 @@ mod claims;
 mod footprint;
 mod merging;
 mod same;
+mod select;
 mod shape;
 mod significance;
 mod structures;
@@ -133,17 +134,28 @@ impl Draft {
     }
 }
 
-/// The assembly (module doc) of the cleaned union `kept` of `cloud`, whose
-/// simplices were found by the groups `group`; `stats` holds the scan's
-/// figures.
-pub(crate) fn assemble<S: Shape>(
+/// The parts one scale (level) of a run found, before they meet the other
+/// levels' (stages 1–4): the candidates, their final claims, the parts
+/// that passed the significance test, and the cleaned union they come
+/// from.
+pub(crate) struct Level<S> {
+    cands: Vec<Candidate>,
+    claims: claims::Claims,
+    parts: Vec<Draft>,
+    kept: Vec<S>,
+}
+
+/// Stages 1–4 of the assembly on the cleaned union `kept` of one level of
+/// a run (its simplices found by the groups `group`); the parts the
+/// significance test rejects are counted in `stats`.
+pub(crate) fn level<S: Shape>(
     cloud: &Cloud<'_>,
     regime: &Regime,
     kept: Vec<S>,
     group: Vec<u32>,
     settings: &Settings,
-    mut stats: RunStats,
-) -> Result<Detection, FilterError> {
+    stats: &mut RunStats,
+) -> Result<Level<S>, FilterError> {
     let points = cloud.points();
     let angle = settings.part_angle_deg;
     // 1–2. Candidates and their footprints.
@@ -157,18 +169,38 @@ pub(crate) fn assemble<S: Shape>(
     let mut parts = claims::parts::<S>(&claims, cands.len(), points, settings.min_vertices);
     // 4. Significance.
     if let Some(log10_epsilon) = regime.significance() {
-        stats.rejected_parts = significance::reject::<S>(&mut parts, &cands, cloud, log10_epsilon);
+        stats.rejected_parts += significance::reject::<S>(&mut parts, &cands, cloud, log10_epsilon);
     }
+    Ok(Level {
+        cands,
+        claims,
+        parts,
+        kept,
+    })
+}
+
+/// Stages 5–6 of the assembly over the `levels` of a run: the parts kept
+/// across levels (the most significant first, `select`), one part per
+/// primitive, structures, outlines and labels.
+pub(crate) fn finish<S: Shape>(
+    cloud: &Cloud<'_>,
+    regime: &Regime,
+    mut levels: Vec<Level<S>>,
+    settings: &Settings,
+    stats: RunStats,
+) -> Detection {
+    let Level {
+        cands,
+        claims,
+        mut parts,
+        kept,
+    } = if levels.len() == 1 {
+        levels.pop().expect("one level")
+    } else {
+        select::across_levels::<S>(levels, cloud, regime, settings.min_vertices)
+    };
     // 5. One primitive, one part.
-    S::merge_apart(&mut parts, &cands, points, angle);
+    S::merge_apart(&mut parts, &cands, cloud.points(), settings.part_angle_deg);
     // 6. Structures, outlines, labels.
-    Ok(structures::detection::<S>(
-        cloud,
-        regime.kind(),
-        &parts,
-        &cands,
-        &claims,
-        &kept,
-        stats,
-    ))
+    structures::detection::<S>(cloud, regime.kind(), &parts, &cands, &claims, &kept, stats)
 }

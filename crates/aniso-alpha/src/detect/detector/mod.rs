@@ -38,10 +38,12 @@
 mod error;
 mod run;
 
+pub(crate) use run::filter_of;
+
 pub use error::DetectError;
 
 use super::estimate::{check_normals_agreement, estimate, estimate_oriented, mode_rotations};
-use super::estimate::{Estimate, Given, GivenNormals, ModeScan};
+use super::estimate::{Estimate, Given, GivenNormals, Ladder, ModeScan};
 use super::orientations::{orientations, Sampler};
 use super::regime::Regime;
 pub use super::StructureKind;
@@ -89,6 +91,7 @@ pub struct Detector {
     estimate: Option<Box<Estimate>>,
     normals: Option<Normals>,
     given_normals: Option<GivenNormals>,
+    ladder: Option<Ladder>,
     progress: Option<Progress>,
 }
 
@@ -151,6 +154,7 @@ impl Detector {
             estimate: None,
             normals: None,
             given_normals: None,
+            ladder: None,
             progress: None,
         }
     }
@@ -260,11 +264,38 @@ impl Detector {
                 e.min_size.value as u32,
             ),
         };
-        d.set = OrientationSet::Data(e.modes.clone());
+        match &e.ladder {
+            Some(l) => d = d.scale_ladder(kind, l),
+            None => d.set = OrientationSet::Data(e.modes.clone()),
+        }
         d.estimate = Some(Box::new(e));
         d.normals = normals.filter(|_| given_normals.is_some_and(|g| g.used));
         d.given_normals = given_normals;
         Ok(d)
+    }
+
+    /// This detector turned into a run of the scale ladder `l` (α per
+    /// level, one λ, the Fibonacci sampler over `l.points`; docs/method.md
+    /// §8): α is the ladder's largest.
+    fn scale_ladder(mut self, kind: StructureKind, l: &Ladder) -> Self {
+        self.alpha = l.alphas.iter().copied().fold(0.0, f64::max);
+        self.lambda2 = if kind == StructureKind::Planes {
+            l.lambda
+        } else {
+            1.0
+        };
+        self.lambda3 = l.lambda;
+        self.set = OrientationSet::Sampler(Sampler::Fibonacci {
+            step_degrees: l.step_deg,
+        });
+        self.ladder = Some(l.clone());
+        self
+    }
+
+    /// The scale ladder this detector runs, if [`Self::auto`] chose one
+    /// (docs/method.md §8).
+    pub fn ladder(&self) -> Option<&Ladder> {
+        self.ladder.as_ref()
     }
 
     /// Normals given with the points, one per point (a scan's `nx ny nz`;
@@ -431,7 +462,7 @@ impl Detector {
     pub fn orientation_count(&self) -> Result<usize, DetectError> {
         Ok(match &self.set {
             OrientationSet::Data(m) => m.iter().map(|m| m.rotations.len()).sum(),
-            _ => self.orientation_set()?.len(),
+            _ => self.orientation_set()?.len() * self.ladder.as_ref().map_or(1, |l| l.alphas.len()),
         })
     }
 

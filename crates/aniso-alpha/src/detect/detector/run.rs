@@ -4,16 +4,17 @@
 
 use super::{check_points, elongation, DetectError, Detector, Mat3};
 use crate::aniso::Anisotropy;
-use crate::detect::assemble::{assemble, Scale, Settings, Shape};
+use crate::detect::assemble::{self, Scale, Settings, Shape};
 use crate::detect::cloud::{Cloud, Copies};
 use crate::detect::detection::{Detection, RunStats};
-use crate::detect::estimate::ModeScan;
+use crate::detect::estimate::{Ladder, ModeScan};
 use crate::detect::filter::component_size_mask;
 use crate::detect::orientations::MAX_ORIENTATIONS;
 use crate::detect::prune::CandidatePairs;
 use crate::detect::regime::Regime;
 use crate::detect::scan::{
-    raw_faces, run_job, union, ChanceScale, Face, Job, JobResult, Pruning, ScanFilter, RADIUS_SLACK,
+    raw_faces, run_job, run_job_at, union, ChanceScale, Face, Job, JobResult, Pruning, ScanFilter,
+    RADIUS_SLACK,
 };
 use crate::detect::StructureKind;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -80,7 +81,8 @@ impl Detector {
         let sub: Vec<[f64; 3]> = distinct.iter().map(|&i| points[i as usize]).collect();
         let none = Copies::none(sub.len());
         let modes = modes_on_distinct(self.modes(), &copies);
-        let det = self.run_cloud(&Cloud::new(&sub, &none), &regime.on(distinct), &modes)?;
+        let on_distinct = self.ladder_on_distinct(&copies);
+        let det = on_distinct.run_cloud(&Cloud::new(&sub, &none), &regime.on(distinct), &modes)?;
         Ok(expand_distinct(det, copies))
     }
 
@@ -116,13 +118,30 @@ impl Detector {
         };
         let done = AtomicUsize::new(0);
         let cancelled = AtomicBool::new(false);
+        // With a scale ladder, the jobs of its top level (the largest α)
+        // each give every level's faces from one triangulation.
+        let levels: &[f64] = self.ladder.as_ref().map_or(&[], |l| &l.alphas);
+        let top = levels.len().saturating_sub(1) as u32;
+        let jobs: Vec<&Job<'_>> = jobs
+            .iter()
+            .filter(|j| levels.is_empty() || j.group == top)
+            .collect();
         let total = jobs.len();
-        let sf = self.scan_filter(cloud, regime, total);
-        let one = |job: &Job<'_>| -> Result<JobResult<S>, DetectError> {
+        let sf = self.scan_filters(cloud, regime, jobs.len() * levels.len().max(1));
+        let one = |job: &&Job<'_>| -> Result<Vec<(u32, JobResult<S>)>, DetectError> {
             if cancelled.load(Ordering::Relaxed) {
                 return Err(DetectError::Cancelled);
             }
-            let r = run_job::<S>(points, job, &pruning, self.tile, sf)?;
+            let r = if levels.is_empty() {
+                let sf = filter_of(&sf, job.group);
+                vec![(
+                    job.group,
+                    run_job::<S>(points, job, &pruning, self.tile, sf)?,
+                )]
+            } else {
+                let per = run_job_at::<S>(points, job, levels, &pruning, self.tile, &sf)?;
+                (0..).zip(per).collect()
+            };
             let d = done.fetch_add(1, Ordering::Relaxed) + 1;
             if let Some(cb) = &self.progress {
                 if !cb(d, total) {
@@ -132,35 +151,42 @@ impl Detector {
             Ok(r)
         };
         #[cfg(feature = "parallel")]
-        let per: Vec<Result<JobResult<S>, DetectError>> = {
+        let per: Vec<Result<Vec<(u32, JobResult<S>)>, DetectError>> = {
             use rayon::prelude::*;
             jobs.par_iter().map(one).collect()
         };
         #[cfg(not(feature = "parallel"))]
-        let per: Vec<Result<JobResult<S>, DetectError>> = jobs.iter().map(one).collect();
+        let per: Vec<Result<Vec<(u32, JobResult<S>)>, DetectError>> =
+            jobs.iter().map(one).collect();
         if cancelled.load(Ordering::Relaxed) {
             return Err(DetectError::Cancelled);
         }
         let mut stats = RunStats {
-            orientations: total,
+            orientations: total * levels.len().max(1),
             ..RunStats::default()
         };
         let mut found: Vec<(u32, Vec<S>)> = Vec::with_capacity(per.len());
-        for (r, job) in per.into_iter().zip(&jobs) {
-            let r = r?;
-            stats.triangulated_points += r.triangulated as u64;
-            stats.raw_simplices += r.raw as u64;
-            stats.filtered_simplices += r.faces.len() as u64;
-            found.push((job.group, r.faces));
+        for r in per {
+            for (group, r) in r? {
+                stats.triangulated_points += r.triangulated as u64;
+                stats.raw_simplices += r.raw as u64;
+                stats.filtered_simplices += r.faces.len() as u64;
+                found.push((group, r.faces));
+            }
         }
-        self.finish_k(cloud, regime, found, scales, stats, sf)
+        self.finish_k(cloud, regime, found, scales, stats, &sf)
     }
 
     /// Candidate pairs for the pruning, once for all orientations over
     /// every point, when the pruning is on, every orientation looks at
-    /// every point, and they are not too many.
+    /// every point (not a ladder over some of them), and they are not too
+    /// many.
     fn candidate_pairs(&self, points: &[[f64; 3]], regime: &Regime) -> Option<CandidatePairs> {
-        if !(self.prune && regime.scans_every_point()) {
+        let subset = self
+            .ladder
+            .as_ref()
+            .is_some_and(|l| l.points.len() < points.len());
+        if !(self.prune && regime.scans_every_point()) || subset {
             return None;
         }
         let lmax = self
@@ -176,26 +202,54 @@ impl Detector {
         )
     }
 
-    /// The path filter of each of the `orientations` orientations of a run
-    /// on `cloud` in `regime` (`scan::ScanFilter`).
-    pub(crate) fn scan_filter(
+    /// The path filters of a run of `orientations` orientations on `cloud`
+    /// in `regime` (`scan::ScanFilter`): one for every job, or with a
+    /// scale ladder one per level, at its α (see [`filter_of`]).
+    pub(crate) fn scan_filters(
         &self,
         cloud: &Cloud<'_>,
         regime: &Regime,
         orientations: usize,
-    ) -> ScanFilter {
-        let chance = ChanceScale::new(cloud, self.alpha, self.elongation(), orientations);
-        ScanFilter::new(regime, self.nb_c, chance)
+    ) -> Vec<ScanFilter> {
+        let e = self.elongation();
+        match &self.ladder {
+            None => vec![ScanFilter::new(
+                regime,
+                self.nb_c,
+                ChanceScale::new(cloud, self.alpha, e, orientations),
+            )],
+            Some(l) => {
+                let per_level = orientations / l.alphas.len().max(1);
+                l.alphas
+                    .iter()
+                    .map(|&a| {
+                        ScanFilter::new(regime, self.nb_c, ChanceScale::new(cloud, a, e, per_level))
+                    })
+                    .collect()
+            }
+        }
+    }
+
+    /// This detector with its ladder's points numbered among the distinct
+    /// points of a cloud with `copies`.
+    fn ladder_on_distinct(&self, copies: &Copies) -> Detector {
+        let mut d = self.clone();
+        if let Some(l) = &mut d.ladder {
+            l.points = on_distinct(&l.points, &distinct_index(copies));
+        }
+        d
     }
 
     /// The jobs of a run over the groups `modes` (none: this detector's
     /// sampler or rotations over every point), checked against
     /// [`MAX_ORIENTATIONS`], and the scale of each group.
     pub(crate) fn scan_jobs<'p>(
-        &self,
+        &'p self,
         modes: &'p [ModeScan],
     ) -> Result<(Vec<Job<'p>>, Vec<Scale>), DetectError> {
-        let (jobs, scales) = if modes.is_empty() {
+        let (jobs, scales) = if let Some(l) = &self.ladder {
+            self.ladder_jobs(l)?
+        } else if modes.is_empty() {
             self.sampler_jobs()?
         } else {
             self.mode_jobs(modes)?
@@ -232,6 +286,27 @@ impl Detector {
         Ok((jobs, scales))
     }
 
+    /// The jobs of a scale ladder: every rotation of the sampler over the
+    /// ladder's points at each level's α, the level as the group.
+    fn ladder_jobs<'p>(&self, l: &'p Ladder) -> Result<(Vec<Job<'p>>, Vec<Scale>), DetectError> {
+        let e = self.elongation();
+        let rotations = self.orientation_set()?;
+        let mut jobs = Vec::with_capacity(rotations.len() * l.alphas.len());
+        let mut scales = Vec::with_capacity(l.alphas.len());
+        for (g, &alpha) in l.alphas.iter().enumerate() {
+            for r in &rotations {
+                jobs.push(Job {
+                    anisotropy: Anisotropy::from_matrix_rows(*r, e)?,
+                    alpha,
+                    ids: Some(&l.points),
+                    group: g as u32,
+                });
+            }
+            scales.push(scale(self.kind, alpha, self.lambda2, self.lambda3));
+        }
+        Ok((jobs, scales))
+    }
+
     /// The jobs of a sampler or of explicit rotations: every rotation over
     /// every point, one group. (A data orientation set without modes has
     /// no rotations.)
@@ -255,8 +330,10 @@ impl Detector {
 
     /// The steps after the scan: the union of the jobs' filtered simplices
     /// (`found`: per job, its group and its simplices), the component
-    /// filter at the scan's threshold (`sf`) and the assembly. `stats`
-    /// holds the scan's figures.
+    /// filter at the scan's threshold (`sf`, [`Self::scan_filters`]) and
+    /// the assembly; with a scale ladder, each level (group) apart up to
+    /// the significance test, then the parts across levels
+    /// (`assemble::finish`). `stats` holds the scan's figures.
     pub(crate) fn finish_k<S: Shape>(
         &self,
         cloud: &Cloud<'_>,
@@ -264,33 +341,38 @@ impl Detector {
         found: Vec<(u32, Vec<S>)>,
         scales: Vec<Scale>,
         mut stats: RunStats,
-        sf: ScanFilter,
+        sf: &[ScanFilter],
     ) -> Result<Detection, DetectError> {
-        let (all, groups) = union(found);
-        stats.union_simplices = all.len();
-        let keep = component_size_mask(&all, sf.nb_c)?;
-        let mut kept = Vec::with_capacity(all.len());
-        let mut kept_groups = Vec::with_capacity(all.len());
-        for ((s, g), k) in all.into_iter().zip(groups).zip(keep) {
-            if k {
-                kept.push(s);
-                kept_groups.push(g);
-            }
-        }
-        stats.kept_simplices = kept.len();
-        let settings = Settings {
+        let settings = |scales: Vec<Scale>| Settings {
             part_angle_deg: self.part_angle_deg,
             min_vertices: S::min_vertices(self.nb_c),
             scales,
         };
-        Ok(assemble::<S>(
+        let Some(ladder) = &self.ladder else {
+            let (kept, groups) = cleaned_union(found, sf[0], &mut stats)?;
+            let s = settings(scales);
+            let level = assemble::level::<S>(cloud, regime, kept, groups, &s, &mut stats)?;
+            return Ok(assemble::finish::<S>(cloud, regime, vec![level], &s, stats));
+        };
+        let mut per_level: Vec<Vec<(u32, Vec<S>)>> = vec![Vec::new(); ladder.alphas.len()];
+        for (g, faces) in found {
+            per_level[g as usize].push((0, faces));
+        }
+        let mut levels = Vec::with_capacity(per_level.len());
+        for (g, found) in per_level.into_iter().enumerate() {
+            let (kept, groups) = cleaned_union(found, sf[g], &mut stats)?;
+            let s = settings(vec![scales[g]]);
+            levels.push(assemble::level::<S>(
+                cloud, regime, kept, groups, &s, &mut stats,
+            )?);
+        }
+        Ok(assemble::finish::<S>(
             cloud,
             regime,
-            kept,
-            kept_groups,
-            &settings,
+            levels,
+            &settings(scales),
             stats,
-        )?)
+        ))
     }
 
     /// The anisotropic α-shape `F_{k,α,Q}(P)` of one orientation (rows of
@@ -331,6 +413,36 @@ impl Detector {
     }
 }
 
+/// The union of the jobs' simplices `found` (per job, its group and its
+/// simplices) without its components smaller than the scan's threshold,
+/// with the group of each simplex; the union's and the kept simplices are
+/// counted in `stats`.
+fn cleaned_union<S: Face>(
+    found: Vec<(u32, Vec<S>)>,
+    sf: ScanFilter,
+    stats: &mut RunStats,
+) -> Result<(Vec<S>, Vec<u32>), DetectError> {
+    let (all, groups) = union(found);
+    stats.union_simplices += all.len();
+    let keep = component_size_mask(&all, sf.nb_c)?;
+    let mut kept = Vec::with_capacity(all.len());
+    let mut kept_groups = Vec::with_capacity(all.len());
+    for ((s, g), k) in all.into_iter().zip(groups).zip(keep) {
+        if k {
+            kept.push(s);
+            kept_groups.push(g);
+        }
+    }
+    stats.kept_simplices += kept.len();
+    Ok((kept, kept_groups))
+}
+
+/// The path filter of a job of group `group` among a run's filters `sf`
+/// ([`Detector::scan_filters`]): the run's one, or its level's.
+pub(crate) fn filter_of(sf: &[ScanFilter], group: u32) -> ScanFilter {
+    sf[(group as usize).min(sf.len() - 1)]
+}
+
 /// Simplices as vectors.
 fn rows<S: Face>(faces: Vec<S>) -> Vec<Vec<u32>> {
     faces.iter().map(|f| f.as_ref().to_vec()).collect()
@@ -353,23 +465,35 @@ fn scale(kind: StructureKind, alpha: f64, lambda2: f64, lambda3: f64) -> Scale {
 /// members are input indices (the estimate ran on the whole cloud), each
 /// becomes its position's index among the distinct points.
 fn modes_on_distinct(modes: &[ModeScan], copies: &Copies) -> Vec<ModeScan> {
+    let at = distinct_index(copies);
+    modes
+        .iter()
+        .map(|m| {
+            let mut m = m.clone();
+            m.points = on_distinct(&m.points, &at);
+            m
+        })
+        .collect()
+}
+
+/// Per input point, the index of its position among the distinct points
+/// of a cloud with `copies`.
+fn distinct_index(copies: &Copies) -> Vec<u32> {
     let (first, distinct) = (copies.first(), copies.distinct());
     let mut at = vec![0u32; first.len()];
     for (k, &i) in distinct.iter().enumerate() {
         at[i as usize] = k as u32;
     }
-    modes
-        .iter()
-        .map(|m| {
-            let mut m = m.clone();
-            for v in &mut m.points {
-                *v = at[first[*v as usize] as usize];
-            }
-            m.points.sort_unstable();
-            m.points.dedup();
-            m
-        })
-        .collect()
+    first.iter().map(|&f| at[f as usize]).collect()
+}
+
+/// Input indices `ids` as indices among the distinct points (`at`,
+/// [`distinct_index`]), ascending and without repeats.
+fn on_distinct(ids: &[u32], at: &[u32]) -> Vec<u32> {
+    let mut out: Vec<u32> = ids.iter().map(|&v| at[v as usize]).collect();
+    out.sort_unstable();
+    out.dedup();
+    out
 }
 
 /// The detection of a cloud with copies from that of its distinct points

@@ -35,7 +35,7 @@ mod path_filter;
 pub(crate) use path_filter::{filter_job, ChanceScale, ScanFilter, LINE_SCAN_MIN};
 
 use super::detection::Primitive;
-use super::faces::{edges_at, triangles_at};
+use super::faces::{edges_at, edges_at_levels, triangles_at};
 use super::filter::{FilterError, Simplex};
 use super::fit::{fit_line_indices, fit_plane_indices};
 use super::parts::{linear_parts, planar_parts, PartsError};
@@ -54,6 +54,10 @@ pub(crate) trait Face: Simplex + AsRef<[u32]> + Send + Sync + 'static {
     const K: usize;
     /// `F_{k,α}` of a triangulation.
     fn at(tri: &Triangulation, alpha: f64) -> Vec<Self>;
+    /// `F_{k,α}` of a triangulation at each α of `alphas`.
+    fn at_levels(tri: &Triangulation, alphas: &[f64]) -> Vec<Vec<Self>> {
+        alphas.iter().map(|&a| Self::at(tri, a)).collect()
+    }
     /// The simplex of the given vertices, sorted.
     fn sorted(v: impl Iterator<Item = u32>) -> Self;
     /// Straight or flat parts of a set of simplices.
@@ -66,6 +70,9 @@ impl Face for [u32; 2] {
     const K: usize = 1;
     fn at(tri: &Triangulation, alpha: f64) -> Vec<Self> {
         edges_at(tri, alpha)
+    }
+    fn at_levels(tri: &Triangulation, alphas: &[f64]) -> Vec<Vec<Self>> {
+        edges_at_levels(tri, alphas)
     }
     fn sorted(mut v: impl Iterator<Item = u32>) -> Self {
         let mut s = [v.next().unwrap_or(0), v.next().unwrap_or(0)];
@@ -168,26 +175,47 @@ fn sentinels(lo: [f64; 3], hi: [f64; 3], alpha: f64) -> [[f64; 3]; 4] {
 /// `owned_below` of `map` are halo points: a simplex is kept only when its
 /// smallest vertex (in input numbering) is owned.
 pub(crate) fn faces_of<S: Face>(
-    mut q: Vec<[f64; 3]>,
+    q: Vec<[f64; 3]>,
     map: &[u32],
     alpha: f64,
     owned: &dyn Fn(u32) -> bool,
 ) -> Result<Vec<S>, ScanError> {
+    Ok(faces_at::<S>(q, map, &[alpha], owned)?
+        .pop()
+        .unwrap_or_default())
+}
+
+/// [`faces_of`] at each α of `alphas` from one triangulation (the
+/// Delaunay tetrahedralization of Q·P does not depend on α; the points
+/// kept by a pruning at the largest α give every smaller α's faces too,
+/// since a point isolated at 2α is a vertex of no face at α).
+pub(crate) fn faces_at<S: Face>(
+    mut q: Vec<[f64; 3]>,
+    map: &[u32],
+    alphas: &[f64],
+    owned: &dyn Fn(u32) -> bool,
+) -> Result<Vec<Vec<S>>, ScanError> {
     if q.len() < 2 {
-        return Ok(Vec::new());
+        return Ok(vec![Vec::new(); alphas.len()]);
     }
     let n_real = q.len() as u32;
     let mut tri = Triangulation::new(&q).map_err(ScanError::Triangulation)?;
     if tri.dimension() < 3 {
         let (lo, hi) = crate::geometry::bounding_box(&q);
-        q.extend(sentinels(lo, hi, alpha));
+        let top = alphas.iter().copied().fold(0.0, f64::max);
+        q.extend(sentinels(lo, hi, top));
         tri = Triangulation::new(&q).map_err(ScanError::Triangulation)?;
     }
-    Ok(S::at(&tri, alpha)
+    Ok(S::at_levels(&tri, alphas)
         .into_iter()
-        .filter(|f| f.as_ref().iter().all(|&v| v < n_real))
-        .map(|f| S::sorted(f.as_ref().iter().map(|&v| map[v as usize])))
-        .filter(|f| owned(f.as_ref()[0]))
+        .map(|faces| {
+            faces
+                .into_iter()
+                .filter(|f| f.as_ref().iter().all(|&v| v < n_real))
+                .map(|f| S::sorted(f.as_ref().iter().map(|&v| map[v as usize])))
+                .filter(|f| owned(f.as_ref()[0]))
+                .collect()
+        })
         .collect())
 }
 
@@ -258,6 +286,19 @@ pub(crate) fn raw_faces<S: Face>(
     pruning: &Pruning<'_>,
     tile: Option<f64>,
 ) -> Result<(Vec<S>, usize), ScanError> {
+    let (mut faces, n) = raw_faces_at::<S>(points, job, &[job.alpha], pruning, tile)?;
+    Ok((faces.pop().unwrap_or_default(), n))
+}
+
+/// [`raw_faces`] at each α of `alphas` (none above the job's α, which
+/// sets the pruning and the halos) from the job's triangulations.
+fn raw_faces_at<S: Face>(
+    points: &[[f64; 3]],
+    job: &Job<'_>,
+    alphas: &[f64],
+    pruning: &Pruning<'_>,
+    tile: Option<f64>,
+) -> Result<(Vec<Vec<S>>, usize), ScanError> {
     let all: Vec<u32>;
     let ids: &[u32] = match job.ids {
         Some(ids) => ids,
@@ -271,8 +312,8 @@ pub(crate) fn raw_faces<S: Face>(
     let Some(side) = tile.filter(|&s| s.is_finite() && s > 0.0) else {
         let (map, q) = pruned(points, ids, a, radius, pruning);
         let n = map.len();
-        let mut faces = faces_of::<S>(q, &map, job.alpha, &|_| true)?;
-        faces.sort_unstable();
+        let mut faces = faces_at::<S>(q, &map, alphas, &|_| true)?;
+        faces.iter_mut().for_each(|f| f.sort_unstable());
         return Ok((faces, n));
     };
     // Tiles: integer cells of side `side`; halo `h` around each.
@@ -286,7 +327,7 @@ pub(crate) fn raw_faces<S: Face>(
     let mut tiles: Vec<[i64; 3]> = keyed.iter().map(|k| k.0).collect();
     tiles.dedup();
     let index = crate::geometry::kdtree::KdTree::new(points, Some(ids.to_vec()));
-    let mut faces: Vec<S> = Vec::new();
+    let mut faces: Vec<Vec<S>> = vec![Vec::new(); alphas.len()];
     let mut triangulated = 0usize;
     for t in tiles {
         let lo = t.map(|c| c as f64 * side);
@@ -306,10 +347,17 @@ pub(crate) fn raw_faces<S: Face>(
         let (map, q) = pruned(points, &sub, a, radius, &Pruning::Grid);
         triangulated += map.len();
         let owned = |v: u32| cell(&points[v as usize]) == t;
-        faces.extend(faces_of::<S>(q, &map, job.alpha, &owned)?);
+        for (all, f) in faces
+            .iter_mut()
+            .zip(faces_at::<S>(q, &map, alphas, &owned)?)
+        {
+            all.extend(f);
+        }
     }
-    faces.sort_unstable();
-    faces.dedup();
+    for f in &mut faces {
+        f.sort_unstable();
+        f.dedup();
+    }
     Ok((faces, triangulated))
 }
 
@@ -321,14 +369,39 @@ pub(crate) fn run_job<S: Face>(
     tile: Option<f64>,
     sf: ScanFilter,
 ) -> Result<JobResult<S>, ScanError> {
-    let (faces, triangulated) = raw_faces::<S>(points, job, pruning, tile)?;
-    let raw = faces.len();
-    let faces = filter_job(&faces, points, &job.anisotropy, sf)?;
-    Ok(JobResult {
-        faces,
-        triangulated,
-        raw,
-    })
+    let mut one = run_job_at::<S>(points, job, &[job.alpha], pruning, tile, &[sf])?;
+    Ok(one.pop().unwrap_or(JobResult {
+        faces: Vec::new(),
+        triangulated: 0,
+        raw: 0,
+    }))
+}
+
+/// [`run_job`] at each α of `alphas` (none above the job's), from one
+/// triangulation per tile: the results in the order of `alphas`, each
+/// filtered by its own `sf` (the points triangulated are counted once,
+/// with the first).
+pub(crate) fn run_job_at<S: Face>(
+    points: &[[f64; 3]],
+    job: &Job<'_>,
+    alphas: &[f64],
+    pruning: &Pruning<'_>,
+    tile: Option<f64>,
+    sf: &[ScanFilter],
+) -> Result<Vec<JobResult<S>>, ScanError> {
+    let (per_alpha, triangulated) = raw_faces_at::<S>(points, job, alphas, pruning, tile)?;
+    per_alpha
+        .into_iter()
+        .zip(sf)
+        .enumerate()
+        .map(|(i, (faces, &sf))| {
+            Ok(JobResult {
+                raw: faces.len(),
+                faces: filter_job(&faces, points, &job.anisotropy, sf)?,
+                triangulated: if i == 0 { triangulated } else { 0 },
+            })
+        })
+        .collect()
 }
 
 /// The union of the jobs' simplices (a sorted set) with, per simplex, the
