@@ -46,31 +46,41 @@ pub struct AlphaArgs {
     /// Input point file (.xyz .txt .csv .pts .ply .las .laz .pcd .e57)
     pub input: PathBuf,
     /// Write the alpha interval of every edge and triangle to this CSV file
-    #[arg(long, value_name = "OUT.csv")]
+    #[arg(long, allow_negative_numbers = true, value_name = "OUT.csv")]
     pub intervals: Option<PathBuf>,
     /// Elongation e1,e2,e3 (each > 0) of the metric Q = diag(e)·R
-    #[arg(long, value_name = "e1,e2,e3", value_parser = parse_positive_triple)]
+    #[arg(long, allow_negative_numbers = true, value_name = "e1,e2,e3", value_parser = parse_positive_triple)]
     pub elongation: Option<[f64; 3]>,
     /// Orientation angles theta,psi,phi (radians) of R = Rz(theta)·Rx(psi)·Ry(phi)
-    #[arg(long, value_name = "theta,psi,phi", value_parser = parse_triple, allow_hyphen_values = true)]
+    #[arg(long, allow_negative_numbers = true, value_name = "theta,psi,phi", value_parser = parse_triple, allow_hyphen_values = true)]
     pub euler: Option<[f64; 3]>,
     /// Alpha of the shape written by --output/--png: a radius (CGAL's
     /// Alpha_shape_3 takes its square)
-    #[arg(long, value_name = "A", value_parser = parse_positive, requires = "shape_out")]
+    #[arg(long, allow_negative_numbers = true, value_name = "A", value_parser = parse_positive, requires = "shape_out")]
     pub alpha: Option<f64>,
     /// Use (and print) the optimal alpha: the smallest at which the
     /// alpha-complex is one solid holding every point
     #[arg(long)]
     pub optimal_alpha: bool,
     /// Write the alpha-shape (PLY, or OBJ by extension)
-    #[arg(long, value_name = "shape.ply", requires = "which_alpha")]
+    #[arg(
+        long,
+        allow_negative_numbers = true,
+        value_name = "shape.ply",
+        requires = "which_alpha"
+    )]
     pub output: Option<PathBuf>,
     /// Write only the oriented boundary surface (regular triangles, normals
     /// outward) instead of every edge and triangle of F_alpha
     #[arg(long, requires = "shape_out")]
     pub surface: bool,
     /// Write a picture of the alpha-shape (PNG, fixed view)
-    #[arg(long, value_name = "OUT.png", requires = "which_alpha")]
+    #[arg(
+        long,
+        allow_negative_numbers = true,
+        value_name = "OUT.png",
+        requires = "which_alpha"
+    )]
     pub png: Option<PathBuf>,
     #[command(flatten)]
     pub input_format: crate::FormatArgs,

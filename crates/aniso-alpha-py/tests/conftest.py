@@ -93,7 +93,7 @@ def detections(scenes):
 
     out = {}
     for scene, (structure, params) in PAPER.items():
-        pts = aa.read(scenes[scene])
+        pts = aa.read(scenes[scene]).points
         out[scene] = (pts, aa.detect(pts, structure, **params))
     return out
 
