@@ -192,7 +192,7 @@ def labelled_array(
     (lines), int32, -1 off the structures (:meth:`Detection.dimensions`);
     with ``classify``, ``Classification`` (uint8, added if missing) set to
     that class on the structures' points. Fields of those names are
-    replaced; the others are copied as they are.
+    replaced where they are; the others are copied as they are.
 
     >>> import numpy as np, aniso_alpha as aa
     >>> g = np.arange(20.0)
@@ -218,13 +218,11 @@ def labelled_array(
         dims["Classification"] = np.where(detection.labels >= 0, np.uint8(classify), old).astype(
             old.dtype
         )
-    kept = [(n, array.dtype.fields[n][0]) for n in names if n not in dims]  # type: ignore[index]
-    dtype = np.dtype(kept + [(n, v.dtype) for n, v in dims.items()])
-    out = np.empty(len(array), dtype=dtype)
-    for n, _ in kept:
-        out[n] = array[n]
-    for n, v in dims.items():
-        out[n] = v
+    fields = [(n, dims[n].dtype if n in dims else array.dtype[n]) for n in names]
+    fields += [(n, v.dtype) for n, v in dims.items() if n not in names]
+    out = np.empty(len(array), dtype=np.dtype(fields))
+    for n, _ in fields:
+        out[n] = dims[n] if n in dims else array[n]
     return out
 
 
