@@ -52,19 +52,35 @@ def test_file_with_normals_gives_the_clis_labels(cli, tmp_path):
     assert not np.array_equal(plain.part_labels, det.part_labels)
 
 
+@pytest.fixture(scope="module")
+def small_ball(tmp_path_factory):
+    """Every 8th point of the ball with its normals, as a PLY file."""
+    cloud = aa.read(BALL)
+    rows = np.hstack([cloud.points, cloud.normals])[::8]
+    path = tmp_path_factory.mktemp("ball") / "small_ball.ply"
+    header = (
+        f"ply\nformat ascii 1.0\nelement vertex {len(rows)}\n"
+        + "".join(f"property double {c}\n" for c in ("x", "y", "z", "nx", "ny", "nz"))
+        + "end_header\n"
+    )
+    path.write_text(header + "\n".join(" ".join(repr(float(v)) for v in r) for r in rows) + "\n")
+    return path
+
+
 @pytest.mark.parametrize(
     "options, flags",
     [
         (dict(sampler="fibonacci", step=15.0), ["--sampler", "fibonacci", "--step", 15]),
-        (dict(alpha=0.2, lambda3=6.0, min_size=8, m1=0.5, m2=4), ["--alpha", 0.2, "--lambda3", 6, "--min-size", 8, "--m1", 0.5, "--m2", 4]),
-        (dict(alpha=0.2, lambda3=6.0, min_size=8, sampler="data", epsilon=None), ["--alpha", 0.2, "--lambda3", 6, "--min-size", 8, "--sampler", "data", "--no-significance"]),
+        (dict(alpha=0.5, lambda3=6.0, min_size=8, m1=0.5, m2=4), ["--alpha", 0.5, "--lambda3", 6, "--min-size", 8, "--m1", 0.5, "--m2", 4]),
+        (dict(alpha=0.5, lambda3=6.0, min_size=8, sampler="data", epsilon=None), ["--alpha", 0.5, "--lambda3", 6, "--min-size", 8, "--sampler", "data", "--no-significance"]),
         (dict(epsilon=1e-3, tile=20.0), ["--epsilon", 0.001, "--tile", 20]),
     ],
 )
-def test_every_option_gives_the_clis_labels(cli, tmp_path, options, flags):
-    cloud = aa.read(BALL)
+def test_every_option_gives_the_clis_labels(cli, tmp_path, small_ball, options, flags):
+    cloud = aa.read(small_ball)
     det = aa.detect(cloud, "planes", **options)
-    labels, parts, report = cli_detect(cli, BALL, tmp_path, "--structure", "planes", *flags)
+    assert len(det.planes) >= 5
+    labels, parts, report = cli_detect(cli, small_ball, tmp_path, "--structure", "planes", *flags)
     np.testing.assert_array_equal(det.labels, labels)
     np.testing.assert_array_equal(det.part_labels, parts)
     assert det.parameters == report["parameters"]
