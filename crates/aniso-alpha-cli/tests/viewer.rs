@@ -4,8 +4,9 @@
 //! Also the PNG pictures (`detect --png`, `alpha --png`).
 //!
 //! Chromium is Debian's `chromium` (`.ci/run` installs it); set
-//! `ANISO_CHROMIUM` to use another binary. Without one, the browser tests
-//! print why and pass without checking (the PNG tests always run).
+//! `ANISO_CHROMIUM` to use another binary. Without one, the browser test
+//! follows the rule of `common::tool_missing`: it says so and checks
+//! nothing, or fails under `ANISO_ALPHA_CI=1` (the PNG tests always run).
 
 use std::io::Read;
 use std::path::{Path, PathBuf};
@@ -240,9 +241,9 @@ fn scene(dir: &TempDir) -> (PathBuf, PathBuf, PathBuf, PathBuf) {
 #[test]
 fn viewer_renders_in_headless_chromium() {
     let Some(browser) = chromium() else {
-        eprintln!(
-            "SKIPPED viewer_renders_in_headless_chromium: no chromium on PATH \
-(apt-get install chromium; .ci/run installs it), nor ANISO_CHROMIUM"
+        common::tool_missing(
+            "viewer_renders_in_headless_chromium",
+            "no chromium on PATH (apt-get install chromium; .ci/run installs it), nor ANISO_CHROMIUM",
         );
         return;
     };

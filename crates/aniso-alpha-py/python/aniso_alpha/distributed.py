@@ -32,7 +32,7 @@ import os
 from typing import Any, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from . import _native
 from ._api import Structure, detect_input, detect_options
@@ -152,16 +152,20 @@ def plan(
     return p
 
 
-def _run_tile(spec: Tuple, payload: Tuple, threads: int) -> Tuple[np.ndarray, np.ndarray, int]:
+def _run_tile(
+    spec: Tuple[Any, ...], payload: Tuple[Any, ...], threads: int
+) -> Tuple[NDArray[np.uint32], NDArray[np.uint64], int]:
     """The task a worker runs: every orientation of ``spec`` on one tile."""
     kind, side, rotations, elongations, alphas, groups = spec
     cell, points, ids, members = payload
     offsets, positions = members if members is not None else (None, None)
     # Arrays unpickled from one message frame may be unaligned: the
     # extension reads aligned, C-contiguous buffers (a copy if need be).
+    def aligned(a: Any) -> Any:
+        return None if a is None else np.require(a, requirements=("C", "A"))
+
     rotations, elongations, alphas, groups, ids, offsets, positions = (
-        None if a is None else np.require(a, requirements=("C", "A"))
-        for a in (rotations, elongations, alphas, groups, ids, offsets, positions)
+        aligned(a) for a in (rotations, elongations, alphas, groups, ids, offsets, positions)
     )
     return _native.tile_step(
         kind, side, rotations, elongations, alphas, groups, cell, points, ids,
@@ -257,10 +261,10 @@ def detect(
     own = None
     if client is None:
         n = int(n_workers) if n_workers else (os.cpu_count() or 1)
-        cluster = LocalCluster(
+        cluster = LocalCluster(  # type: ignore[no-untyped-call]
             n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None
         )
-        own = (Client(cluster), cluster)
+        own = (Client(cluster), cluster)  # type: ignore[no-untyped-call]
         client = own[0]
     try:
         p = plan(
@@ -277,13 +281,15 @@ def detect(
         labels, part_labels, report, messages, native = p.finish(points, outputs, threads)
     finally:
         if own is not None:
-            own[0].close()
+            own[0].close()  # type: ignore[no-untyped-call]
             own[1].close()
     r = json.loads(report)
     return Detection(labels, part_labels, r["structures"], r["parameters"], list(messages), native)
 
 
-def _run(client: Any, p: "_native.Plan", points: np.ndarray, task_threads: int) -> List[Tuple]:
+def _run(
+    client: Any, p: "_native.Plan", points: NDArray[np.float64], task_threads: int
+) -> List[Tuple[Any, ...]]:
     """Runs every tile of ``p`` on ``client``'s workers, at most a few tiles
     per worker in flight (the driver never holds every tile's copy of its
     points at once); returns the tiles' outputs in completion order."""
@@ -292,15 +298,15 @@ def _run(client: Any, p: "_native.Plan", points: np.ndarray, task_threads: int) 
     [spec] = client.scatter([p.step_spec()], broadcast=True)
     tiles = iter(p.tiles(points))
     limit = 2 * _workers(client) + 2
-    outputs: List[Tuple] = []
+    outputs: List[Tuple[Any, ...]] = []
 
-    def submit(tile: Tuple) -> Any:
+    def submit(tile: Tuple[Any, ...]) -> Any:
         cell, ids = tile
         payload = (cell, np.ascontiguousarray(points[ids]), ids, p.members(ids))
         [data] = client.scatter([payload])
         return client.submit(_run_tile, spec, data, task_threads, pure=False)
 
-    pending = as_completed([submit(t) for _, t in zip(range(limit), tiles)])
+    pending = as_completed([submit(t) for _, t in zip(range(limit), tiles)])  # type: ignore[no-untyped-call]
     for done in pending:
         faces, offsets, triangulated = done.result()
         # Unpickled from one frame, the arrays may be unaligned (see _run_tile).
@@ -314,5 +320,5 @@ def _run(client: Any, p: "_native.Plan", points: np.ndarray, task_threads: int) 
         done.release()
         nxt = next(tiles, None)
         if nxt is not None:
-            pending.add(submit(nxt))
+            pending.add(submit(nxt))  # type: ignore[no-untyped-call]
     return outputs
