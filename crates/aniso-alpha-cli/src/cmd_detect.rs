@@ -38,8 +38,10 @@ orientations from the data).\n\
 alpha is a radius (the short semi-axis of the ellipsoid), not CGAL's squared alpha.\n\
 Without INPUT, runs on a built-in example scene (a Fig. 10-like polyhedron in uniform background, \
 planes, alpha 1, lambda2 4, lambda3 8, min-size 20) and says where it wrote its results.\n\
---labels writes one integer per input point: its structure id, or -1; --part-labels its part \
-(plane or segment) id, or -1. Parts are disjoint.\n\
+The summary prints one row per plane (or segment): its normal and a point on it, points, RMS, \
+extent. --labels writes one integer per input point: its structure id, or -1 (a polyhedral \
+surface, e.g. a room's six walls, is one structure); --part-labels its plane (or segment) id, \
+or -1: the per-plane ids. Parts are disjoint.\n\
 --output OUT.las|.laz|.ply writes the input cloud back with every attribute it had (a LAS/LAZ \
 input's records byte for byte; another input to LAS becomes point format 0 with its attributes \
 as extra bytes) and two int32 fields, structure and part (-1 off the structures); .obj writes \
@@ -105,10 +107,12 @@ pub struct DetectArgs {
     /// memory, the same result
     #[arg(long, allow_negative_numbers = true, value_name = "SIZE", value_parser = parse_positive)]
     pub tile: Option<f64>,
-    /// Write one label per input point (structure id or -1)
+    /// Write one label per input point: its structure id (a polyhedral
+    /// surface is one structure), or -1
     #[arg(long, allow_negative_numbers = true, value_name = "OUT.txt")]
     pub labels: Option<PathBuf>,
-    /// Write one part (plane or segment) label per input point, or -1
+    /// Write one part label per input point: its plane (or segment) id,
+    /// the per-plane ids, or -1
     #[arg(long, allow_negative_numbers = true, value_name = "OUT.txt")]
     pub part_labels: Option<PathBuf>,
     /// Write the input points with every attribute they had, their

@@ -157,3 +157,28 @@ def test_segments_of_lines(detections):
         assert s.endpoints.shape == (2, 3)
         assert s.length == pytest.approx(np.linalg.norm(s.endpoints[1] - s.endpoints[0]))
         np.testing.assert_array_equal(s.inliers, np.flatnonzero(det.part_labels == s.id))
+
+
+def test_open3d_itself():
+    """The real open3d.geometry.PointCloud (.ci/run installs Open3D from
+    PyPI): its points and normals are what aa.detect reads, and the largest
+    plane agrees with Open3D's own segment_plane on its inliers."""
+    from conftest import need
+
+    o3d = need("open3d", "pip install open3d")
+    cloud = aa.read(BALL)
+    pcd = o3d.geometry.PointCloud()
+    pcd.points = o3d.utility.Vector3dVector(cloud.points)
+    pcd.normals = o3d.utility.Vector3dVector(cloud.normals)
+    det = aa.detect(pcd, "planes")
+    np.testing.assert_array_equal(det.part_labels, aa.detect(cloud, "planes").part_labels)
+    plane = det.planes[0]
+    sub = pcd.select_by_index(plane.inliers.tolist())
+    eq, inliers = sub.segment_plane(distance_threshold=3 * plane.rms, ransac_n=3, num_iterations=200)
+    eq = np.asarray(eq)
+    assert abs(abs(eq[:3] @ plane.equation[:3]) - 1) < 1e-3
+    assert len(inliers) > 0.9 * len(plane.inliers)
+    # Normals estimated by Open3D itself are used as given normals.
+    pcd.estimate_normals(o3d.geometry.KDTreeSearchParamHybrid(radius=2.0, max_nn=30))
+    det = aa.detect(pcd, "planes")
+    assert det.parameters["normals"]["source"] == "input" and len(det.planes) >= 15
