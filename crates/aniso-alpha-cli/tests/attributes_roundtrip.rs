@@ -12,7 +12,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-mod common;
+use crate::common;
 use common::TempDir;
 
 use aniso_alpha::io::{read_points, Attribute, PointCloud, ReadOptions, Values};

@@ -2,6 +2,8 @@
 //! is a module here (a binary per file cost a link each). `cargo test -p
 //! aniso-alpha-cli --test cli MODULE::` runs one file's tests.
 
+mod common;
+
 #[path = "attributes_roundtrip.rs"]
 mod attributes_roundtrip;
 #[path = "bad_input.rs"]

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-mod common;
+use crate::common;
 use aniso_alpha::rng::SplitMix64;
 use common::TempDir;
 

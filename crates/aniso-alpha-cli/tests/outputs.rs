@@ -5,7 +5,7 @@ use std::path::Path;
 use std::process::{Command, Output};
 use std::time::{Duration, Instant};
 
-mod common;
+use crate::common;
 use common::TempDir;
 
 const BIN: &str = env!("CARGO_BIN_EXE_aniso-alpha");

@@ -14,7 +14,7 @@
 
 use std::path::{Path, PathBuf};
 
-mod common;
+use crate::common;
 use common::TempDir;
 use std::process::Command;
 

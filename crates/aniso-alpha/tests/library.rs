@@ -6,6 +6,9 @@
 //! (`io_e57`, `io_fuzz_regressions`), so that without the feature they
 //! are not built rather than built empty.
 
+mod alpha_common;
+mod common;
+
 #[path = "alpha_fixtures.rs"]
 mod alpha_fixtures;
 #[path = "alpha_oracle.rs"]
