@@ -170,12 +170,11 @@ def write(
     labels, parts = _labels_of(detection, len(cloud.points))
     if classify is not None and not (isinstance(classify, (int, np.integer)) and 0 <= int(classify) <= 255):
         raise ValueError(f"classify must be a LAS class between 0 and 255, got {classify!r}")
-    las = cloud._las if cloud._las is not None else None
     _native.write(
         os.fspath(path),
         cloud.points,
         list(cloud.attributes.items()),
-        las,
+        cloud._las,
         labels,
         parts,
         detection._native,
