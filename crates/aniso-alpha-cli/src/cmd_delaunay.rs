@@ -20,7 +20,7 @@ pub struct DelaunayArgs {
     /// Input point file (.xyz .txt .csv .pts .ply .las .laz .pcd .e57)
     pub input: PathBuf,
     /// Output file of tetrahedra
-    #[arg(long, value_name = "OUT")]
+    #[arg(long, allow_negative_numbers = true, value_name = "OUT")]
     pub tets: PathBuf,
     #[command(flatten)]
     pub input_format: crate::FormatArgs,

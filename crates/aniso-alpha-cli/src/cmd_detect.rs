@@ -4,12 +4,14 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use aniso_alpha::detect::orientations::Sampler;
 use aniso_alpha::detect::StructureKind;
-use aniso_alpha::detect::{Detection, Detector, Given, OrientationSet, Primitive};
+use aniso_alpha::detect::{DetectError, Detection, Detector, OrientationSet, Primitive};
 use aniso_alpha::eval::{evaluate, Evaluation};
 use aniso_alpha::io::{self, write_scene, Mesh, PointCloud, ReadOptions};
-use aniso_alpha::report::detection_json;
+use aniso_alpha::options::{
+    ignored_normals_reason, run_warnings, DetectOptions, SamplerChoice, Style,
+};
+use aniso_alpha::report::{detection_json, part_meshes, PartMeshes};
 use aniso_alpha::synth::{Scene, SceneOptions};
 use clap::{Args, ValueEnum};
 use serde_json::json;
@@ -36,8 +38,10 @@ orientations from the data).\n\
 alpha is a radius (the short semi-axis of the ellipsoid), not CGAL's squared alpha.\n\
 Without INPUT, runs on a built-in example scene (a Fig. 10-like polyhedron in uniform background, \
 planes, alpha 1, lambda2 4, lambda3 8, min-size 20) and says where it wrote its results.\n\
---labels writes one integer per input point: its structure id, or -1; --part-labels its part \
-(plane or segment) id, or -1. Parts are disjoint.\n\
+The summary prints one row per plane (or segment): its normal and a point on it, points, RMS, \
+extent. --labels writes one integer per input point: its structure id, or -1 (a polyhedral \
+surface, e.g. a room's six walls, is one structure); --part-labels its plane (or segment) id, \
+or -1: the per-plane ids. Parts are disjoint.\n\
 --output OUT.las|.laz|.ply writes the input cloud back with every attribute it had (a LAS/LAZ \
 input's records byte for byte; another input to LAS becomes point format 0 with its attributes \
 as extra bytes) and two int32 fields, structure and part (-1 off the structures); .obj writes \
@@ -59,33 +63,38 @@ pub struct DetectArgs {
     #[arg(long, value_enum)]
     pub structure: Option<Structure>,
     /// Alpha: the ellipsoid's short semi-axis, a radius (default: estimated)
-    #[arg(long, value_name = "A", value_parser = parse_positive)]
+    #[arg(long, allow_negative_numbers = true, value_name = "A", value_parser = parse_positive)]
     pub alpha: Option<f64>,
     /// Elongation lambda2 of planes (default: lambda3)
-    #[arg(long, value_name = "L2", value_parser = parse_positive)]
+    #[arg(long, allow_negative_numbers = true, value_name = "L2", value_parser = parse_positive)]
     pub lambda2: Option<f64>,
     /// Elongation lambda3, the long axis (default: estimated)
-    #[arg(long, value_name = "L3", value_parser = parse_positive)]
+    #[arg(long, allow_negative_numbers = true, value_name = "L3", value_parser = parse_positive)]
     pub lambda3: Option<f64>,
     /// Minimum size nb_c of a piece, in simplices (default: estimated)
-    #[arg(long, value_name = "NBC")]
-    pub min_size: Option<usize>,
+    #[arg(long, allow_negative_numbers = true, value_name = "NBC")]
+    pub min_size: Option<u64>,
     /// Orientations: the data's (modes of normals or directions), the
     /// paper's box, or near-uniform Fibonacci directions (default: data,
     /// or box when alpha, lambda3 and min-size are all given)
     #[arg(long, value_enum)]
     pub sampler: Option<SamplerKind>,
     /// Box sampler: sampling step on the box surface
-    #[arg(long, value_name = "M1", default_value_t = 0.3, value_parser = parse_positive)]
+    #[arg(long, allow_negative_numbers = true, value_name = "M1", default_value_t = 0.3, value_parser = parse_positive)]
     pub m1: f64,
     /// Number of rotations theta about the normal (planes, when lambda2 != lambda3)
-    #[arg(long, value_name = "M2", default_value_t = 12)]
-    pub m2: usize,
+    #[arg(
+        long,
+        allow_negative_numbers = true,
+        value_name = "M2",
+        default_value_t = 12
+    )]
+    pub m2: u64,
     /// Fibonacci sampler: angular step in degrees
-    #[arg(long, value_name = "DEG", default_value_t = 10.0, value_parser = parse_positive)]
+    #[arg(long, allow_negative_numbers = true, value_name = "DEG", default_value_t = 10.0, value_parser = parse_positive)]
     pub step: f64,
     /// Significance: keep parts with at most EPS expected false alarms
-    #[arg(long, value_name = "EPS", default_value_t = 1.0, value_parser = parse_positive)]
+    #[arg(long, allow_negative_numbers = true, value_name = "EPS", default_value_t = 1.0, value_parser = parse_positive)]
     pub epsilon: f64,
     /// Keep every part (no significance test: nb_c alone, as the paper)
     #[arg(long)]
@@ -96,42 +105,44 @@ pub struct DetectArgs {
     pub ignore_normals: bool,
     /// Triangulate in tiles of this side (input units) with halos: bounded
     /// memory, the same result
-    #[arg(long, value_name = "SIZE", value_parser = parse_positive)]
+    #[arg(long, allow_negative_numbers = true, value_name = "SIZE", value_parser = parse_positive)]
     pub tile: Option<f64>,
-    /// Write one label per input point (structure id or -1)
-    #[arg(long, value_name = "OUT.txt")]
+    /// Write one label per input point: its structure id (a polyhedral
+    /// surface is one structure), or -1
+    #[arg(long, allow_negative_numbers = true, value_name = "OUT.txt")]
     pub labels: Option<PathBuf>,
-    /// Write one part (plane or segment) label per input point, or -1
-    #[arg(long, value_name = "OUT.txt")]
+    /// Write one part label per input point: its plane (or segment) id,
+    /// the per-plane ids, or -1
+    #[arg(long, allow_negative_numbers = true, value_name = "OUT.txt")]
     pub part_labels: Option<PathBuf>,
     /// Write the input points with every attribute they had, their
     /// structure and part ids, and one clean mesh per part: PLY (faces and
     /// edges with structure and part ids), LAS/LAZ (every record kept byte
     /// for byte, the ids as two int32 extra-bytes fields), or OBJ
     /// (geometry only), by extension
-    #[arg(long, value_name = "OUT.ply|las|laz")]
+    #[arg(long, allow_negative_numbers = true, value_name = "OUT.ply|las|laz")]
     pub output: Option<PathBuf>,
     /// With a .las/.laz/.ply --output: give the points of the structures
     /// found this LAS classification, e.g. planes=6 (building)
-    #[arg(long, value_name = "KIND=CLASS", value_parser = common::parse_classify, requires = "output")]
+    #[arg(long, allow_negative_numbers = true, value_name = "KIND=CLASS", value_parser = common::parse_classify, requires = "output")]
     pub classify: Option<common::Classify>,
     /// Exclude the points of these LAS classes from the detection
     /// (labelled -1), comma-separated, e.g. 7,18 (noise); needs a
     /// classification (LAS, or a PLY/PCD 'classification' property)
-    #[arg(long, value_name = "C1,C2,...", value_parser = common::parse_classes)]
+    #[arg(long, allow_negative_numbers = true, value_name = "C1,C2,...", value_parser = common::parse_classes)]
     pub background_classes: Option<aniso_alpha::io::ClassSet>,
     /// Write the raw union of the scanned alpha-shapes (debugging; PLY or OBJ)
-    #[arg(long, value_name = "OUT.ply")]
+    #[arg(long, allow_negative_numbers = true, value_name = "OUT.ply")]
     pub union: Option<PathBuf>,
     /// Write a JSON report: parameters (estimated or given, with reasons),
     /// structures and their parts (planes, outlines, segments, NFA)
-    #[arg(long, value_name = "OUT.json")]
+    #[arg(long, allow_negative_numbers = true, value_name = "OUT.json")]
     pub report: Option<PathBuf>,
     /// Write an interactive 3D view of the result (one self-contained HTML file)
-    #[arg(long, value_name = "OUT.html")]
+    #[arg(long, allow_negative_numbers = true, value_name = "OUT.html")]
     pub html: Option<PathBuf>,
     /// Write a picture of the result (PNG, fixed view)
-    #[arg(long, value_name = "OUT.png")]
+    #[arg(long, allow_negative_numbers = true, value_name = "OUT.png")]
     pub png: Option<PathBuf>,
     #[command(flatten)]
     pub input_format: crate::FormatArgs,
@@ -157,64 +168,32 @@ fn kind_of(s: Structure) -> StructureKind {
     }
 }
 
-/// Builds the detector: the example's, explicit parameters, or estimated.
-fn detector(
-    args: &DetectArgs,
-    points: &[[f64; 3]],
-    normals: Option<&[[f64; 3]]>,
-    example: bool,
-) -> Result<Detector, CliError> {
+/// The options of a run, as the library's one options-to-detector
+/// builder takes them: the flags given, or for the built-in example the
+/// paper's Fig. 10 parameters where no flag overrides them.
+fn options(args: &DetectArgs, example: bool) -> DetectOptions {
     let structure = args.structure.unwrap_or(Structure::Planes);
-    let kind = kind_of(structure);
-    let m2 = u32::try_from(args.m2).map_err(|_| CliError::msg("--m2 is too large"))?;
-    let nb_c = match args.min_size {
-        Some(n) => Some(u32::try_from(n).map_err(|_| CliError::msg("--min-size is too large"))?),
-        None => None,
-    };
-    let box_sampler = Sampler::Box { m1: args.m1, m2 };
-    let fib = Sampler::Fibonacci {
-        step_degrees: args.step,
-    };
-    let explicit = example || (args.alpha.is_some() && args.lambda3.is_some() && nb_c.is_some());
-    let d = if explicit {
-        let alpha = args.alpha.unwrap_or(1.0);
-        let lambda3 = args.lambda3.unwrap_or(8.0);
-        let lambda2 = args.lambda2.unwrap_or(if example { 4.0 } else { lambda3 });
-        let nb_c = nb_c.unwrap_or(20);
-        let d = match kind {
-            StructureKind::Lines => Detector::lines(alpha, lambda3, nb_c),
-            StructureKind::Planes => Detector::planes(alpha, lambda2, lambda3, nb_c),
-        };
-        let d = match args.sampler.unwrap_or(SamplerKind::Box) {
-            SamplerKind::Box => d.sampler(box_sampler),
-            SamplerKind::Fibonacci => d.sampler(fib),
-            SamplerKind::Data => d.data_orientations(points, m2),
-        };
-        match normals {
-            Some(n) => d.normals(n),
-            None => d,
-        }
-    } else {
-        let given = Given {
-            alpha: args.alpha,
-            lambda2: args.lambda2,
-            lambda3: args.lambda3,
-            min_size: nb_c,
-        };
-        let d = match normals {
-            Some(n) => Detector::auto_oriented(kind, points, n, &given, m2)?,
-            None => Detector::auto_with(kind, points, &given, m2)?,
-        };
-        match args.sampler.unwrap_or(SamplerKind::Data) {
-            SamplerKind::Data => d,
-            SamplerKind::Box => d.sampler(box_sampler),
-            SamplerKind::Fibonacci => d.sampler(fib),
-        }
-    };
-    Ok(
-        d.significance((!args.no_significance).then_some(args.epsilon))
-            .tile(args.tile),
-    )
+    let or_example = |given: Option<f64>, v: f64| given.or(example.then_some(v));
+    DetectOptions {
+        alpha: or_example(args.alpha, 1.0),
+        lambda2: match structure {
+            Structure::Planes => or_example(args.lambda2, 4.0),
+            Structure::Lines => args.lambda2,
+        },
+        lambda3: or_example(args.lambda3, 8.0),
+        min_size: args.min_size.or(example.then_some(20)),
+        sampler: args.sampler.map(|s| match s {
+            SamplerKind::Data => SamplerChoice::Data,
+            SamplerKind::Box => SamplerChoice::Box,
+            SamplerKind::Fibonacci => SamplerChoice::Fibonacci,
+        }),
+        m1: args.m1,
+        m2: args.m2,
+        step: args.step,
+        epsilon: (!args.no_significance).then_some(args.epsilon),
+        tile: args.tile,
+        ..DetectOptions::new(kind_of(structure))
+    }
 }
 
 /// The folder the built-in example writes into.
@@ -381,26 +360,25 @@ fn detect_points(
     example: bool,
     timings: &mut Timings,
 ) -> Result<(Detector, Detection, f64), CliError> {
-    let in_file = |e: aniso_alpha::detect::DetectError| match &args.input {
-        Some(p) => CliError::in_file(p, e),
-        None => CliError::msg(e.to_string()),
+    let in_file = |e: DetectError| match (&args.input, &e) {
+        (
+            Some(p),
+            DetectError::Empty | DetectError::NonFinite { .. } | DetectError::OutOfRange { .. },
+        ) => CliError::in_file(p, e),
+        _ => CliError::msg(e.to_string()),
     };
     let start = Instant::now();
-    let detector = timings.phase("estimate", || detector(args, points, normals, example))?;
-    if let Some(g) = detector.given_normals().filter(|g| !g.used) {
-        common::warn(format_args!(
-            "the input's normals disagree with its points: {}",
-            ignored_normals(g.agreement)
-        ));
+    let options = options(args, example);
+    let detector = timings
+        .phase("estimate", || options.build(points, normals, Style::Cli))
+        .map_err(in_file)?;
+    let threads = rayon::current_num_threads();
+    for w in run_warnings(&options, &detector, points.len(), threads, Style::Cli) {
+        common::warn(format_args!("{w}"));
     }
-    let n_orient = detector.orientation_count().map_err(|e| {
-        let flags = match args.sampler {
-            Some(SamplerKind::Fibonacci) => format!("--step {}", args.step),
-            _ => format!("--m1 {} --m2 {}", args.m1, args.m2),
-        };
-        CliError::msg(format!("{flags}: {e}"))
-    })?;
-    warn_if_huge(points.len(), n_orient);
+    let n_orient = detector
+        .orientation_count()
+        .map_err(|e| CliError::msg(format!("{}: {e}", options.orientation_flags(Style::Cli))))?;
     let bar = common::progress(n_orient as u64, "orientations");
     let tick = {
         let bar = bar.clone();
@@ -455,7 +433,11 @@ fn write_labels_and_meshes(
         common::write_output(p, timings, |w| write_ints(w, part_labels))?;
     }
     if let Some(p) = &paths.output {
-        let (mut edges, mut faces, element_labels) = part_meshes(det, points);
+        let PartMeshes {
+            mut edges,
+            mut faces,
+            element_labels,
+        } = part_meshes(det, points);
         common::reindex(&mut edges, *keep);
         common::reindex(&mut faces, *keep);
         if paths.labelled_output {
@@ -615,25 +597,6 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
     common::print_summary(&out)
 }
 
-/// Point insertions above which a run is announced as long: at roughly a
-/// microsecond each, about half an hour of one core.
-const HUGE_RUN: f64 = 2e9;
-
-/// Says so before starting when `points × orientations` triangulation
-/// work is huge (issue 19: `--m2 100000` showed an 8-hour progress bar).
-fn warn_if_huge(points: usize, orientations: usize) {
-    let work = points as f64 * orientations as f64;
-    if work > HUGE_RUN {
-        let threads = rayon::current_num_threads().max(1) as f64;
-        let hours = work * 1e-6 / threads / 3600.0;
-        common::warn(format_args!(
-            "a large run: {points} points × {orientations} orientations = {work:.2e} point \
-             insertions, very roughly {hours:.1} hour(s) on {threads} thread(s); fewer orientations \
-             (--m1, --m2, --step) or fewer points make it shorter"
-        ));
-    }
-}
-
 fn write_ints(w: &mut dyn std::io::Write, values: &[i64]) -> std::io::Result<()> {
     let mut s = String::with_capacity(values.len() * 3);
     for v in values {
@@ -654,46 +617,6 @@ fn split_simplices(det: &Detection) -> (Vec<[u32; 2]>, Vec<[u32; 3]>) {
         }
     }
     (edges, faces)
-}
-
-/// The clean mesh of every part over the input points: a planar part's
-/// triangles (its 2D alpha-shape), a straight part's polyline through its
-/// points in order along the line; with (structure, part) per element.
-type PartMeshes = (Vec<[u32; 2]>, Vec<[u32; 3]>, Vec<[i64; 2]>);
-fn part_meshes(det: &Detection, points: &[[f64; 3]]) -> PartMeshes {
-    let mut edges = Vec::new();
-    let mut edge_labels = Vec::new();
-    let mut faces = Vec::new();
-    let mut face_labels = Vec::new();
-    let mut part = 0i64;
-    for s in &det.structures {
-        for p in &s.parts {
-            let l = [i64::from(s.id), part];
-            faces.extend_from_slice(&p.mesh);
-            face_labels.extend(std::iter::repeat_n(l, p.mesh.len()));
-            if let Primitive::Line(f) = &p.primitive {
-                let mut along: Vec<(f64, u32)> = p
-                    .vertices
-                    .iter()
-                    .map(|&v| {
-                        let q = points[v as usize];
-                        let t = (0..3)
-                            .map(|k| (q[k] - f.centroid[k]) * f.direction[k])
-                            .sum::<f64>();
-                        (t, v)
-                    })
-                    .collect();
-                along.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-                for w in along.windows(2) {
-                    edges.push([w[0].1, w[1].1]);
-                    edge_labels.push(l);
-                }
-            }
-            part += 1;
-        }
-    }
-    edge_labels.extend(face_labels);
-    (edges, faces, edge_labels)
 }
 
 fn fmt_param(r: &serde_json::Value, name: &str) -> String {
@@ -718,15 +641,6 @@ fn trim(v: f64) -> String {
     } else {
         format!("{v:.4}")
     }
-}
-
-/// Why the input's normals were not used.
-fn ignored_normals(agreement: f64) -> String {
-    format!(
-        "only {:.0}% of the locally planar points have their given normal within 25 degrees of \
-         their neighbourhood's (at least half must); normals estimated instead",
-        100.0 * agreement
-    )
 }
 
 fn summary(
@@ -765,6 +679,13 @@ fn summary(
         ));
         o.push_str(&format!("  alpha: {}\n", e.alpha.reason));
     }
+    if let Some(l) = d.ladder() {
+        o.push_str(&format!(
+            "  orientations: the Fibonacci sampler ({} deg) at {} levels of alpha, each structure at its most significant (see --report)\n",
+            l.step_deg,
+            l.alphas.len()
+        ));
+    }
     if let OrientationSet::Data(modes) = d.orientations() {
         o.push_str(&format!(
             "  orientations from the data: {} mode(s) of the local {}s, each with its own alpha and lambda (see --report)\n",
@@ -781,7 +702,7 @@ fn summary(
     if let Some(g) = d.given_normals().filter(|g| !g.used) {
         o.push_str(&format!(
             "  normals: the input's were ignored: {}\n",
-            ignored_normals(g.agreement)
+            ignored_normals_reason(g.agreement)
         ));
     }
     o.push_str(&format!(
@@ -792,43 +713,89 @@ fn summary(
         det.num_parts(),
         det.stats.rejected_parts
     ));
-    o.push_str(
-        "   id  kind      points  parts      rms  log10 NFA  plane [a b c d] / segment length\n",
-    );
-    for s in det.structures.iter().take(20) {
-        let what = match (&s.primitive, s.parts.len()) {
-            (Primitive::Plane(_), 1) => s
-                .primitive
-                .plane_equation()
-                .map(|p| format!("[{:.3} {:.3} {:.3} {:.3}]", p[0], p[1], p[2], p[3]))
-                .unwrap_or_default(),
-            (Primitive::Line(f), 1) => format!("{:.3}", f.extent),
-            _ => format!("{} facets", s.parts.len()),
-        };
-        o.push_str(&format!(
-            "  {:>3}  {:<8} {:>7}  {:>5}  {:>7.3}  {:>9.1}  {}\n",
-            s.id,
-            s.kind_name(),
-            s.vertices.len(),
-            s.parts.len(),
-            s.primitive.rms(),
-            s.log10_nfa,
-            what
-        ));
-    }
-    if det.structures.len() > 20 {
-        o.push_str(&format!(
-            "  ... and {} more (see --report)\n",
-            det.structures.len() - 20
-        ));
-    }
+    o.push_str(&part_table(det));
     let bg = det.labels.iter().filter(|&&l| l < 0).count();
     o.push_str(&format!(
-        "  {} structure(s), {} part(s); {} of {} points are background\n",
+        "  {} structure(s), {} part(s); {} of {} points are background \
+         (--labels: structure ids; --part-labels: {} ids)\n",
         det.structures.len(),
         det.num_parts(),
         bg,
-        det.labels.len()
+        det.labels.len(),
+        if d.kind() == StructureKind::Planes {
+            "plane"
+        } else {
+            "segment"
+        }
     ));
+    o
+}
+
+/// Rows of the summary's part table at most (the report has every part).
+const TABLE_ROWS: usize = 30;
+
+/// One row per part (a plane, a facet of a surface, a line or a segment
+/// of a polyline): its structure, points, RMS, NFA, extent, and the plane
+/// or line as a unit normal (direction) through a point on it, the
+/// centroid of its points. A plane through a point keeps its precision
+/// far from the origin (UTM coordinates), where `[a b c d]` would need
+/// about 12 digits in a, b and c: the normal is printed to 1e-6, the
+/// point to 1e-5 of the part's size (at least millimetres in metres).
+fn part_table(det: &Detection) -> String {
+    let mut o = String::from(
+        "  structure  part  kind       points        rms  log10 NFA  extent               \
+         normal (planes) / direction (lines)  through point\n",
+    );
+    let mut rows = 0usize;
+    let mut part = 0usize;
+    for s in &det.structures {
+        for p in &s.parts {
+            if rows < TABLE_ROWS {
+                let kind = match (&p.primitive, s.parts.len()) {
+                    (Primitive::Plane(_), 1) => "plane",
+                    (Primitive::Plane(_), _) => "facet",
+                    (Primitive::Line(_), 1) => "line",
+                    (Primitive::Line(_), _) => "segment",
+                    (Primitive::None, _) => "unfitted",
+                };
+                let (extent, axis, centroid) = match &p.primitive {
+                    Primitive::Plane(f) => (f.extent.to_vec(), f.normal, f.centroid),
+                    Primitive::Line(f) => (vec![f.extent], f.direction, f.centroid),
+                    Primitive::None => (vec![], [f64::NAN; 3], [f64::NAN; 3]),
+                };
+                let size = extent.iter().fold(1e-12f64, |m, &e| m.max(e.abs()));
+                let digits = (5 - size.log10().floor() as i64).clamp(3, 12) as usize;
+                let extent = extent
+                    .iter()
+                    .map(|e| format!("{e:.0$}", digits - 2))
+                    .collect::<Vec<_>>()
+                    .join(" x ");
+                o.push_str(&format!(
+                    "  {:>9}  {:>4}  {:<8} {:>8}  {:>9.3e}  {:>9.1}  {:<19}  [{:>9.6} {:>9.6} {:>9.6}]        [{:.digits$} {:.digits$} {:.digits$}]\n",
+                    s.id,
+                    part,
+                    kind,
+                    p.vertices.len(),
+                    p.primitive.rms(),
+                    p.log10_nfa,
+                    extent,
+                    axis[0],
+                    axis[1],
+                    axis[2],
+                    centroid[0],
+                    centroid[1],
+                    centroid[2],
+                ));
+                rows += 1;
+            }
+            part += 1;
+        }
+    }
+    if part > rows {
+        o.push_str(&format!(
+            "  ... and {} more part(s) (see --report)\n",
+            part - rows
+        ));
+    }
     o
 }

@@ -23,27 +23,37 @@ aniso-alpha eval --truth poly.xyz --labels labels.txt --part-column 4 --part-lab
 )]
 pub struct EvalArgs {
     /// Ground-truth scene
-    #[arg(long, value_name = "SCENE.xyz")]
+    #[arg(long, allow_negative_numbers = true, value_name = "SCENE.xyz")]
     pub truth: PathBuf,
     /// Detected labels, one per line
-    #[arg(long, value_name = "LABELS.txt")]
+    #[arg(long, allow_negative_numbers = true, value_name = "LABELS.txt")]
     pub labels: PathBuf,
     /// Print the scores as JSON
     #[arg(long)]
     pub json: bool,
     /// 0-based column of the label in a text truth file
-    #[arg(long, value_name = "N", default_value_t = 3)]
+    #[arg(
+        long,
+        allow_negative_numbers = true,
+        value_name = "N",
+        default_value_t = 3
+    )]
     pub label_column: usize,
     /// 0-based column of the true facet (part) id, to score parts too
     /// (`synth polyhedron` writes it in column 4)
-    #[arg(long, value_name = "N")]
+    #[arg(long, allow_negative_numbers = true, value_name = "N")]
     pub part_column: Option<usize>,
     /// Detected part labels, one per line (`detect --part-labels`)
-    #[arg(long, value_name = "PARTS.txt", requires = "part_column")]
+    #[arg(
+        long,
+        allow_negative_numbers = true,
+        value_name = "PARTS.txt",
+        requires = "part_column"
+    )]
     pub part_labels: Option<PathBuf>,
     /// LAS truth: classes read as background (-1), comma-separated, or
     /// `none` [default: 0,1,7,18: never classified, unclassified, noise]
-    #[arg(long, value_name = "C1,C2,...", value_parser = common::parse_classes)]
+    #[arg(long, allow_negative_numbers = true, value_name = "C1,C2,...", value_parser = common::parse_classes)]
     pub background_classes: Option<aniso_alpha::io::ClassSet>,
     #[command(flatten)]
     pub input_format: crate::FormatArgs,

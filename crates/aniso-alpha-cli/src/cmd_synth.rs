@@ -37,25 +37,31 @@ pub struct SynthArgs {
     #[arg(value_enum)]
     pub scene: Scene,
     /// Random seed
-    #[arg(long, value_name = "S", default_value_t = 0)]
+    #[arg(
+        long,
+        allow_negative_numbers = true,
+        value_name = "S",
+        default_value_t = 0
+    )]
     pub seed: u64,
     /// Output scene file
-    #[arg(long, value_name = "OUT.xyz")]
+    #[arg(long, allow_negative_numbers = true, value_name = "OUT.xyz")]
     pub output: PathBuf,
     /// Number of uniform background points (default: the paper's count,
     /// scaled with --density)
-    #[arg(long, value_name = "N")]
+    #[arg(long, allow_negative_numbers = true, value_name = "N")]
     pub background: Option<usize>,
     /// Background density in points per alpha-ellipsoid (default 0.01).
     /// Alone it keeps the paper's box and scales the background count
     /// (--density 0.03: 3x the paper's background in the same box); with
     /// --background N it sizes the box to hold N points at that density
-    #[arg(long, value_name = "X", value_parser = parse_positive)]
+    #[arg(long, allow_negative_numbers = true, value_name = "X", value_parser = parse_positive)]
     pub density: Option<f64>,
     /// Gaussian jitter (standard deviation, input units) of every
     /// coordinate of the structure points
     #[arg(
         long,
+        allow_negative_numbers = true,
         value_name = "SIGMA",
         default_value_t = 0.0,
         conflicts_with = "jitter_d"
@@ -63,13 +69,13 @@ pub struct SynthArgs {
     pub jitter: f64,
     /// Gaussian jitter as a fraction of the structure spacing d (lines
     /// d = 7, planes and polyhedron d = 3): sigma = F * d
-    #[arg(long, value_name = "F", value_parser = parse_nonnegative)]
+    #[arg(long, allow_negative_numbers = true, value_name = "F", value_parser = parse_nonnegative)]
     pub jitter_d: Option<f64>,
     /// Sample the structures at random positions instead of on a grid
     #[arg(long)]
     pub random_sampling: bool,
     /// Number of structures (lines or planes; not for the polyhedron)
-    #[arg(long, value_name = "N")]
+    #[arg(long, allow_negative_numbers = true, value_name = "N")]
     pub structures: Option<usize>,
     /// Make the structures cross (two lines through one point, planes
     /// cutting each other)

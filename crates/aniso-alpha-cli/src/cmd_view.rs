@@ -29,20 +29,20 @@ pub struct ViewArgs {
     /// Input point file (.xyz .txt .csv .pts .ply .las .laz .pcd .e57), as given to detect
     pub input: PathBuf,
     /// Structure label per point, one per line (`detect --labels`)
-    #[arg(long, value_name = "L.txt")]
+    #[arg(long, allow_negative_numbers = true, value_name = "L.txt")]
     pub labels: Option<PathBuf>,
     /// Part label per point, one per line (`detect --part-labels`)
-    #[arg(long, value_name = "P.txt")]
+    #[arg(long, allow_negative_numbers = true, value_name = "P.txt")]
     pub part_labels: Option<PathBuf>,
     /// The report of the detection (`detect --report`): kinds, planes,
     /// segments, outlines, RMS, NFA
-    #[arg(long, value_name = "R.json")]
+    #[arg(long, allow_negative_numbers = true, value_name = "R.json")]
     pub report: Option<PathBuf>,
     /// The HTML file to write
     #[arg(long, short = 'o', value_name = "OUT.html")]
     pub output: PathBuf,
     /// Most points drawn (the background is thinned first)
-    #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_POINTS)]
+    #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = DEFAULT_MAX_POINTS)]
     pub max_points: usize,
     #[command(flatten)]
     pub input_format: crate::FormatArgs,

@@ -47,7 +47,7 @@ struct Cli {
 #[command(next_help_heading = "Common options")]
 pub struct CommonArgs {
     /// Worker threads (default: all cores)
-    #[arg(long, value_name = "N")]
+    #[arg(long, allow_negative_numbers = true, value_name = "N")]
     pub threads: Option<NonZeroUsize>,
     /// No progress bars, messages or summary: nothing but errors, the files
     /// asked for, and a value asked for on stdout (alpha --optimal-alpha)
@@ -78,7 +78,7 @@ pub struct QuietArgs {
 pub struct FormatArgs {
     /// Input format, overriding the extension: xyz, ply, las, laz, pcd, e57
     /// (an INPUT of `-` is standard input, text unless --format says otherwise)
-    #[arg(long, value_name = "FMT", value_parser = common::parse_format)]
+    #[arg(long, allow_negative_numbers = true, value_name = "FMT", value_parser = common::parse_format)]
     pub format: Option<aniso_alpha::io::Format>,
 }
 

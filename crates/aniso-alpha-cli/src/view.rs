@@ -447,8 +447,9 @@ fn fmt_num(x: f64) -> String {
 fn fmt_plane(p: [f64; 4]) -> String {
     let mut s = String::new();
     for (k, (c, var)) in p[..3].iter().zip(["x", "y", "z"]).enumerate() {
-        // A unit normal: four decimals.
-        let v = format!("{:.4}", c.abs());
+        // A unit normal: six decimals (an error of 1e-6 rad moves a
+        // 100 m plane by 0.1 mm).
+        let v = format!("{:.6}", c.abs());
         let v = v.trim_end_matches('0').trim_end_matches('.');
         let c = &if v == "0" { 0.0 } else { *c };
         if k == 0 {
@@ -464,9 +465,21 @@ fn fmt_plane(p: [f64; 4]) -> String {
         s,
         " {} {} = 0",
         if p[3] < 0.0 { "−" } else { "+" },
-        fmt_num(p[3].abs())
+        fmt_offset(p[3].abs())
     );
     s
+}
+
+/// A plane's offset d: as [`fmt_num`], but in full to the millimetre
+/// (three decimals) from 1e6 to 1e15, where coordinates such as UTM's put
+/// it and `1.121e6` would lose the plane.
+fn fmt_offset(d: f64) -> String {
+    if d.is_finite() && (1e6..1e15).contains(&d.abs()) {
+        let s = format!("{d:.3}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        fmt_num(d)
+    }
 }
 
 /// A number of false alarms from its log₁₀.
@@ -1276,6 +1289,11 @@ mod tests {
             "0x + 0.6y − 0.8z + 12.5 = 0"
         );
         assert_eq!(fmt_plane([-1.0, 0.0, 0.0, -3.0]), "−1x + 0y + 0z − 3 = 0");
+        // UTM: d in full, the normal to six decimals.
+        assert_eq!(
+            fmt_plane([0.316228, 0.948683, 0.0, -1121431.5974]),
+            "0.316228x + 0.948683y + 0z − 1121431.597 = 0"
+        );
         assert_eq!(fmt_num(1.0e-7), "1.000e-7");
     }
 

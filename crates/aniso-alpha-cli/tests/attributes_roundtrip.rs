@@ -5,13 +5,14 @@
 //! and with laspy (an independent LAS/LAZ reader) when it can be imported:
 //! by the Python named by `ANISO_ALPHA_PYTHON` (then it must have laspy and
 //! lazrs: `.ci/run` sets it to a virtual environment with both), else by
-//! `python3` if it has them (else the laspy half is skipped, with a
-//! message).
+//! `python3` if it has them (else the laspy half follows the rule of
+//! `common::tool_missing`: skipped with a message, a failure under
+//! `ANISO_ALPHA_CI=1`).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-mod common;
+use crate::common;
 use common::TempDir;
 
 use aniso_alpha::io::{read_points, Attribute, PointCloud, ReadOptions, Values};
@@ -130,9 +131,12 @@ fn laspy_check(input: &Path, output: &Path, dir: &TempDir, classify: Option<u8>)
             !required,
             "ANISO_ALPHA_PYTHON={python} has no laspy/lazrs: {probe:?}"
         );
-        eprintln!(
-            "SKIPPED: laspy half of the round trip ({python} cannot import laspy and lazrs; \
-             .ci/run installs them)"
+        common::tool_missing(
+            "the laspy half of the round trip",
+            &format!(
+                "{python} cannot import laspy and lazrs (set ANISO_ALPHA_PYTHON to a Python \
+                 that has them; .ci/run does)"
+            ),
         );
         return None;
     }

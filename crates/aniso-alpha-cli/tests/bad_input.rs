@@ -4,7 +4,7 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
-mod common;
+use crate::common;
 use common::TempDir;
 
 const BIN: &str = env!("CARGO_BIN_EXE_aniso-alpha");
@@ -508,7 +508,7 @@ fn huge_run_warns_before_it_starts() {
         warning.contains("3000 points × 972000 orientations = 2.92e9"),
         "{warning}"
     );
-    assert!(warning.contains("--m1, --m2, --step"), "{warning}");
+    assert!(warning.contains("(--m1, --m2)"), "{warning}");
     assert!(!status.success());
     // Stopped before the end: no labels file, complete or partial.
     assert!(!d.path("labels.txt").exists());

@@ -5,7 +5,7 @@ use std::path::Path;
 use std::process::{Command, Output};
 use std::time::{Duration, Instant};
 
-mod common;
+use crate::common;
 use common::TempDir;
 
 const BIN: &str = env!("CARGO_BIN_EXE_aniso-alpha");
@@ -146,9 +146,9 @@ fn a_read_only_folder_fails_before_the_work() {
     let ro = d.0.join("ro");
     std::fs::create_dir(&ro).unwrap();
     std::fs::set_permissions(&ro, std::fs::Permissions::from_mode(0o555)).unwrap();
-    // Root writes into a folder of mode 0555: then take sysfs, where
-    // creating a file is refused even to root (so the check runs in CI's
-    // containers too).
+    // Root writes into a folder of mode 0555: then take sysfs or procfs,
+    // where creating a file is refused even to root (so the check runs in
+    // CI's containers too).
     let writable = |dir: &std::path::Path| {
         let probe = dir.join("aniso-alpha-probe");
         let ok = std::fs::write(&probe, b"x").is_ok();
@@ -157,12 +157,17 @@ fn a_read_only_folder_fails_before_the_work() {
     };
     let folder = if !writable(&ro) {
         ro.clone()
-    } else if std::path::Path::new("/sys/kernel").is_dir()
-        && !writable(std::path::Path::new("/sys/kernel"))
+    } else if let Some(p) = ["/sys/kernel", "/proc"]
+        .iter()
+        .map(std::path::Path::new)
+        .find(|p| p.is_dir() && !writable(p))
     {
-        std::path::PathBuf::from("/sys/kernel")
+        p.to_path_buf()
     } else {
-        eprintln!("skipped: no folder here that this user cannot write into");
+        common::tool_missing(
+            "a_read_only_folder_fails_before_the_work",
+            "no folder here that this user cannot write into",
+        );
         return;
     };
     // The input is bad too: the output check must come first.

@@ -4,15 +4,16 @@
 //! Also the PNG pictures (`detect --png`, `alpha --png`).
 //!
 //! Chromium is Debian's `chromium` (`.ci/run` installs it); set
-//! `ANISO_CHROMIUM` to use another binary. Without one, the browser tests
-//! print why and pass without checking (the PNG tests always run).
+//! `ANISO_CHROMIUM` to use another binary. Without one, the browser test
+//! follows the rule of `common::tool_missing`: it says so and checks
+//! nothing, or fails under `ANISO_ALPHA_CI=1` (the PNG tests always run).
 
 use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-mod common;
+use crate::common;
 use aniso_alpha::rng::SplitMix64;
 use common::TempDir;
 
@@ -240,9 +241,9 @@ fn scene(dir: &TempDir) -> (PathBuf, PathBuf, PathBuf, PathBuf) {
 #[test]
 fn viewer_renders_in_headless_chromium() {
     let Some(browser) = chromium() else {
-        eprintln!(
-            "SKIPPED viewer_renders_in_headless_chromium: no chromium on PATH \
-(apt-get install chromium; .ci/run installs it), nor ANISO_CHROMIUM"
+        common::tool_missing(
+            "viewer_renders_in_headless_chromium",
+            "no chromium on PATH (apt-get install chromium; .ci/run installs it), nor ANISO_CHROMIUM",
         );
         return;
     };

@@ -8,6 +8,8 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+use aniso_alpha::io::Values;
+
 /// Points borrowed from a C-contiguous float64 numpy array of shape (n, 3):
 /// the caller's own array when it is one, else a converted copy.
 pub struct Points<'py> {
@@ -100,4 +102,72 @@ pub fn rows_to_numpy<'py, T: numpy::Element, const N: usize>(
     Array2::from_shape_vec((m, N), flat)
         .expect("m * N elements")
         .into_pyarray(py)
+}
+
+/// A column of attribute values as a 1-D numpy array of its type.
+pub fn values_to_numpy<'py>(py: Python<'py>, values: Values) -> Bound<'py, PyAny> {
+    match values {
+        Values::I8(v) => v.into_pyarray(py).into_any(),
+        Values::U8(v) => v.into_pyarray(py).into_any(),
+        Values::I16(v) => v.into_pyarray(py).into_any(),
+        Values::U16(v) => v.into_pyarray(py).into_any(),
+        Values::I32(v) => v.into_pyarray(py).into_any(),
+        Values::U32(v) => v.into_pyarray(py).into_any(),
+        Values::I64(v) => v.into_pyarray(py).into_any(),
+        Values::U64(v) => v.into_pyarray(py).into_any(),
+        Values::F32(v) => v.into_pyarray(py).into_any(),
+        Values::F64(v) => v.into_pyarray(py).into_any(),
+    }
+}
+
+/// A 1-D numpy array of `n` values (bool, integers up to 64 bits or
+/// floats) as a column of attribute values of that type; `name` is
+/// the attribute's, for the error.
+pub fn numpy_to_values(name: &str, obj: &Bound<'_, PyAny>, n: usize) -> PyResult<Values> {
+    let py = obj.py();
+    let np = py.import("numpy")?;
+    let a = np.call_method1("ascontiguousarray", (obj,))?;
+    let shape: Vec<usize> = a.getattr("shape")?.extract()?;
+    if shape != [n] {
+        return Err(PyValueError::new_err(format!(
+            "attribute {name:?}: {} values for {n} points (a 1-D array of one value per point is needed), got shape {shape:?}",
+            shape.iter().product::<usize>()
+        )));
+    }
+    // Bools as uint8; any other dtype in native byte order (a file's
+    // big-endian column, e.g.), without a copy when it already is.
+    let a = if a.getattr("dtype")?.getattr("kind")?.extract::<String>()? == "b" {
+        a.call_method1("astype", (np.getattr("uint8")?,))?
+    } else {
+        a
+    };
+    let native = a.getattr("dtype")?.call_method1("newbyteorder", ("=",))?;
+    let a = np.call_method1("ascontiguousarray", (a, &native))?;
+    let dtype = a.getattr("dtype")?;
+    let kind: String = dtype.getattr("kind")?.extract()?;
+    let size: usize = dtype.getattr("itemsize")?.extract()?;
+    macro_rules! take {
+        ($t:ty, $variant:ident) => {{
+            let arr = a.cast::<numpy::PyArray1<$t>>()?.try_readonly()?;
+            Values::$variant(arr.as_slice()?.to_vec())
+        }};
+    }
+    Ok(match (kind.as_str(), size) {
+        ("i", 1) => take!(i8, I8),
+        ("u", 1) => take!(u8, U8),
+        ("i", 2) => take!(i16, I16),
+        ("u", 2) => take!(u16, U16),
+        ("i", 4) => take!(i32, I32),
+        ("u", 4) => take!(u32, U32),
+        ("i", 8) => take!(i64, I64),
+        ("u", 8) => take!(u64, U64),
+        ("f", 4) => take!(f32, F32),
+        ("f", 8) => take!(f64, F64),
+        _ => {
+            return Err(PyValueError::new_err(format!(
+                "attribute {name:?}: dtype {} cannot be written (integers, floats or bools)",
+                dtype.str()?
+            )))
+        }
+    })
 }

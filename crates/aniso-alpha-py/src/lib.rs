@@ -11,23 +11,30 @@
 
 mod convert;
 mod errors;
+mod options;
 mod report;
 mod run;
 mod split;
 
 use std::path::PathBuf;
+use std::sync::Arc;
 
 use aniso_alpha::alpha::AlphaComplex;
 use aniso_alpha::aniso::Anisotropy;
 use aniso_alpha::delaunay::Triangulation;
-use aniso_alpha::detect::StructureKind;
-use aniso_alpha::detect::{Detector, Given};
-use aniso_alpha::io::{read_points, ReadOptions};
-use numpy::{IntoPyArray, PyArray1, PyArray2};
+use aniso_alpha::detect::Detection;
+use aniso_alpha::io::{
+    read_points, write_labelled_cloud, Attribute, Format, Labelled, LasSource, PointCloud,
+    ReadOptions,
+};
+use aniso_alpha::options::{run_warnings, Style};
+use aniso_alpha::report::{part_meshes, PartMeshes};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 
-use convert::{rows_to_numpy, Points};
+use convert::{rows_to_numpy, values_to_numpy, Points};
 use errors::{io_error, value_error};
 use run::{detached, thread_count};
 
@@ -111,63 +118,43 @@ fn alpha_intervals<'py>(
     ))
 }
 
-/// Labels (int64 (n,)), part labels (int64 (n,)) and the JSON text of
-/// `{"structures": [...], "parameters": {...}}`.
-pub(crate) type DetectOut<'py> = (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<i64>>, String);
+/// What a detection returns to Python: labels (int64 (n,)), part labels
+/// (int64 (n,)), the JSON text of `{"structures": [...], "parameters":
+/// {...}}`, the warnings the CLI would print, and the detection itself
+/// (for `write`).
+pub(crate) type DetectOut<'py> = (
+    Bound<'py, PyArray1<i64>>,
+    Bound<'py, PyArray1<i64>>,
+    String,
+    Vec<String>,
+    PyDetection,
+);
 
-/// The parameters of a detection call, checked.
-pub(crate) struct Params {
-    kind: StructureKind,
-    given: Given,
+/// A detection kept on the Rust side, for the meshes `write` adds to a
+/// PLY (opaque to Python).
+#[pyclass(frozen, name = "NativeDetection", module = "aniso_alpha._native")]
+pub struct PyDetection {
+    det: Arc<Detection>,
 }
 
-impl Params {
-    /// Checks `structure` and the values given.
-    pub(crate) fn new(
-        structure: &str,
-        alpha: Option<f64>,
-        lambda2: Option<f64>,
-        lambda3: Option<f64>,
-        min_size: Option<i64>,
-    ) -> PyResult<Self> {
-        let planes = match structure {
-            "lines" => false,
-            "planes" => true,
-            other => {
-                return Err(PyValueError::new_err(format!(
-                    "structure must be \"lines\" or \"planes\", got {other:?}"
-                )))
-            }
-        };
-        if !planes && lambda2.is_some() {
-            return Err(PyValueError::new_err(
-                "lambda2 is a parameter of planes (lines use lambda3 only)",
-            ));
-        }
-        let min_size = min_size
-            .map(|m| {
-                u32::try_from(m).map_err(|_| {
-                    PyValueError::new_err(format!(
-                        "bad parameter: min_size must be between 1 and {}, got {m}",
-                        u32::MAX
-                    ))
-                })
-            })
-            .transpose()?;
-        let kind = if planes {
-            StructureKind::Planes
-        } else {
-            StructureKind::Lines
-        };
-        Ok(Params {
-            kind,
-            given: Given {
-                alpha,
-                lambda2,
-                lambda3,
-                min_size,
-            },
-        })
+impl PyDetection {
+    /// The Python side of a finished detection: labels, part labels,
+    /// report and warnings, and the detection.
+    pub(crate) fn output<'py>(
+        py: Python<'py>,
+        det: Detection,
+        json: String,
+        warnings: Vec<String>,
+    ) -> DetectOut<'py> {
+        let labels = det.labels.clone().into_pyarray(py);
+        let parts = det.part_labels().into_pyarray(py);
+        (
+            labels,
+            parts,
+            json,
+            warnings,
+            PyDetection { det: Arc::new(det) },
+        )
     }
 }
 
@@ -177,55 +164,22 @@ pub(crate) fn extract_normals<'py>(n: &Bound<'py, PyAny>) -> PyResult<Points<'py
     Points::extract(n).map_err(|e| PyValueError::new_err(format!("normals: {e}")))
 }
 
-/// The detector of a call: with alpha, lambda3 and min_size all given, the
-/// CLI's explicit run (the paper's box sampler; lambda2 of planes defaults
-/// to lambda3); otherwise parameters and orientations from the data, the
-/// given ones kept ([`Detector::auto`]).
-pub(crate) fn detector_for(
-    p: &Params,
-    pts: &[[f64; 3]],
-    normals: Option<&[[f64; 3]]>,
-) -> PyResult<Detector> {
-    let g = &p.given;
-    Ok(match (g.alpha, g.lambda3, g.min_size) {
-        (Some(alpha), Some(lambda3), Some(min_size)) => {
-            let d = match p.kind {
-                StructureKind::Planes => {
-                    Detector::planes(alpha, g.lambda2.unwrap_or(lambda3), lambda3, min_size)
-                }
-                StructureKind::Lines => Detector::lines(alpha, lambda3, min_size),
-            };
-            match normals {
-                Some(n) => d.normals(n),
-                None => d,
-            }
-        }
-        _ => match normals {
-            Some(n) => Detector::auto_oriented(p.kind, pts, n, g, 12).map_err(value_error)?,
-            None => Detector::auto(p.kind, pts, g).map_err(value_error)?,
-        },
-    })
-}
-
-/// Structure detection (docs/method.md §4): `structure` is "lines" or "planes". With
-/// alpha, lambda3 and min_size all given, the CLI's explicit run (the
-/// paper's box sampler); otherwise [`Detector::auto`] estimates what is
-/// missing and scans the data orientation set.
+/// Structure detection (docs/method.md §4): `structure` is "lines" or
+/// "planes", `options` the keyword arguments of `aniso_alpha.detect`
+/// (alpha, lambda2, lambda3, min_size, sampler, m1, m2, step, epsilon,
+/// tile), built into a detector as the CLI builds its flags
+/// ([`DetectOptions::build`](aniso_alpha::options::DetectOptions::build)).
 #[pyfunction]
-#[pyo3(signature = (points, structure, alpha = None, lambda2 = None, lambda3 = None, min_size = None, threads = None, normals = None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (points, structure, options = None, threads = None, normals = None))]
 fn detect<'py>(
     py: Python<'py>,
     points: &Bound<'py, PyAny>,
     structure: &str,
-    alpha: Option<f64>,
-    lambda2: Option<f64>,
-    lambda3: Option<f64>,
-    min_size: Option<i64>,
+    options: Option<&Bound<'py, PyDict>>,
     threads: Option<i64>,
     normals: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<DetectOut<'py>> {
-    let params = Params::new(structure, alpha, lambda2, lambda3, min_size)?;
+    let options = options::detect_options(structure, options)?;
     let points = Points::extract(points)?;
     let normals = normals.map(extract_normals).transpose()?;
     let threads = thread_count(threads)?;
@@ -234,23 +188,130 @@ fn detect<'py>(
     // The whole call (estimation included) runs on the pool of `detached`,
     // which the library's parallel loops use: no `Detector::threads`, which
     // would start a second pool.
-    let (labels, parts, json) = detached(py, threads, |_| {
-        let detector = detector_for(&params, pts, normals)?;
+    let (det, json, warnings) = detached(py, threads, |n| {
+        let detector = options::build(&options, pts, normals)?;
+        let warnings = run_warnings(&options, &detector, pts.len(), n, Style::Python);
         let det = detector.run(pts).map_err(value_error)?;
         let json = report::detection_json(&det, &detector);
-        let parts = det.part_labels();
-        Ok((det.labels, parts, json))
+        Ok((det, json, warnings))
     })?;
-    Ok((labels.into_pyarray(py), parts.into_pyarray(py), json))
+    Ok(PyDetection::output(py, det, json, warnings))
 }
 
-/// The points of a point file, float64 (n, 3), in file order.
+/// A LAS/LAZ file's header, VLRs and point records, kept for `write` to
+/// copy every record byte for byte (opaque to Python).
+#[pyclass(frozen, name = "LasSource", module = "aniso_alpha._native")]
+pub struct PyLas {
+    las: Arc<LasSource>,
+}
+
+/// What `read` returns: points (float64 (n, 3)), the attributes as (name,
+/// 1-D array of the file's type) in file order, the normals (float64 (n,
+/// 3)) when the file gives them, the reader's warnings, a LAS/LAZ file's
+/// records, and the format's name.
+type ReadOut<'py> = (
+    Bound<'py, PyArray2<f64>>,
+    Vec<(String, Bound<'py, PyAny>)>,
+    Option<Bound<'py, PyArray2<f64>>>,
+    Vec<String>,
+    Option<PyLas>,
+    &'static str,
+);
+
+/// The points of a point file in file order, with every attribute the
+/// file has (as the CLI reads an input for `detect --output`); the
+/// normals are those `detect` uses: a PLY's `nx ny nz` or a PCD's
+/// `normal_x normal_y normal_z`.
 #[pyfunction]
-fn read(py: Python<'_>, path: PathBuf) -> PyResult<Bound<'_, PyArray2<f64>>> {
-    let cloud = detached(py, 1, |_| {
-        read_points(&path, &ReadOptions::default()).map_err(io_error)
+#[pyo3(signature = (path, attributes = true))]
+fn read(py: Python<'_>, path: PathBuf, attributes: bool) -> PyResult<ReadOut<'_>> {
+    let (cloud, format) = detached(py, 1, |_| {
+        let options = ReadOptions {
+            attributes,
+            ..ReadOptions::default()
+        };
+        let format = Format::resolve(&path, &options).map_err(io_error)?;
+        let cloud = read_points(&path, &options).map_err(io_error)?;
+        Ok((cloud, format))
     })?;
-    Ok(rows_to_numpy(py, cloud.points))
+    let normals = match format {
+        Format::Ply | Format::Pcd => cloud.normals().map(|n| rows_to_numpy(py, n)),
+        _ => None,
+    };
+    let warnings = cloud.warnings.iter().map(|w| w.to_string()).collect();
+    let las = cloud.las.map(|l| PyLas { las: Arc::from(l) });
+    let attrs = cloud
+        .attributes
+        .into_iter()
+        .map(|a| (a.name, values_to_numpy(py, a.values)))
+        .collect();
+    let name = match format {
+        Format::Text => "text",
+        Format::Ply => "ply",
+        Format::Las => "las",
+        Format::Pcd => "pcd",
+        Format::E57 => "e57",
+    };
+    Ok((
+        rows_to_numpy(py, cloud.points),
+        attrs,
+        normals,
+        warnings,
+        las,
+        name,
+    ))
+}
+
+/// Writes the labelled cloud as `aniso-alpha detect --output` does
+/// ([`write_labelled_cloud`]): the points with their attributes (a LAS
+/// source's records byte for byte when its point count matches), the
+/// structure and part ids, the parts' meshes (PLY) when the detection is
+/// given, and `classify` as the structures' LAS classification.
+#[pyfunction]
+#[pyo3(signature = (path, points, attributes, las, labels, part_labels, detection = None, classify = None))]
+#[allow(clippy::too_many_arguments)]
+fn write(
+    py: Python<'_>,
+    path: PathBuf,
+    points: &Bound<'_, PyAny>,
+    attributes: Vec<(String, Bound<'_, PyAny>)>,
+    las: Option<&PyLas>,
+    labels: PyReadonlyArray1<'_, i64>,
+    part_labels: PyReadonlyArray1<'_, i64>,
+    detection: Option<&PyDetection>,
+    classify: Option<u8>,
+) -> PyResult<()> {
+    let points = Points::extract(points)?;
+    let n = points.as_slice().len();
+    let mut attrs = Vec::with_capacity(attributes.len());
+    for (name, values) in &attributes {
+        attrs.push(Attribute::new(
+            name.clone(),
+            convert::numpy_to_values(name, values, n)?,
+        ));
+    }
+    let cloud = PointCloud {
+        points: points.as_slice().to_vec(),
+        attributes: attrs,
+        las: las.map(|l| Box::new(LasSource::clone(&l.las))),
+        ..PointCloud::default()
+    };
+    let det = detection.map(|d| Arc::clone(&d.det));
+    let (labels, part_labels) = (labels.as_slice()?, part_labels.as_slice()?);
+    detached(py, 1, |_| {
+        let meshes = match &det {
+            Some(d) if d.labels.len() == n => part_meshes(d, &cloud.points),
+            _ => PartMeshes::default(),
+        };
+        let labelled = Labelled {
+            edges: &meshes.edges,
+            faces: &meshes.faces,
+            element_labels: &meshes.element_labels,
+            classify,
+            ..Labelled::new(labels, part_labels)
+        };
+        write_labelled_cloud(&path, &cloud, &labelled).map_err(io_error)
+    })
 }
 
 /// The address of the memory the library reads `points` from (tests check
@@ -278,7 +339,9 @@ mod native {
     #[pymodule_export]
     use super::split::{plan, tile_step, PyPlan};
     #[pymodule_export]
-    use super::{_panic, _points_address, alpha_intervals, delaunay, detect, read};
+    use super::{
+        _panic, _points_address, alpha_intervals, delaunay, detect, read, write, PyDetection, PyLas,
+    };
 
     use pyo3::prelude::*;
 

@@ -17,43 +17,44 @@ use pyo3::prelude::*;
 use crate::convert::{rows_to_numpy, Points};
 use crate::errors::value_error;
 use crate::run::{detached, thread_count};
-use crate::{detector_for, extract_normals, DetectOut, Params};
+use crate::{extract_normals, options, DetectOut, PyDetection};
+use aniso_alpha::options::{run_warnings, Style};
+use pyo3::types::PyDict;
 
 /// A split detection run (`aniso_alpha.distributed`); made by [`plan`].
 #[pyclass(frozen, name = "Plan", module = "aniso_alpha._native")]
 pub struct PyPlan {
     plan: Plan,
+    /// The warnings the CLI would print for these options and points.
+    warnings: Vec<String>,
 }
 
 /// The plan of a split run over `points` with tiles of side `tile`: the
 /// parameters as `detect` would choose them (estimated from the data when
 /// alpha, lambda3 or min_size is missing), fixed for every tile.
 #[pyfunction]
-#[pyo3(signature = (points, structure, tile, alpha = None, lambda2 = None, lambda3 = None, min_size = None, threads = None, normals = None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (points, structure, tile, options = None, threads = None, normals = None))]
 pub fn plan(
     py: Python<'_>,
     points: &Bound<'_, PyAny>,
     structure: &str,
     tile: f64,
-    alpha: Option<f64>,
-    lambda2: Option<f64>,
-    lambda3: Option<f64>,
-    min_size: Option<i64>,
+    options: Option<&Bound<'_, PyDict>>,
     threads: Option<i64>,
     normals: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<PyPlan> {
-    let params = Params::new(structure, alpha, lambda2, lambda3, min_size)?;
+    let options = options::detect_options(structure, options)?;
     let points = Points::extract(points)?;
     let normals = normals.map(extract_normals).transpose()?;
     let threads = thread_count(threads)?;
     let pts = points.as_slice();
     let normals = normals.as_ref().map(|n| n.as_slice());
-    let plan = detached(py, threads, |_| {
-        let detector = detector_for(&params, pts, normals)?;
-        detector.plan(pts, tile).map_err(value_error)
+    let (plan, warnings) = detached(py, threads, |n| {
+        let detector = options::build(&options, pts, normals)?;
+        let warnings = run_warnings(&options, &detector, pts.len(), n, Style::Python);
+        Ok((detector.plan(pts, tile).map_err(value_error)?, warnings))
     })?;
-    Ok(PyPlan { plan })
+    Ok(PyPlan { plan, warnings })
 }
 
 /// A tile: its cell (3 ints) and the ids of its points (uint32, ascending).
@@ -65,7 +66,15 @@ impl PyPlan {
     fn with_tile(&self, tile: f64) -> PyResult<PyPlan> {
         Ok(PyPlan {
             plan: self.plan.with_side(tile).map_err(value_error)?,
+            warnings: self.warnings.clone(),
         })
+    }
+
+    /// The warnings the CLI would print for this run (normals not used,
+    /// a very large run).
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.warnings.clone()
     }
 
     /// The halo width (the largest 2·alpha·lambda_max of the jobs).
@@ -200,13 +209,12 @@ impl PyPlan {
         drop(outputs);
         let pts = points.as_slice();
         let plan = &self.plan;
-        let (labels, parts, json) = detached(py, threads, |_| {
+        let (det, json) = detached(py, threads, |_| {
             let det = plan.finish(pts, outs).map_err(value_error)?;
             let json = crate::report::detection_json(&det, plan.detector());
-            let parts = det.part_labels();
-            Ok((det.labels, parts, json))
+            Ok((det, json))
         })?;
-        Ok((labels.into_pyarray(py), parts.into_pyarray(py), json))
+        Ok(PyDetection::output(py, det, json, self.warnings.clone()))
     }
 }
 

@@ -93,7 +93,7 @@ def detections(scenes):
 
     out = {}
     for scene, (structure, params) in PAPER.items():
-        pts = aa.read(scenes[scene])
+        pts = aa.read(scenes[scene]).points
         out[scene] = (pts, aa.detect(pts, structure, **params))
     return out
 
@@ -107,3 +107,18 @@ def scenes(cli, tmp_path_factory) -> Dict[str, pathlib.Path]:
         out[kind] = d / f"{kind}.xyz"
         run_cli(cli, "synth", kind, "--seed", 1, "--output", out[kind])
     return out
+
+
+def need(module: str, why: str):
+    """Imports `module` for a test that needs it: a skip saying so when it
+    is missing, a failure under ANISO_ALPHA_CI=1 (set by .ci/run, which
+    installs it), as the Rust tests' `tool_missing` rule."""
+    import importlib
+
+    try:
+        return importlib.import_module(module)
+    except ImportError as e:
+        msg = f"{module} is not installed ({e}): {why}"
+        if os.environ.get("ANISO_ALPHA_CI", "") not in ("", "0"):
+            pytest.fail(msg + " (ANISO_ALPHA_CI is set: a test whose tool is missing fails)")
+        pytest.skip(msg)

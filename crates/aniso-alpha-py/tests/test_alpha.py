@@ -81,6 +81,23 @@ def test_equals_cli(cli, tmp_path, kwargs):
     # The CLI writes shortest round-trip decimals: the values are equal.
     assert ours == theirs
     assert list(ours) == list(theirs)  # and in the same order
+    # The binary output: the same rows, as one NumPy structured array.
+    npy = tmp_path / "iv.npy"
+    run_cli(cli, *args[:3], npy, *args[4:])
+    rows = np.load(npy)
+    assert rows.dtype.names == ("dim", "v0", "v1", "v2", "alpha_min", "alpha_max")
+    iv = aa.alpha_intervals(src_points(src), **kwargs)
+    edges, tris = rows[rows["dim"] == 1], rows[rows["dim"] == 2]
+    assert (rows["dim"][: len(edges)] == 1).all()  # edges first
+    np.testing.assert_array_equal(np.c_[edges["v0"], edges["v1"]], iv.edges)
+    assert (edges["v2"] == np.iinfo(np.uint32).max).all()
+    np.testing.assert_array_equal(np.c_[edges["alpha_min"], edges["alpha_max"]], iv.edge_alpha)
+    np.testing.assert_array_equal(np.c_[tris["v0"], tris["v1"], tris["v2"]], iv.triangles)
+    np.testing.assert_array_equal(np.c_[tris["alpha_min"], tris["alpha_max"]], iv.triangle_alpha)
+
+
+def src_points(path):
+    return aa.read(path).points
 
 
 def test_threads_do_not_change_the_result():

@@ -84,4 +84,7 @@ def test_input_forms_give_the_same_result(detections):
 
 def test_repr(detections):
     det = detections["lines"][1]
-    assert repr(det).startswith(f"Detection({len(det.structures)} structure(s), 1550 points")
+    parts = int(det.part_labels.max()) + 1
+    assert repr(det).startswith(
+        f"Detection({len(det.structures)} structure(s), {parts} segment(s), 1550 points"
+    )

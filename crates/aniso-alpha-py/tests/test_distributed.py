@@ -121,7 +121,7 @@ def test_a_list_of_las_tiles(client, tmp_path):
     paths = [tmp_path / "west.las", tmp_path / "east.las"]
     write_las(paths[0], west)
     write_las(paths[1], east)
-    whole = np.vstack([aa.read(p) for p in paths])
+    whole = np.vstack([aa.read(p).points for p in paths])
     assert whole.shape == pts.shape
     ref = aa.detect(whole, "planes")
     det = distributed.detect([str(p) for p in paths], "planes", tile=3.0, client=client)

@@ -72,8 +72,8 @@ def test_read_formats(tmp_path):
     ) + "end_header\n"
     ply.write_bytes(header.encode() + pts.astype("<f8").tobytes())
     for path in (xyz, csv, ply):
-        got = aa.read(path)
+        got = aa.read(path).points
         assert got.dtype == np.float64 and got.shape == (50, 3) and got.flags.c_contiguous
         np.testing.assert_array_equal(got, pts)
     # str and os.PathLike both work.
-    np.testing.assert_array_equal(aa.read(str(ply)), pts)
+    np.testing.assert_array_equal(aa.read(str(ply)).points, pts)

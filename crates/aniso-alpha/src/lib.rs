@@ -18,7 +18,9 @@
 //! * [`detect`]: orientation samplers, the path filter of non-significant
 //!   structures, connected components, least-squares line/plane fits;
 //! * [`synth`]: deterministic benchmark scenes with ground truth;
-//! * [`eval`]: detection scores (precision/recall/F1, structures found).
+//! * [`eval`]: detection scores (precision/recall/F1, structures found);
+//! * [`options`]: a detection's options as the CLI and the Python package
+//!   take them, checked and built into a [`Detector`] by one builder;
 //! * [`alpha`]: alpha-shape intervals of edges and triangles, `F_α`, the
 //!   α-shape surface, and the anisotropic complex of `Q·P`;
 //!
@@ -50,6 +52,7 @@ pub mod detect;
 pub mod eval;
 pub mod geometry;
 pub mod io;
+pub mod options;
 mod par;
 #[cfg(feature = "json")]
 pub mod report;

@@ -52,7 +52,7 @@ pub fn parameters_json(d: &Detector) -> Value {
             None => param(value, false, "given"),
         }
     };
-    let orientations = match d.orientations() {
+    let mut orientations = match d.orientations() {
         OrientationSet::Sampler(Sampler::Box { m1, m2 }) => {
             json!({"kind": "box", "m1": m1, "m2": m2, "count": d.orientation_count().unwrap_or(0)})
         }
@@ -76,6 +76,13 @@ pub fn parameters_json(d: &Detector) -> Value {
             })).collect::<Vec<_>>(),
         }),
     };
+    if let Some(l) = d.ladder() {
+        orientations["ladder"] = json!({
+            "alphas": l.alphas.iter().copied().map(num).collect::<Vec<_>>(),
+            "lambda": num(l.lambda),
+            "points": l.points.len(),
+        });
+    }
     let mut v = json!({
         "structure": match kind { StructureKind::Lines => "lines", StructureKind::Planes => "planes" },
         "k": kind.k(),
@@ -109,6 +116,7 @@ pub fn parameters_json(d: &Detector) -> Value {
             "spacing": num(e.spacing),
             "noise": num(e.noise),
             "structure_fraction": num(e.structure_fraction),
+            "explained": num(e.explained),
         });
     }
     v
@@ -205,4 +213,59 @@ pub fn detection_json(det: &Detection, d: &Detector) -> Value {
         "parts": det.num_parts(),
         "background_points": det.labels.iter().filter(|&&l| l < 0).count(),
     })
+}
+
+/// The clean meshes of a detection's parts over the input points, as the
+/// CLI's `detect --output` and the Python package's `write` add them to a
+/// PLY: a planar part's triangles (its 2D α-shape), a straight part's
+/// polyline through its points in order along the line.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PartMeshes {
+    /// The straight parts' edges.
+    pub edges: Vec<[u32; 2]>,
+    /// The planar parts' triangles.
+    pub faces: Vec<[u32; 3]>,
+    /// (structure id, global part id) of each edge, then of each face.
+    pub element_labels: Vec<[i64; 2]>,
+}
+
+/// The [`PartMeshes`] of `det`, run on `points`.
+pub fn part_meshes(det: &Detection, points: &[[f64; 3]]) -> PartMeshes {
+    let mut edges = Vec::new();
+    let mut edge_labels = Vec::new();
+    let mut faces = Vec::new();
+    let mut face_labels = Vec::new();
+    let mut part = 0i64;
+    for s in &det.structures {
+        for p in &s.parts {
+            let l = [i64::from(s.id), part];
+            faces.extend_from_slice(&p.mesh);
+            face_labels.extend(std::iter::repeat_n(l, p.mesh.len()));
+            if let Primitive::Line(f) = &p.primitive {
+                let mut along: Vec<(f64, u32)> = p
+                    .vertices
+                    .iter()
+                    .map(|&v| {
+                        let q = points[v as usize];
+                        let t = (0..3)
+                            .map(|k| (q[k] - f.centroid[k]) * f.direction[k])
+                            .sum::<f64>();
+                        (t, v)
+                    })
+                    .collect();
+                along.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+                for w in along.windows(2) {
+                    edges.push([w[0].1, w[1].1]);
+                    edge_labels.push(l);
+                }
+            }
+            part += 1;
+        }
+    }
+    edge_labels.extend(face_labels);
+    PartMeshes {
+        edges,
+        faces,
+        element_labels: edge_labels,
+    }
 }

@@ -4,7 +4,7 @@
 //! 1e-9 relative, `inf` exactly where CGAL has it. See
 //! fixtures/CGAL_README.md.
 
-mod common;
+use crate::common;
 use aniso_alpha::alpha::{q_matrix, AlphaComplex};
 use common::*;
 

@@ -9,7 +9,7 @@
 //!   vertices exactly when it is a Delaunay edge or triangle with
 //!   `α_min ≤ α ≤ α_max`.
 
-mod alpha_common;
+use crate::alpha_common;
 use alpha_common::*;
 use aniso_alpha::alpha::exact::{edge_diametral_side, triangle_diametral_side};
 use aniso_alpha::alpha::AlphaComplex;

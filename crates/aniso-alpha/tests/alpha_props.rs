@@ -14,7 +14,7 @@
 //!   triangles' exactly, after rounding too, on degenerate sets where
 //!   radii computed by different formulas tie.
 
-mod common;
+use crate::common;
 use aniso_alpha::alpha::{q_matrix, AlphaComplex};
 use common::Rng;
 use proptest::prelude::*;

@@ -1,7 +1,7 @@
 //! The α-shape surface (regular triangles, oriented outward) and
 //! `optimal_alpha`.
 
-mod alpha_common;
+use crate::alpha_common;
 use alpha_common::*;
 use aniso_alpha::alpha::AlphaComplex;
 use aniso_alpha::geometry::{cross, dot, sub};

@@ -1,7 +1,7 @@
 //! Our tets equal CGAL's, tet for tet, on every reference fixture
 //! (copied from the project's shared fixtures; see fixtures/CGAL_README.md).
 
-mod common;
+use crate::common;
 use aniso_alpha::delaunay::Triangulation;
 use common::*;
 

@@ -5,7 +5,7 @@
 //! orientation, local Delaunay with the perturbation (including hull
 //! convexity), Euler characteristic, every input point a vertex.
 
-mod common;
+use crate::common;
 use aniso_alpha::delaunay::Triangulation;
 use aniso_alpha::geometry::predicates::{insphere_perturbed, orient3d, Sign};
 use common::{canonical_sorted, Rng};

@@ -4,7 +4,6 @@
 //! crate's own simple reader; scans with poses written here with the
 //! crate's writer; hostile files (every truncation, byte flips, a lying
 //! point count) give errors, never a panic.
-#![cfg(feature = "e57")]
 
 use std::path::{Path, PathBuf};
 

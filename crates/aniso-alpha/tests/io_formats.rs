@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-mod common;
+use crate::common;
 use common::TempDir;
 
 use aniso_alpha::io::{

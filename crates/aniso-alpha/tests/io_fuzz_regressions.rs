@@ -3,7 +3,6 @@
 //! or a typed error, with and without attributes, and none panics out of
 //! the reader. Specific expectations are checked next to the code (e.g.
 //! `io::las`'s tests) or below.
-#![cfg(feature = "las")]
 
 use std::path::Path;
 

@@ -7,3 +7,8 @@
 mod tempdir;
 #[allow(unused_imports)]
 pub use tempdir::TempDir;
+
+#[path = "../../../aniso-alpha/tests/common/tools.rs"]
+mod tools;
+#[allow(unused_imports)]
+pub use tools::{tool_missing, tools_required};

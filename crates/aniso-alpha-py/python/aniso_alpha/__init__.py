@@ -9,25 +9,42 @@ even on degenerate input. Points in and results out are numpy arrays.
 >>> aa.delaunay(grid).shape
 (48, 4)
 
-Functions: :func:`detect`, :func:`delaunay`, :func:`alpha_intervals`,
-:func:`read`. Every long call releases the GIL and takes ``threads=``
-(default: all cores); bad input raises ``ValueError`` with the library's
-message.
+Functions: :func:`detect` (the CLI's ``detect``, the same options and
+labels), :func:`read` (a :class:`Cloud`: points, normals, attributes),
+:func:`write` (the labelled cloud, as ``detect --output``),
+:func:`labelled_array` (PDAL's structured arrays), :func:`delaunay`,
+:func:`alpha_intervals`. :func:`detect` takes a :class:`Cloud`, PDAL's
+arrays, an Open3D ``PointCloud`` or any (n, 3) array-like; its
+:class:`Detection` lists each :class:`Plane` (equation, inliers, outline)
+or :class:`Segment`. Every long call releases the GIL and takes
+``threads=`` (default: all cores); bad input raises ``ValueError`` with
+the library's message; what the CLI prints as a warning is an
+:class:`AnisoAlphaWarning`.
 
 :mod:`aniso_alpha.distributed` (with the optional ``dask[distributed]``,
 the ``distributed`` extra) runs :func:`detect` tile by tile on a Dask
 cluster, with the same result.
 """
 
-from ._api import AlphaIntervals, Detection, alpha_intervals, delaunay, detect, read
+from ._api import AlphaIntervals, Sampler, Structure, alpha_intervals, delaunay, detect
+from ._io import AnisoAlphaWarning, Cloud, labelled_array, read, write
 from ._native import __version__
+from ._results import Detection, Plane, Segment
 
 __all__ = [
     "AlphaIntervals",
+    "AnisoAlphaWarning",
+    "Cloud",
     "Detection",
+    "Plane",
+    "Sampler",
+    "Segment",
+    "Structure",
     "__version__",
     "alpha_intervals",
     "delaunay",
     "detect",
+    "labelled_array",
     "read",
+    "write",
 ]

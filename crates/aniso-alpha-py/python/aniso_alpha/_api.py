@@ -1,59 +1,25 @@
-"""The functions and result types of :mod:`aniso_alpha` (re-exported there)."""
+"""The functions of :mod:`aniso_alpha` (re-exported there): the
+triangulation, the alpha intervals and the detection."""
 
 from __future__ import annotations
 
 import json
-import os
 from dataclasses import dataclass
-from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, Literal, Optional, Sequence, Tuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _native
+from ._io import _warn, source_points
+from ._results import Detection
 
-__all__ = [
-    "AlphaIntervals",
-    "Detection",
-    "alpha_intervals",
-    "delaunay",
-    "detect",
-    "read",
-]
+__all__ = ["AlphaIntervals", "Sampler", "Structure", "alpha_intervals", "delaunay", "detect"]
 
-PathLike = Union[str, "os.PathLike[str]"]
-
-
-@dataclass(frozen=True, eq=False)
-class Detection:
-    """The result of :func:`detect`.
-
-    Attributes:
-        labels: int64 array of shape (n,): for each input point, the id of the
-            largest structure that holds it (an index into ``structures``),
-            or -1 for background. An exact duplicate has its first
-            occurrence's label.
-        part_labels: int64 array of shape (n,): the id of the planar facet
-            (planes) or straight segment (lines) that holds the point, parts
-            numbered structure by structure, or -1.
-        structures: one dict per structure, largest first, as in the
-            ``"structures"`` list of the JSON report that
-            ``aniso-alpha detect --report`` writes.
-        parameters: the parameters used, as the report's ``"parameters"``.
-    """
-
-    labels: NDArray[np.int64]
-    part_labels: NDArray[np.int64]
-    structures: List[Dict[str, Any]]
-    parameters: Dict[str, Any]
-
-    def __repr__(self) -> str:
-        background = int(np.count_nonzero(self.labels < 0))
-        return (
-            f"Detection({len(self.structures)} structure(s), "
-            f"{len(self.labels)} points of which {background} background, "
-            f"parameters={self.parameters!r})"
-        )
+#: What :func:`detect` looks for.
+Structure = Literal["planes", "lines"]
+#: Where :func:`detect`'s orientations come from.
+Sampler = Literal["data", "box", "fibonacci"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -165,14 +131,6 @@ def alpha_intervals(
         euler: three angles in radians (default 0, 0, 0).
         threads: threads to use (default: all cores); the result does not
             depend on it.
-        normals: optional array-like of shape (n, 3), the points' normals
-            (e.g. a scan's ``nx ny nz``, or Open3D's ``pcd.normals``; the
-            sign does not matter). For planes, a point then joins a plane
-            only if its normal is within 36.9 degrees of the plane's (window
-            frames and ledges stay out of a facade), and the data's
-            orientations come from them. Rows of zeros or NaN are missing
-            normals. Lines ignore them. As ``aniso-alpha detect`` does with
-            a PLY or PCD file that has normals.
 
     Raises:
         ValueError: wrong shape, NaN or infinite coordinates, an elongation
@@ -196,51 +154,132 @@ def alpha_intervals(
     return AlphaIntervals(edges, edge_alpha, triangles, triangle_alpha)
 
 
-def detect(
-    points: ArrayLike,
-    structure: str,
+def detect_options(
     *,
     alpha: Optional[float] = None,
     lambda2: Optional[float] = None,
     lambda3: Optional[float] = None,
     min_size: Optional[int] = None,
-    threads: Optional[int] = None,
+    sampler: Optional[Sampler] = None,
+    m1: float = 0.3,
+    m2: int = 12,
+    step: float = 10.0,
+    epsilon: Optional[float] = 1.0,
+    tile: Optional[float] = None,
+) -> Dict[str, Any]:
+    """The options of :func:`detect` as the extension takes them."""
+    return dict(
+        alpha=alpha,
+        lambda2=lambda2,
+        lambda3=lambda3,
+        min_size=min_size,
+        sampler=sampler,
+        m1=m1,
+        m2=m2,
+        step=step,
+        epsilon=epsilon,
+        tile=tile,
+    )
+
+
+def detect_input(
+    source: Any, normals: Optional[ArrayLike], ignore_normals: bool
+) -> Tuple[Any, Optional[ArrayLike]]:
+    """The points of ``source`` and the normals to use."""
+    points, own = source_points(source)
+    if normals is not None and ignore_normals:
+        raise ValueError("normals are given and ignore_normals=True: pass one or the other")
+    if ignore_normals:
+        return points, None
+    return points, (normals if normals is not None else own)
+
+
+def detect(
+    points: Any,
+    structure: Structure,
+    *,
+    alpha: Optional[float] = None,
+    lambda2: Optional[float] = None,
+    lambda3: Optional[float] = None,
+    min_size: Optional[int] = None,
+    sampler: Optional[Sampler] = None,
+    m1: float = 0.3,
+    m2: int = 12,
+    step: float = 10.0,
+    epsilon: Optional[float] = 1.0,
+    tile: Optional[float] = None,
     normals: Optional[ArrayLike] = None,
+    ignore_normals: bool = False,
+    threads: Optional[int] = None,
 ) -> Detection:
     """Finds lines or planes (and polyhedral surfaces) in ``points`` with
     anisotropic alpha-shapes (Bougleux, Melkemi & Elmoataz 2005), as
-    ``aniso-alpha detect`` does.
+    ``aniso-alpha detect`` does: the options are the CLI's, built into a
+    detector by the same code, and the same file gives the same labels.
 
     Args:
-        points: array-like of shape (n, 3).
+        points: the cloud: a :class:`Cloud` from :func:`aniso_alpha.read`
+            (its normals used for planes, as the CLI uses a file's), a PDAL
+            structured array or mapping of dimensions (``X``, ``Y``, ``Z``,
+            and ``NormalX``, ``NormalY``, ``NormalZ`` when present: what
+            ``pipeline.arrays`` and ``filters.python``'s ``ins`` hold), an
+            Open3D ``PointCloud`` (its ``points``, and ``normals`` when
+            ``has_normals()``), or any array-like of shape (n, 3).
         structure: ``"lines"`` (k = 1, ellipsoids elongated by ``lambda3``)
             or ``"planes"`` (k = 2, flattened by ``lambda2`` and
             ``lambda3``).
-        alpha: the ellipsoid's short semi-axis.
+        alpha: the ellipsoid's short semi-axis, a radius (``--alpha``).
         lambda2: the elongation of the second axis (planes only; default
-            ``lambda3`` when ``lambda3`` is given).
-        lambda3: the elongation of the long axis.
-        min_size: nb_c, the number of simplices a piece needs to count.
+            ``lambda3`` when the run is explicit) (``--lambda2``).
+        lambda3: the elongation of the long axis (``--lambda3``).
+        min_size: nb_c, the number of simplices a piece needs to count
+            (``--min-size``).
+        sampler: the orientations scanned: ``"data"`` (the modes of the
+            local normals or directions), ``"box"`` (the paper's box
+            sampler, ``m1``, ``m2``) or ``"fibonacci"`` (near-uniform,
+            ``step``); default ``"box"`` when ``alpha``, ``lambda3`` and
+            ``min_size`` are all given, else ``"data"`` (``--sampler``).
+        m1: box sampler: the grid spacing on the box faces (``--m1``).
+        m2: turns about a plane's normal when lambda2 != lambda3, box and
+            data orientations (``--m2``).
+        step: Fibonacci sampler: the angular step in degrees (``--step``).
+        epsilon: the significance test's expected false alarms (``--epsilon``);
+            ``None``: no test, min_size alone, as the paper
+            (``--no-significance``).
+        tile: triangulate in tiles of this side (input units) with halos:
+            bounded memory, the same result (``--tile``).
+        normals: the points' normals, array-like (n, 3) (the sign does not
+            matter), overriding those of ``points``: for planes, a point
+            joins a plane only if its normal is within 36.9 degrees of the
+            plane's, and the data's orientations come from them. Rows of
+            zeros or NaN are missing normals. Lines ignore them.
+        ignore_normals: estimate every normal from its neighbourhood even
+            when ``points`` has normals (``--ignore-normals``).
         threads: threads to use (default: all cores); the result does not
-            depend on it.
+            depend on it (``--threads``).
 
     With ``alpha``, ``lambda3`` and ``min_size`` all given, this is the
-    CLI's run with explicit parameters (the paper's box of orientations):
-    the same labels as ``aniso-alpha detect --alpha ... --lambda3 ...
-    --min-size ...``. With any of them left ``None``, the missing ones are
-    estimated from the data (point spacing, noise, the modes of the local
-    normals or directions, which also give the orientations scanned), and
-    the given ones are kept. Each of ``Detection.parameters["alpha"]``,
-    ``["lambda2"]``, ``["lambda3"]`` and ``["min_size"]`` is a dict with its
-    ``"value"``, whether it was ``"estimated"``, and the ``"reason"`` for it.
+    paper's run with explicit parameters (the box of orientations). With
+    any of them left ``None``, the missing ones are estimated from the data
+    (point spacing, noise, the modes of the local normals or directions,
+    which also give the orientations scanned), and the given ones are kept.
+    Each of ``Detection.parameters["alpha"]``, ``["lambda2"]``,
+    ``["lambda3"]`` and ``["min_size"]`` is a dict with its ``"value"``,
+    whether it was ``"estimated"``, and the ``"reason"`` for it.
 
     Returns:
-        a :class:`Detection`: per-point ``labels`` and ``part_labels``, the
-        ``structures`` and the ``parameters`` used.
+        a :class:`Detection`: per-point ``labels`` (structures) and
+        ``part_labels`` (planes or segments), the ``structures``, the
+        ``planes`` or ``segments`` (equation, inliers, outline), the
+        ``parameters`` used. What the CLI prints as a warning (normals
+        given but not used, a very large run) is issued as an
+        :class:`AnisoAlphaWarning`.
 
     Raises:
-        ValueError: wrong shape, no points, NaN or infinite coordinates, a
-            parameter out of range, an unknown ``structure``.
+        ValueError: wrong shape, no points, NaN or infinite coordinates, an
+            option out of range (named as here: ``min_size``), an unknown
+            ``structure`` or ``sampler``.
+        TypeError: an option of the wrong type.
 
     The GIL is released during the detection.
 
@@ -261,36 +300,25 @@ def detect(
     >>> x, y = (a.ravel() for a in np.meshgrid(g, g))
     >>> planes = np.vstack([np.c_[x, y, np.full(900, 10.0)], np.c_[x, np.full(900, 15.0), y]])
     >>> det = aa.detect(planes + np.random.default_rng(1).normal(0, 0.01, planes.shape), "planes")
-    >>> len(det.structures), det.parameters["alpha"]["estimated"]
+    >>> len(det.planes), det.parameters["alpha"]["estimated"]
     (2, True)
     """
-    labels, part_labels, report = _native.detect(
-        points, structure, alpha, lambda2, lambda3, min_size, threads, normals
+    pts, nrm = detect_input(points, normals, ignore_normals)
+    options = detect_options(
+        alpha=alpha,
+        lambda2=lambda2,
+        lambda3=lambda3,
+        min_size=min_size,
+        sampler=sampler,
+        m1=m1,
+        m2=m2,
+        step=step,
+        epsilon=epsilon,
+        tile=tile,
     )
+    labels, part_labels, report, messages, native = _native.detect(
+        pts, structure, options, threads, nrm
+    )
+    _warn(messages)
     r = json.loads(report)
-    return Detection(labels, part_labels, r["structures"], r["parameters"])
-
-
-def read(path: PathLike) -> NDArray[np.float64]:
-    """The points of a point file: float64 array of shape (n, 3), in file
-    order, the format chosen by extension: ``.xyz`` ``.txt`` ``.csv``
-    ``.pts`` (text: x y z in the first three columns), ``.ply`` (ascii and
-    binary), ``.las`` ``.laz``, ``.pcd``, ``.e57``.
-
-    Raises:
-        OSError: the file cannot be opened (``FileNotFoundError``...).
-        ValueError: an unknown extension, a malformed file (the message
-            names the file and, for text, the line), NaN or infinite
-            coordinates, no points.
-
-    The GIL is released while the file is read.
-
-    >>> import os, tempfile, aniso_alpha as aa
-    >>> path = os.path.join(tempfile.mkdtemp(), "points.xyz")
-    >>> with open(path, "w") as f:
-    ...     _ = f.write("x y z\\n0 0 0\\n1 2 3\\n")
-    >>> aa.read(path)
-    array([[0., 0., 0.],
-           [1., 2., 3.]])
-    """
-    return _native.read(os.fspath(path))
+    return Detection(labels, part_labels, r["structures"], r["parameters"], list(messages), native)

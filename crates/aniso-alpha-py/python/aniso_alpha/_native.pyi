@@ -2,7 +2,7 @@
 # (crates/aniso-alpha-py/src/lib.rs). The public, documented API is the
 # package `aniso_alpha`; these are its private building blocks.
 
-from typing import List, Optional, Tuple
+from typing import Any, Dict, List, Optional, Tuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -22,17 +22,23 @@ def alpha_intervals(
 ) -> Tuple[NDArray[np.uint32], NDArray[np.float64], NDArray[np.uint32], NDArray[np.float64]]:
     """(edges, edge [alpha_min, alpha_max], triangles, triangle [alpha_min, alpha_max]), rows sorted."""
 
+class NativeDetection:
+    """A detection kept on the Rust side (for the meshes `write` adds)."""
+
+class LasSource:
+    """A LAS/LAZ file's header, VLRs and records (for `write`)."""
+
+_DetectOut = Tuple[NDArray[np.int64], NDArray[np.int64], str, List[str], NativeDetection]
+
 def detect(
-    points: ArrayLike,
+    points: Any,
     structure: str,
-    alpha: Optional[float] = None,
-    lambda2: Optional[float] = None,
-    lambda3: Optional[float] = None,
-    min_size: Optional[int] = None,
+    options: Optional[Dict[str, Any]] = None,
     threads: Optional[int] = None,
     normals: Optional[ArrayLike] = None,
-) -> Tuple[NDArray[np.int64], NDArray[np.int64], str]:
-    """(labels, part_labels, JSON text of {"structures": [...], "parameters": {...}})."""
+) -> _DetectOut:
+    """(labels, part_labels, JSON text of {"structures": [...], "parameters": {...}},
+    warnings, the detection)."""
 
 class Plan:
     """A split detection run (aniso_alpha.distributed); made by `plan`."""
@@ -46,6 +52,9 @@ class Plan:
     @property
     def jobs(self) -> int:
         """The number of jobs (orientations)."""
+    @property
+    def warnings(self) -> List[str]:
+        """The warnings the CLI would print for this run."""
     def with_tile(self, tile: float) -> "Plan":
         """The same plan with tiles of another side."""
     def tiles(self, points: ArrayLike) -> List[Tuple[Tuple[int, int, int], NDArray[np.uint32]]]:
@@ -63,17 +72,14 @@ class Plan:
         points: ArrayLike,
         outputs: List[Tuple[NDArray[np.uint32], NDArray[np.uint64], int]],
         threads: Optional[int] = None,
-    ) -> Tuple[NDArray[np.int64], NDArray[np.int64], str]:
-        """(labels, part_labels, JSON report) from the tiles' outputs."""
+    ) -> _DetectOut:
+        """(labels, part_labels, JSON report, warnings, detection) from the tiles' outputs."""
 
 def plan(
     points: ArrayLike,
     structure: str,
     tile: float,
-    alpha: Optional[float] = None,
-    lambda2: Optional[float] = None,
-    lambda3: Optional[float] = None,
-    min_size: Optional[int] = None,
+    options: Optional[Dict[str, Any]] = None,
     threads: Optional[int] = None,
     normals: Optional[ArrayLike] = None,
 ) -> Plan:
@@ -95,8 +101,29 @@ def tile_step(
 ) -> Tuple[NDArray[np.uint32], NDArray[np.uint64], int]:
     """(faces flat, offsets per job, points triangulated) of one tile."""
 
-def read(path: str) -> NDArray[np.float64]:
-    """float64 (n, 3), the points of a point file in file order."""
+def read(
+    path: str, attributes: bool = True
+) -> Tuple[
+    NDArray[np.float64],
+    List[Tuple[str, NDArray[Any]]],
+    Optional[NDArray[np.float64]],
+    List[str],
+    Optional[LasSource],
+    str,
+]:
+    """(points, attributes, normals, warnings, LAS source, format name)."""
+
+def write(
+    path: str,
+    points: ArrayLike,
+    attributes: List[Tuple[str, NDArray[Any]]],
+    las: Optional[LasSource],
+    labels: NDArray[np.int64],
+    part_labels: NDArray[np.int64],
+    detection: Optional[NativeDetection] = None,
+    classify: Optional[int] = None,
+) -> None:
+    """Writes the labelled cloud (LAS/LAZ/PLY), as `detect --output`."""
 
 def _points_address(points: ArrayLike) -> int:
     """Address of the float64 buffer the library reads (tests: no copy)."""

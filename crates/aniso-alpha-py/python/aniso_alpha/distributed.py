@@ -32,10 +32,12 @@ import os
 from typing import Any, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from . import _native
-from ._api import Detection, PathLike, read
+from ._api import Structure, detect_input, detect_options
+from ._io import Cloud, PathLike, _warn, read
+from ._results import Detection
 
 __all__ = ["detect", "load", "plan"]
 
@@ -65,11 +67,15 @@ def load(source: Source) -> np.ndarray:
     dtype('float64')
     """
     if isinstance(source, (str, os.PathLike)):
-        return read(source)
+        return read(source, attributes=False).points
+    if isinstance(source, Cloud):
+        return source.points
     if isinstance(source, (list, tuple)) and source and all(
         isinstance(s, (str, os.PathLike)) for s in source
     ):
-        return np.ascontiguousarray(np.concatenate([read(s) for s in source]))
+        return np.ascontiguousarray(
+            np.concatenate([read(s, attributes=False).points for s in source])
+        )
     if hasattr(source, "compute") and hasattr(source, "chunks"):
         source = source.compute()
     a = np.ascontiguousarray(source, dtype=np.float64)
@@ -108,16 +114,13 @@ def _computed(a: Any) -> Any:
 
 def plan(
     points: ArrayLike,
-    structure: str,
+    structure: Structure,
     *,
     tile: Optional[float] = None,
     workers: int = 1,
-    alpha: Optional[float] = None,
-    lambda2: Optional[float] = None,
-    lambda3: Optional[float] = None,
-    min_size: Optional[int] = None,
     threads: Optional[int] = None,
     normals: Optional[ArrayLike] = None,
+    **options: Any,
 ) -> "_native.Plan":
     """The plan of a tiled run over ``points`` (the parameters as
     :func:`aniso_alpha.detect` chooses them, and the tiles): what
@@ -127,12 +130,21 @@ def plan(
 
     The plan has ``tile``, ``halo`` (2·alpha·lambda_max), ``jobs`` (the
     number of orientations) and ``tiles(points)``: a list of (cell, ids).
+    ``options`` are :func:`aniso_alpha.detect`'s (``alpha``, ``lambda2``,
+    ``lambda3``, ``min_size``, ``sampler``, ``m1``, ``m2``, ``step``,
+    ``epsilon``).
     """
     pts = load(points)
     if tile is not None and not (math.isfinite(tile) and tile > 0):
         raise ValueError(f"tile must be positive and finite, got {tile}")
+    if "tile" in options:
+        raise TypeError("plan's tile is the Dask tiles' side, given once")
     p = _native.plan(
-        pts, structure, tile if tile is not None else 1.0, alpha, lambda2, lambda3, min_size, threads,
+        pts,
+        structure,
+        tile if tile is not None else 1.0,
+        detect_options(**options),
+        threads,
         _computed(normals),
     )
     if tile is None:
@@ -140,16 +152,20 @@ def plan(
     return p
 
 
-def _run_tile(spec: Tuple, payload: Tuple, threads: int) -> Tuple[np.ndarray, np.ndarray, int]:
+def _run_tile(
+    spec: Tuple[Any, ...], payload: Tuple[Any, ...], threads: int
+) -> Tuple[NDArray[np.uint32], NDArray[np.uint64], int]:
     """The task a worker runs: every orientation of ``spec`` on one tile."""
     kind, side, rotations, elongations, alphas, groups = spec
     cell, points, ids, members = payload
     offsets, positions = members if members is not None else (None, None)
     # Arrays unpickled from one message frame may be unaligned: the
     # extension reads aligned, C-contiguous buffers (a copy if need be).
+    def aligned(a: Any) -> Any:
+        return None if a is None else np.require(a, requirements=("C", "A"))
+
     rotations, elongations, alphas, groups, ids, offsets, positions = (
-        None if a is None else np.require(a, requirements=("C", "A"))
-        for a in (rotations, elongations, alphas, groups, ids, offsets, positions)
+        aligned(a) for a in (rotations, elongations, alphas, groups, ids, offsets, positions)
     )
     return _native.tile_step(
         kind, side, rotations, elongations, alphas, groups, cell, points, ids,
@@ -166,26 +182,26 @@ def _workers(client: Any) -> int:
 
 def detect(
     source: Source,
-    structure: str,
+    structure: Structure,
     *,
     tile: Optional[float] = None,
     client: Any = None,
     n_workers: Optional[int] = None,
-    alpha: Optional[float] = None,
-    lambda2: Optional[float] = None,
-    lambda3: Optional[float] = None,
-    min_size: Optional[int] = None,
     threads: Optional[int] = None,
     task_threads: int = 1,
     normals: Optional[ArrayLike] = None,
+    ignore_normals: bool = False,
+    **options: Any,
 ) -> Detection:
     """Finds lines or planes as :func:`aniso_alpha.detect` does, with the
     triangulations run as Dask tasks, tile by tile.
 
     Args:
-        source: a path to a point file, a list of paths (e.g. LAS/LAZ tiles,
-            read and concatenated in order), a Dask array of shape (n, 3),
-            or any array-like of shape (n, 3).
+        source: a path to a point file (its normals used, as
+            :func:`aniso_alpha.detect` uses a :class:`~aniso_alpha.Cloud`'s),
+            a :class:`~aniso_alpha.Cloud`, a list of paths (e.g. LAS/LAZ
+            tiles, read and concatenated in order, coordinates only), a
+            Dask array of shape (n, 3), or any array-like of shape (n, 3).
         structure: ``"lines"`` or ``"planes"``.
         tile: the side of the tiles, in input units (default: see
             :func:`plan`). Any side gives the same result; smaller tiles
@@ -194,9 +210,10 @@ def detect(
             ``LocalCluster`` of ``n_workers`` processes (default: one per
             core), one thread each, and closes it at the end.
         n_workers: the workers of the LocalCluster started without a client.
-        alpha, lambda2, lambda3, min_size: as :func:`aniso_alpha.detect`;
-            the missing ones are estimated once, from the whole cloud, on
-            this process.
+        options: :func:`aniso_alpha.detect`'s (``alpha``, ``lambda2``,
+            ``lambda3``, ``min_size``, ``sampler``, ``m1``, ``m2``,
+            ``step``, ``epsilon``); the missing parameters are estimated
+            once, from the whole cloud, on this process.
         threads: threads of the estimate and of the final step, on this
             process (default: all cores).
         task_threads: threads of each tile task (default 1: Dask runs one
@@ -205,6 +222,7 @@ def detect(
             :func:`aniso_alpha.detect`'s ``normals`` (an array-like or a
             Dask array); used on this process, by the estimate and the
             final step (the tiles' triangulations do not need them).
+        ignore_normals: as :func:`aniso_alpha.detect`'s.
 
     Returns:
         the :class:`~aniso_alpha.Detection` of :func:`aniso_alpha.detect`
@@ -232,14 +250,21 @@ def detect(
     """
     from dask.distributed import Client, LocalCluster
 
+    if isinstance(source, (str, os.PathLike)):
+        source = read(source)
+    if isinstance(source, Cloud):
+        _, normals = detect_input(source, normals, ignore_normals)
+        source = source.points
+    else:
+        _, normals = detect_input(None, normals, ignore_normals)
     points = load(source)
     own = None
     if client is None:
         n = int(n_workers) if n_workers else (os.cpu_count() or 1)
-        cluster = LocalCluster(
+        cluster = LocalCluster(  # type: ignore[no-untyped-call]
             n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None
         )
-        own = (Client(cluster), cluster)
+        own = (Client(cluster), cluster)  # type: ignore[no-untyped-call]
         client = own[0]
     try:
         p = plan(
@@ -247,24 +272,24 @@ def detect(
             structure,
             tile=tile,
             workers=_workers(client),
-            alpha=alpha,
-            lambda2=lambda2,
-            lambda3=lambda3,
-            min_size=min_size,
             threads=threads,
             normals=normals,
+            **options,
         )
+        _warn(p.warnings)
         outputs = _run(client, p, points, task_threads)
-        labels, part_labels, report = p.finish(points, outputs, threads)
+        labels, part_labels, report, messages, native = p.finish(points, outputs, threads)
     finally:
         if own is not None:
-            own[0].close()
+            own[0].close()  # type: ignore[no-untyped-call]
             own[1].close()
     r = json.loads(report)
-    return Detection(labels, part_labels, r["structures"], r["parameters"])
+    return Detection(labels, part_labels, r["structures"], r["parameters"], list(messages), native)
 
 
-def _run(client: Any, p: "_native.Plan", points: np.ndarray, task_threads: int) -> List[Tuple]:
+def _run(
+    client: Any, p: "_native.Plan", points: NDArray[np.float64], task_threads: int
+) -> List[Tuple[Any, ...]]:
     """Runs every tile of ``p`` on ``client``'s workers, at most a few tiles
     per worker in flight (the driver never holds every tile's copy of its
     points at once); returns the tiles' outputs in completion order."""
@@ -273,15 +298,15 @@ def _run(client: Any, p: "_native.Plan", points: np.ndarray, task_threads: int) 
     [spec] = client.scatter([p.step_spec()], broadcast=True)
     tiles = iter(p.tiles(points))
     limit = 2 * _workers(client) + 2
-    outputs: List[Tuple] = []
+    outputs: List[Tuple[Any, ...]] = []
 
-    def submit(tile: Tuple) -> Any:
+    def submit(tile: Tuple[Any, ...]) -> Any:
         cell, ids = tile
         payload = (cell, np.ascontiguousarray(points[ids]), ids, p.members(ids))
         [data] = client.scatter([payload])
         return client.submit(_run_tile, spec, data, task_threads, pure=False)
 
-    pending = as_completed([submit(t) for _, t in zip(range(limit), tiles)])
+    pending = as_completed([submit(t) for _, t in zip(range(limit), tiles)])  # type: ignore[no-untyped-call]
     for done in pending:
         faces, offsets, triangulated = done.result()
         # Unpickled from one frame, the arrays may be unaligned (see _run_tile).
@@ -295,5 +320,5 @@ def _run(client: Any, p: "_native.Plan", points: np.ndarray, task_threads: int) 
         done.release()
         nxt = next(tiles, None)
         if nxt is not None:
-            pending.add(submit(nxt))
+            pending.add(submit(nxt))  # type: ignore[no-untyped-call]
     return outputs

@@ -254,9 +254,9 @@ pub const EXPLAINED_MIN: f64 = 0.5;
 /// planes and 1–3 for lines; the top level alone is rarely chosen.
 pub const LADDER_LEVELS: [f64; 5] = [
     0.25,
-    0.353_553_390_593_273_8,
+    std::f64::consts::FRAC_1_SQRT_2 / 2.0,
     0.5,
-    0.707_106_781_186_547_6,
+    std::f64::consts::FRAC_1_SQRT_2,
     1.0,
 ];
 
@@ -744,6 +744,10 @@ fn estimate_with(
                 (0..n as u32).filter(|&i| !off(i as usize)).collect(),
             )
         });
+    let (alpha_p, lambda2_p, lambda3_p) = match &ladder {
+        None => (alpha_p, lambda2_p, lambda3_p),
+        Some(l) => ladder_params(kind, l, explained, spacing_median),
+    };
     Estimate {
         kind,
         points: n,
@@ -779,6 +783,36 @@ fn explained_share(
     let candidates = (0..shapes.len()).filter(|&i| !off(i)).count();
     let explained = member.iter().filter(|&&m| m).count();
     explained as f64 / candidates.max(1) as f64
+}
+
+/// The parameters α, λ₂, λ₃ as a ladder run reports them: α the largest
+/// level's, with every level in the reason.
+fn ladder_params(kind: StructureKind, l: &Ladder, explained: f64, d: f64) -> (Param, Param, Param) {
+    let alphas: Vec<String> = l.alphas.iter().map(|a| format!("{a:.4}")).collect();
+    let why = format!(
+        "scale ladder: the modes of the local {}s explain {:.0}% of the points (under {:.0}%), so \
+         each structure takes the most significant of alpha = {} (reach {C_REACH}·{d:.4}·2^(j/2 - 2), \
+         d the median spacing) with lambda {}",
+        match kind {
+            StructureKind::Planes => "normal",
+            StructureKind::Lines => "direction",
+        },
+        100.0 * explained,
+        100.0 * EXPLAINED_MIN,
+        alphas.join(", "),
+        l.lambda
+    );
+    let param = |value: f64| Param {
+        value,
+        estimated: true,
+        reason: why.clone(),
+    };
+    let top = l.alphas.iter().copied().fold(0.0, f64::max);
+    let l2 = match kind {
+        StructureKind::Planes => l.lambda,
+        StructureKind::Lines => 1.0,
+    };
+    (param(top), param(l2), param(l.lambda))
 }
 
 /// The ladder of a cloud of median nearest-neighbour distance `d` over

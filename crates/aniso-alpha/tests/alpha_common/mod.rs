@@ -228,10 +228,8 @@ pub fn oracle_triangle(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3], p: &[f64; 3]) -
         .signum()
 }
 
-#[path = "../common/mod.rs"]
-mod common;
 /// Deterministic PRNG (SplitMix64), shared with the other tests.
-pub use common::Rng;
+pub use crate::common::Rng;
 
 pub fn random_points(seed: u64, n: usize) -> Vec<[f64; 3]> {
     let mut r = Rng::new(seed);

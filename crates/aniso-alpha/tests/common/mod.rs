@@ -68,3 +68,8 @@ pub use aniso_alpha::rng::SplitMix64 as Rng;
 mod tempdir;
 #[allow(unused_imports)]
 pub use tempdir::TempDir;
+
+#[path = "tools.rs"]
+mod tools;
+#[allow(unused_imports)]
+pub use tools::{tool_missing, tools_required};

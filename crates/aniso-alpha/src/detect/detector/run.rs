@@ -19,6 +19,10 @@ use crate::detect::scan::{
 use crate::detect::StructureKind;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
+/// What one job of a scan gives: per level (one without a ladder), the
+/// group and the result.
+type PerJob<S> = Result<Vec<(u32, JobResult<S>)>, DetectError>;
+
 /// Candidate pairs for the pruning are found once for all orientations
 /// unless there would be more than this many per point (plus a constant):
 /// then each orientation grids its own transformed points.
@@ -128,7 +132,7 @@ impl Detector {
             .collect();
         let total = jobs.len();
         let sf = self.scan_filters(cloud, regime, jobs.len() * levels.len().max(1));
-        let one = |job: &&Job<'_>| -> Result<Vec<(u32, JobResult<S>)>, DetectError> {
+        let one = |job: &&Job<'_>| -> PerJob<S> {
             if cancelled.load(Ordering::Relaxed) {
                 return Err(DetectError::Cancelled);
             }
@@ -151,13 +155,12 @@ impl Detector {
             Ok(r)
         };
         #[cfg(feature = "parallel")]
-        let per: Vec<Result<Vec<(u32, JobResult<S>)>, DetectError>> = {
+        let per: Vec<PerJob<S>> = {
             use rayon::prelude::*;
             jobs.par_iter().map(one).collect()
         };
         #[cfg(not(feature = "parallel"))]
-        let per: Vec<Result<Vec<(u32, JobResult<S>)>, DetectError>> =
-            jobs.iter().map(one).collect();
+        let per: Vec<PerJob<S>> = jobs.iter().map(one).collect();
         if cancelled.load(Ordering::Relaxed) {
             return Err(DetectError::Cancelled);
         }

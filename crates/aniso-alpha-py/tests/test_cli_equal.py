@@ -1,0 +1,160 @@
+"""The same file gives the same labels in Python as in the CLI: a cloud read
+with its normals, every option the CLI has, and the labelled cloud
+written back (the same bytes as `detect --output`)."""
+
+import json
+import warnings
+
+import numpy as np
+import pytest
+
+import aniso_alpha as aa
+from conftest import FIXTURES, read_ints, run_cli
+
+BALL = FIXTURES / "real" / "ball.ply"  # CGAL's ball with its normals (nx ny nz)
+
+
+def cli_detect(cli, path, tmp, *args):
+    run_cli(
+        cli,
+        "detect",
+        path,
+        *args,
+        "--labels",
+        tmp / "labels.txt",
+        "--part-labels",
+        tmp / "parts.txt",
+        "--report",
+        tmp / "report.json",
+    )
+    report = json.loads((tmp / "report.json").read_text())
+    return read_ints(tmp / "labels.txt"), read_ints(tmp / "parts.txt"), report
+
+
+def test_file_with_normals_gives_the_clis_labels(cli, tmp_path):
+    cloud = aa.read(BALL)
+    assert cloud.normals is not None and cloud.normals.shape == (len(cloud), 3)
+    assert {"nx", "ny", "nz"} <= set(cloud.attributes)
+    det = aa.detect(cloud, "planes")
+    labels, parts, report = cli_detect(cli, BALL, tmp_path, "--structure", "planes")
+    np.testing.assert_array_equal(det.labels, labels)
+    np.testing.assert_array_equal(det.part_labels, parts)
+    assert det.parameters == report["parameters"]
+    assert det.parameters["normals"]["source"] == "input"
+    # Without the normals, both estimate them: the same labels again, and
+    # not those with normals.
+    plain = aa.detect(cloud, "planes", ignore_normals=True)
+    labels, _, report = cli_detect(
+        cli, BALL, tmp_path, "--structure", "planes", "--ignore-normals"
+    )
+    np.testing.assert_array_equal(plain.labels, labels)
+    assert plain.parameters["normals"]["source"] == "estimated"
+    assert not np.array_equal(plain.part_labels, det.part_labels)
+
+
+@pytest.fixture(scope="module")
+def small_ball(tmp_path_factory):
+    """Every 8th point of the ball with its normals, as a PLY file."""
+    cloud = aa.read(BALL)
+    rows = np.hstack([cloud.points, cloud.normals])[::8]
+    path = tmp_path_factory.mktemp("ball") / "small_ball.ply"
+    header = (
+        f"ply\nformat ascii 1.0\nelement vertex {len(rows)}\n"
+        + "".join(f"property double {c}\n" for c in ("x", "y", "z", "nx", "ny", "nz"))
+        + "end_header\n"
+    )
+    path.write_text(header + "\n".join(" ".join(repr(float(v)) for v in r) for r in rows) + "\n")
+    return path
+
+
+@pytest.mark.parametrize(
+    "options, flags",
+    [
+        (dict(sampler="fibonacci", step=15.0), ["--sampler", "fibonacci", "--step", 15]),
+        (dict(alpha=0.5, lambda3=6.0, min_size=8, m1=0.5, m2=4), ["--alpha", 0.5, "--lambda3", 6, "--min-size", 8, "--m1", 0.5, "--m2", 4]),
+        (dict(alpha=0.5, lambda3=6.0, min_size=8, sampler="data", epsilon=None), ["--alpha", 0.5, "--lambda3", 6, "--min-size", 8, "--sampler", "data", "--no-significance"]),
+        (dict(epsilon=1e-3, tile=20.0), ["--epsilon", 0.001, "--tile", 20]),
+    ],
+)
+def test_every_option_gives_the_clis_labels(cli, tmp_path, small_ball, options, flags):
+    cloud = aa.read(small_ball)
+    det = aa.detect(cloud, "planes", **options)
+    assert len(det.planes) >= 5
+    labels, parts, report = cli_detect(cli, small_ball, tmp_path, "--structure", "planes", *flags)
+    np.testing.assert_array_equal(det.labels, labels)
+    np.testing.assert_array_equal(det.part_labels, parts)
+    assert det.parameters == report["parameters"]
+
+
+def test_options_are_checked_with_pythons_names():
+    pts = aa.read(BALL).points
+    for options, text in [
+        (dict(min_size=0), "min_size must be between 1"),
+        (dict(m2=0), "m2 must be between 1"),
+        (dict(m1=-1.0), "m1 must be positive"),
+        (dict(step=0.0), "step must be positive"),
+        (dict(epsilon=0.0), "epsilon must be positive"),
+        (dict(tile=-2.0), "tile must be positive"),
+        (dict(sampler="grid"), 'sampler must be "data", "box" or "fibonacci"'),
+    ]:
+        with pytest.raises(ValueError, match=text) as e:
+            aa.detect(pts, "planes", **options)
+        assert "--" not in str(e.value) and "min-size" not in str(e.value)
+    with pytest.raises(TypeError, match="m2 must be an integer"):
+        aa.detect(pts, "planes", m2=1.5)  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="ignore_normals"):
+        aa.detect(pts, "planes", normals=pts, ignore_normals=True)
+
+
+def test_write_gives_the_clis_output(cli, tmp_path):
+    # A LAS input: the records copied byte for byte, the ids as extra bytes,
+    # the classification set; and a PLY input with its meshes.
+    for src, options, flags in [
+        (FIXTURES / "las" / "autzen.las", dict(classify=6), ["--classify", "planes=6"]),
+        (BALL, {}, []),
+    ]:
+        for ext in (".las", ".ply"):
+            cloud = aa.read(src)
+            det = aa.detect(cloud, "planes")
+            ours, theirs = tmp_path / f"py{ext}", tmp_path / f"cli{ext}"
+            aa.write(ours, cloud, det, **options)
+            run_cli(cli, "detect", src, "--structure", "planes", "--output", theirs, *flags)
+            assert ours.read_bytes() == theirs.read_bytes(), (src.name, ext)
+            back = aa.read(ours)
+            np.testing.assert_array_equal(back.attributes["structure"], det.labels)
+            np.testing.assert_array_equal(back.attributes["part"], det.part_labels)
+    # Points alone: the same ids; a wrong count is refused.
+    with pytest.raises(ValueError, match="labels for a cloud of"):
+        aa.write(tmp_path / "x.ply", cloud.points[:10], det)
+
+
+def test_read_keeps_the_attributes_in_their_types():
+    cloud = aa.read(FIXTURES / "las" / "autzen.las")
+    assert cloud.format == "las" and cloud.normals is None
+    assert cloud.attributes["intensity"].dtype == np.uint16
+    assert cloud.attributes["classification"].dtype == np.uint8
+    assert all(len(v) == len(cloud) for v in cloud.attributes.values())
+    # Array-like: the functions that took read's points take the cloud.
+    assert np.asarray(cloud) is cloud.points
+    coords = aa.read(FIXTURES / "las" / "autzen.las", attributes=False)
+    assert coords.attributes == {}
+    np.testing.assert_array_equal(coords.points, cloud.points)
+
+
+def test_warnings_reach_python(tmp_path):
+    # A text file's header line, as the CLI warns.
+    path = tmp_path / "header.xyz"
+    path.write_text("x y z\n0 0 0\n1 0 0\n0 1 0\n")
+    with pytest.warns(aa.AnisoAlphaWarning, match="line 1 taken as a header"):
+        aa.read(path)
+    # Normals that disagree with the points are not used, with the CLI's
+    # warning, and the detection says so.
+    cloud = aa.read(BALL)
+    wrong = np.random.default_rng(5).normal(size=cloud.points.shape)
+    with pytest.warns(aa.AnisoAlphaWarning, match="normals disagree with its points") as w:
+        det = aa.detect(cloud, "planes", normals=wrong)
+    assert det.warnings and det.warnings[0] in str(w[0].message)
+    assert det.parameters["normals"]["input_ignored"] is True
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert aa.detect(cloud, "planes").warnings == []
