@@ -25,6 +25,8 @@ mod delaunay_fixtures;
 mod delaunay_props;
 #[path = "detect_degenerate.rs"]
 mod detect_degenerate;
+#[path = "detect_no_flag.rs"]
+mod detect_no_flag;
 #[path = "detect_robustness.rs"]
 mod detect_robustness;
 #[path = "detect_scenes.rs"]

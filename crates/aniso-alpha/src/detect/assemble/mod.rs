@@ -90,7 +90,7 @@ pub(crate) struct Candidate {
 }
 
 /// A part between the claims and the numbering of structures.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub(crate) struct Draft {
     /// Its points (ascending).
     members: Vec<u32>,

@@ -3,13 +3,13 @@
 //! planes lying apart the joint plane's test (step 5).
 
 use super::super::detection::Primitive;
-use super::super::fit::{fit_line, fit_plane_indices};
+use super::super::fit::fit_line;
 use super::Candidate;
 use crate::geometry::{dot, sub};
 
 /// Share of a piece's points that must lie within τ of the other's
 /// primitive (or of the joint one) for the two to be one.
-const SAME_SHARE: f64 = 0.8;
+pub(super) const SAME_SHARE: f64 = 0.8;
 
 /// What the same-primitive tests look at of a candidate or a part: its
 /// primitive, its claim radius τ and its points.
@@ -100,147 +100,10 @@ pub(super) fn joint_line_keeps(a: Piece, b: Piece, points: &[[f64; 3]]) -> bool 
     within(a.seeds) && within(b.seeds)
 }
 
-/// Whether two parallel planar pieces that lie apart are one plane seen
-/// in two places: the plane fitted to both keeps, for each piece, at least
-/// [`SAME_SHARE`] of the points its own plane keeps within τ. Two pieces
-/// of one wall fitted apart can tilt by a degree or so each (noise, a
-/// slight bow of the wall), so that either one's plane, carried over the
-/// gap, misses the other by more than τ; the joint plane passes through
-/// both. Two distinct parallel planes (a façade and a wall set back from
-/// it by more than τ) leave about half of each piece outside the joint
-/// plane, which lies between them.
-pub(super) fn joint_plane_keeps(a: Piece, b: Piece, angle_deg: f64, points: &[[f64; 3]]) -> bool {
-    let joint: Vec<u32> = a.seeds.iter().chain(b.seeds).copied().collect();
-    let Ok(f) = fit_plane_indices(points, &joint) else {
-        return false;
-    };
-    // The joint plane must be parallel to both pieces: two small patches
-    // at different heights (the floors of two storeys) are both kept by
-    // the plane tilted through them.
-    let cos = angle_deg.to_radians().cos();
-    let parallel = |p: &Piece| match p.fit {
-        Primitive::Plane(q) => dot(q.normal, f.normal).abs() >= cos,
-        _ => false,
-    };
-    if !(parallel(&a) && parallel(&b)) {
-        return false;
-    }
-    let joint_fit = Primitive::Plane(f);
-    let tau = a.tau.max(b.tau);
-    [a, b].iter().all(|p| {
-        let (mut own, mut kept) = (0usize, 0usize);
-        for &v in p.seeds {
-            let q = &points[v as usize];
-            own += usize::from(p.fit.distance(q) <= p.tau);
-            kept += usize::from(joint_fit.distance(q) <= tau);
-        }
-        own > 0 && kept as f64 >= SAME_SHARE * own as f64
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::detect::fit::fit_line_indices;
-    use crate::rng::SplitMix64;
-
-    /// Half-width of the uniform jitter across the test pieces; τ is
-    /// twice it.
-    const NOISE: f64 = 0.03;
-    const TAU: f64 = 0.06;
-
-    /// Points on z = `height(x)` over [xa, xb] × [ya, yb], on a grid of
-    /// step 0.25, jittered across by ±[`NOISE`]: their ids.
-    fn piece(
-        out: &mut Vec<[f64; 3]>,
-        rng: &mut SplitMix64,
-        (xa, xb): (f64, f64),
-        (ya, yb): (f64, f64),
-        height: impl Fn(f64) -> f64,
-    ) -> Vec<u32> {
-        let start = out.len() as u32;
-        let (nx, ny) = (((xb - xa) / 0.25) as usize, ((yb - ya) / 0.25) as usize);
-        for i in 0..=nx {
-            for j in 0..=ny {
-                let (x, y) = (xa + 0.25 * i as f64, ya + 0.25 * j as f64);
-                out.push([x, y, height(x) + NOISE * (2.0 * rng.uniform() - 1.0)]);
-            }
-        }
-        (start..out.len() as u32).collect()
-    }
-
-    fn fit(points: &[[f64; 3]], ids: &[u32]) -> Primitive {
-        Primitive::Plane(fit_plane_indices(points, ids).unwrap())
-    }
-
-    /// A piece's plane, claim radius [`TAU`] and points.
-    fn as_piece<'a>(fit: &'a Primitive, seeds: &'a [u32]) -> Piece<'a> {
-        Piece {
-            fit,
-            tau: TAU,
-            seeds,
-        }
-    }
-
-    #[test]
-    fn a_wall_bowed_across_a_gap_is_one_plane_for_the_joint_fit_only() {
-        // Two pieces of one wall, 10 m apart, each tilted 0.34° the other
-        // way (a bow of 3 cm at their far ends): either piece's own plane,
-        // carried over the gap, misses the other by 6–18 cm, twice τ, so
-        // the test that merges candidates says "two planes"; the plane
-        // fitted to both keeps them.
-        let mut rng = SplitMix64::new(7);
-        let mut pts = Vec::new();
-        let a = piece(&mut pts, &mut rng, (0.0, 10.0), (0.0, 10.0), |x| {
-            0.006 * (x - 5.0)
-        });
-        let b = piece(&mut pts, &mut rng, (20.0, 30.0), (0.0, 10.0), |x| {
-            -0.006 * (x - 25.0)
-        });
-        let (fa, fb) = (fit(&pts, &a), fit(&pts, &b));
-        let (pa, pb) = (as_piece(&fa, &a), as_piece(&fb, &b));
-        assert!(!same_primitive(pa, pb, 10.0, &pts));
-        assert!(joint_plane_keeps(pa, pb, 10.0, &pts));
-        assert!(joint_plane_keeps(pb, pa, 10.0, &pts));
-    }
-
-    #[test]
-    fn two_small_patches_at_two_heights_are_not_one_plane() {
-        // Two flat patches a quarter metre across, 10 m apart and 2.5 m
-        // apart in height (the floors of two storeys): the plane fitted to
-        // both tilts 14° and keeps each within τ, so only its angle to the
-        // patches tells them apart. Without the angle test (90°) they would
-        // be one plane.
-        let mut rng = SplitMix64::new(9);
-        let mut pts = Vec::new();
-        let a = piece(&mut pts, &mut rng, (0.0, 0.25), (0.0, 0.25), |_| 0.0);
-        let b = piece(&mut pts, &mut rng, (10.0, 10.25), (0.0, 0.25), |_| 2.5);
-        let (fa, fb) = (fit(&pts, &a), fit(&pts, &b));
-        let (pa, pb) = (as_piece(&fa, &a), as_piece(&fb, &b));
-        assert!(!joint_plane_keeps(pa, pb, 10.0, &pts));
-        assert!(joint_plane_keeps(pa, pb, 90.0, &pts));
-    }
-
-    #[test]
-    fn a_wall_set_back_by_five_tau_beside_another_stays_apart() {
-        // A façade and a wall 30 cm behind it, side by side: the joint
-        // plane lies between them and keeps about half of each.
-        let mut rng = SplitMix64::new(8);
-        let mut pts = Vec::new();
-        let a = piece(&mut pts, &mut rng, (0.0, 10.0), (0.0, 10.0), |_| 0.0);
-        let b = piece(&mut pts, &mut rng, (0.0, 10.0), (12.0, 22.0), |_| 0.3);
-        let (fa, fb) = (fit(&pts, &a), fit(&pts, &b));
-        let (pa, pb) = (as_piece(&fa, &a), as_piece(&fb, &b));
-        assert!(!same_primitive(pa, pb, 10.0, &pts));
-        assert!(!joint_plane_keeps(pa, pb, 10.0, &pts));
-        // The same two pieces in one plane are one.
-        let mut flat = pts.clone();
-        for &v in &b {
-            flat[v as usize][2] -= 0.3;
-        }
-        let fb = fit(&flat, &b);
-        assert!(joint_plane_keeps(pa, as_piece(&fb, &b), 10.0, &flat));
-    }
 
     #[test]
     fn pieces_of_a_noisy_line_are_one_line_and_crossing_lines_are_not() {
