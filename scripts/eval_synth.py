@@ -6,7 +6,7 @@
 
     python3 scripts/eval_synth.py --bin PATH [--split train|heldout|all]
         [--seeds 1 2 3] [--kinds lines planes crossing polyhedron]
-        [--variants base jitter10 random bg3 bg10] [--modes noflag paper]
+        [--variants base jitter10 random bg3 bg10] [--modes noflag [paper]]
         [--jobs N] [--json out.json] [--md out.md]
 
 Kinds: `synth lines`, `synth planes`, crossing planes (`synth planes
@@ -17,7 +17,8 @@ held-out 101-105 (fixed with the corpus split, scripts/corpus/README.md);
 --seeds overrides both. Modes: `noflag` (`detect SCENE --structure
 lines|planes`) and `paper` (scripts/eval_robustness.py's parameters:
 lines alpha 1, lambda3 10, min-size 4; planes alpha 1, lambda2 4,
-lambda3 8, min-size 20). Each labelling is scored by `aniso-alpha eval
+lambda3 8, min-size 20). The default is `noflag` alone, the quick loop for
+tuning; `--modes noflag paper` gives the full table. Each labelling is scored by `aniso-alpha eval
 --json`.
 """
 import argparse
@@ -105,7 +106,9 @@ def main():
     ap.add_argument("--seeds", type=int, nargs="+", help="these seeds (split 'custom') instead of the split's")
     ap.add_argument("--kinds", nargs="+", default=list(KINDS), choices=list(KINDS))
     ap.add_argument("--variants", nargs="+", default=list(VARIANTS), choices=list(VARIANTS))
-    ap.add_argument("--modes", nargs="+", default=["noflag", "paper"], choices=["noflag", "paper"])
+    ap.add_argument("--modes", nargs="+", default=["noflag"], choices=["noflag", "paper"],
+                    help="noflag (default; about 1 minute a split) and/or paper (about 15-20 minutes a split: "
+                         "the box sampler)")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--json")
     ap.add_argument("--md")
