@@ -267,8 +267,13 @@ fn building_planes_from_the_data() {
         "building, PCA normals: {s:?}, {} orientations",
         det.stats.orientations
     );
-    assert!(s.found >= 11, "{s:?}");
-    assert!(s.parts <= 80, "{s:?}");
+    // Without its normals one noisy floor (4,425 labelled points) comes
+    // out as two overlapping parts of 1,719 and 1,547 points whose joint
+    // plane fails the test: a far piece of 94 points that tilted one of
+    // them into agreement is farther from both than their sizes, and no
+    // longer merges (docs/method.md §4, "what a part is").
+    assert!(s.found >= 10, "{s:?}");
+    assert!(s.parts <= 90, "{s:?}");
     assert!(s.f1 >= 0.83, "{s:?}");
     assert!(worst_rms(&det) < 1.0, "{}", worst_rms(&det));
     check_parts(&det, &points);

@@ -5,13 +5,13 @@
 //! a plane is for RANSAC and for the labels of CGAL's scans.
 //!
 //! **What a part is.** Two pieces of one plane are one part when the gap
-//! between them is at most the size of the smaller one (the longer side
-//! of its bounding rectangle on its plane): a gap smaller than the pieces
-//! reads as a hole in one surface (an occluder's shadow, a window); a gap
-//! larger than both is two surfaces that happen to be coplanar (the flat
-//! roofs of two houses at one height, the floors of two buildings), which
-//! stay two parts. The gap is the distance between the pieces' bounding
-//! boxes.
+//! between them is at most the size of the larger one (the longer side of
+//! its bounding rectangle on its plane): a gap smaller than a piece reads
+//! as a hole in one surface (an occluder's shadow across a wall, a
+//! window); a gap larger than both is two surfaces that happen to be
+//! coplanar (the flat roofs of two houses at one height, the floors of two
+//! buildings), which stay two parts. The gap is the distance between the
+//! pieces' bounding boxes.
 //!
 //! Two parts are one plane by the test that merges candidates (parallel,
 //! each centroid within τ of the other's plane, or most of the smaller
@@ -19,8 +19,9 @@
 //! to both (it keeps, for each piece, most of what its own plane keeps).
 //! A pair is only tested when its normals are within the part angle, each
 //! one's plane passes within τ of the other's bounding box, and the gap
-//! rule holds; the pairs come from a sweep over the boxes sorted along x
-//! (no pair of parts is looked at that the gap rule excludes along x), so
+//! rule holds; the pairs come from a sweep along x over the boxes grown by
+//! their parts' sizes (no pair is looked at whose grown extents along x
+//! are apart, which the gap rule excludes), so
 //! that a large area with thousands of parallel parts (every roof at one
 //! height) costs about one test per neighbouring pair. The pairs are taken
 //! largest pieces first, and each is tested as the groups merged so far:
@@ -119,7 +120,7 @@ fn size(fit: &Primitive) -> f64 {
 }
 
 /// The pairs of parts passing the cheap tests (parallel normals, each
-/// plane within its τ of the other's box, the gap at most the smaller
+/// plane within its τ of the other's box, the gap at most the larger
 /// part's size), largest pieces first.
 fn pairs(
     parts: &[Draft],
@@ -134,18 +135,19 @@ fn pairs(
     let sizes: Vec<f64> = parts.iter().map(|p| size(&p.fit)).collect();
     let tau = |a: usize| cands[parts[a].cand].tau;
     let cos = angle_deg.to_radians().cos();
-    // Sweep along x: b can be within the gap rule of a only if it starts
-    // at most size(a) after a ends.
+    // Sweep along x over each part's box grown by its size: two parts
+    // within the gap rule have grown extents that overlap.
+    let start = |a: usize| boxes[a].0[0] - sizes[a];
+    let end = |a: usize| boxes[a].1[0] + sizes[a];
     let mut order: Vec<usize> = (0..parts.len()).collect();
-    order.sort_by(|&a, &b| boxes[a].0[0].total_cmp(&boxes[b].0[0]).then(a.cmp(&b)));
+    order.sort_by(|&a, &b| start(a).total_cmp(&start(b)).then(a.cmp(&b)));
     let mut pairs: Vec<(usize, usize)> = Vec::new();
     for (k, &a) in order.iter().enumerate() {
-        let reach = boxes[a].1[0] + sizes[a];
         for &b in order[k + 1..].iter() {
-            if boxes[b].0[0] > reach {
+            if start(b) > end(a) {
                 break;
             }
-            if gap(&boxes[a], &boxes[b]) <= sizes[a].min(sizes[b])
+            if gap(&boxes[a], &boxes[b]) <= sizes[a].max(sizes[b])
                 && parallel_planes(&parts[a].fit, &parts[b].fit, cos)
                 && (plane_meets_box(&parts[a].fit, tau(a), &boxes[b])
                     || plane_meets_box(&parts[b].fit, tau(b), &boxes[a]))
@@ -365,7 +367,10 @@ impl Groups {
         angle_deg: f64,
     ) -> bool {
         let (ra, rb) = (uf.find(a as u32) as usize, uf.find(b as u32) as usize);
-        if ra == rb || !self.one_plane(parts, ra, rb, points, angle_deg) {
+        if ra == rb {
+            return false;
+        }
+        if !self.one_plane(parts, ra, rb, points, angle_deg) {
             return false;
         }
         uf.union_min_root(a as u32, b as u32);
