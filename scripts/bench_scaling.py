@@ -1,11 +1,17 @@
 #!/usr/bin/env python3
 """Growth of `detect` (automatic mode) with the number of points at
-constant density (issue: real scans, tiles): copies of the CGAL ball scan
-(the fixture, 31,374 points) laid out on a grid, each copy 1.5 object
-sizes from the next, from 1 copy to 32 (1.0M points). Prints wall time,
-peak RSS, microseconds per point and planes found per copy.
+constant density (issue: real scans, tiles): copies of a scan laid out on
+a grid, from 1 copy to many. By default the CGAL ball scan (the fixture,
+31,374 points), each copy 1.5 object sizes from the next; `--scan` takes
+any binary PLY (e.g. an airborne tile of the corpus, scripts/corpus/) and
+`--spacing 1` lays its copies edge to edge, as the tiles of one survey:
+the ground of every copy is then one plane across the tiles, and every
+roof has a coplanar twin in each copy (the case where merging coplanar
+parts was quadratic). Prints wall time, peak RSS, microseconds per point,
+planes found per copy and, with `--timings`, the CLI's phases.
 
     python3 scripts/bench_scaling.py [--bin target/release/aniso-alpha] [--copies 1,4,16,32]
+        [--scan FILE.ply --spacing 1] [--timeout S]
 
 Needs numpy and GNU time (/usr/bin/time) for the peak RSS.
 """
@@ -25,34 +31,54 @@ import sys  # noqa: E402
 sys.path.insert(0, sys_path)
 from bench_real import read_ply  # noqa: E402
 
+sys.path.insert(0, os.path.join(sys_path, "corpus"))
+from common import read_ply as read_any_ply  # noqa: E402
+
 
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--bin", default=os.path.join(ROOT, "target/release/aniso-alpha"))
     ap.add_argument("--copies", default="1,4,16,32")
     ap.add_argument("--threads", default=None)
+    ap.add_argument("--scan", default=None, help="a binary PLY to copy (default: CGAL's ball)")
+    ap.add_argument("--spacing", type=float, default=1.5,
+                    help="copy pitch in units of the scan's extent (1: edge to edge)")
+    ap.add_argument("--timeout", type=float, default=None, help="seconds per run (then: > timeout)")
     a = ap.parse_args()
-    pts, _ = read_ply(os.path.join(ROOT, "crates/aniso-alpha/tests/fixtures/real/ball.ply"))
-    size = (pts.max(0) - pts.min(0)).max()
-    print("| copies | points | wall s | peak RSS MiB | µs / point | parts | parts / copy |")
-    print("|---:|---:|---:|---:|---:|---:|---:|")
+    if a.scan:
+        v = read_any_ply(a.scan)
+        pts = np.stack([v["x"], v["y"], v["z"]], axis=1).astype(np.float64)
+    else:
+        pts, _ = read_ply(os.path.join(ROOT, "crates/aniso-alpha/tests/fixtures/real/ball.ply"))
+    lo, hi = pts.min(0), pts.max(0)
+    pitch = a.spacing * (hi - lo)
+    print("| copies | points | wall s | peak RSS MiB | µs / point | parts | parts / copy | phases (s) |")
+    print("|---:|---:|---:|---:|---:|---:|---:|---|")
     with tempfile.TemporaryDirectory() as tmp:
         for c in map(int, a.copies.split(",")):
             side = int(np.ceil(np.sqrt(c)))
-            cloud = np.concatenate([pts + np.array([1.5 * size * (k % side), 1.5 * size * (k // side), 0.0])
+            cloud = np.concatenate([pts + np.array([pitch[0] * (k % side), pitch[1] * (k // side), 0.0])
                                     for k in range(c)])
             f = os.path.join(tmp, "copies.xyz")
             np.savetxt(f, cloud, fmt="%.5f")
             rep = os.path.join(tmp, "r.json")
-            args = ["/usr/bin/time", "-f", "%M", a.bin, "detect", f, "--structure", "planes", "--report", rep, "--quiet"]
+            args = ["/usr/bin/time", "-f", "%M", a.bin, "detect", f, "--structure", "planes", "--report", rep,
+                    "--quiet", "--timings"]
             if a.threads:
                 args += ["--threads", a.threads]
             t = time.perf_counter()
-            r = subprocess.run(args, check=True, capture_output=True, text=True)
+            try:
+                r = subprocess.run(args, check=True, capture_output=True, text=True, timeout=a.timeout)
+            except subprocess.TimeoutExpired:
+                print(f"| {c} | {len(cloud)} | > {a.timeout:.0f} | | | | | |", flush=True)
+                continue
             wall = time.perf_counter() - t
-            rss = int(r.stderr.strip().splitlines()[-1]) / 1024
+            lines = r.stderr.strip().splitlines()
+            rss = int(lines[-1]) / 1024
+            phases = next((json.loads(x) for x in lines if x.startswith("{")), {})
+            ph = ", ".join(f"{k} {v:.1f}" for k, v in phases.items() if k != "total")
             parts = sum(len(s.get("parts", [])) for s in json.load(open(rep))["structures"])
-            print(f"| {c} | {len(cloud)} | {wall:.2f} | {rss:.0f} | {1e6 * wall / len(cloud):.1f} | {parts} | {parts / c:.1f} |",
+            print(f"| {c} | {len(cloud)} | {wall:.2f} | {rss:.0f} | {1e6 * wall / len(cloud):.1f} | {parts} | {parts / c:.1f} | {ph} |",
                   flush=True)
 
 
