@@ -524,7 +524,6 @@ fn normals_agreement(shapes: &[LocalShape], normals: &[[f32; 3]]) -> GivenNormal
 /// linear coarse neighbourhoods (linearity ≈ 0.55, planarity ≈ 0.85) make
 /// lines of their own. A pole or a cable is more linear than planar at its
 /// best scales (linearity 0.78–0.93, planarity 0.3–0.7 on that street).
-
 pub fn surface_points(line_shapes: &[LocalShape], plane_shapes: &[LocalShape]) -> Vec<bool> {
     line_shapes
         .iter()
@@ -615,25 +614,96 @@ fn estimate_with(
     let structure: Vec<u32> = (0..n as u32)
         .filter(|&i| shapes[i as usize].score(kind) >= SCORE_MIN && !off(i as usize))
         .collect();
-    let mut sp: Vec<f32> = structure
+    let (spacing, noise) = spacing_and_noise(kind, shapes, &structure, (spacing_median, 0.0));
+    let (alpha_p, lambda2_p, lambda3_p, min_size_p) = cloud_params(kind, spacing, noise, given);
+    let found = concentrated_modes(kind, shapes, &structure, &off);
+    let member_of = mode_members(kind, shapes, &found, &off);
+    let explained = explained_share(kind, shapes, &member_of, &off);
+    let mode_scans: Vec<ModeScan> = found
+        .into_iter()
+        .zip(member_of)
+        .map(|(m, members)| {
+            let core: Vec<u32> = members
+                .iter()
+                .copied()
+                .filter(|&i| shapes[i as usize].score(kind) >= SCORE_MIN)
+                .collect();
+            let (d, sigma) = spacing_and_noise(kind, shapes, &core, (spacing, noise));
+            mode_scan(kind, points, m, members, (d, sigma), given, m2)
+        })
+        .collect();
+    let ladder = (explained < EXPLAINED_MIN
+        && given.alpha.is_none()
+        && given.lambda2.is_none()
+        && given.lambda3.is_none()
+        && spacing_median.is_finite()
+        && spacing_median > 0.0)
+        .then(|| {
+            ladder(
+                spacing_median,
+                (0..n as u32).filter(|&i| !off(i as usize)).collect(),
+            )
+        });
+    let (alpha_p, lambda2_p, lambda3_p) = match &ladder {
+        None => (alpha_p, lambda2_p, lambda3_p),
+        Some(l) => ladder_params(kind, l, explained, spacing_median),
+    };
+    Estimate {
+        kind,
+        points: n,
+        spacing_median,
+        spacing,
+        noise,
+        structure_fraction: structure.len() as f64 / n.max(1) as f64,
+        alpha: alpha_p,
+        lambda2: lambda2_p,
+        lambda3: lambda3_p,
+        min_size: min_size_p,
+        modes: mode_scans,
+        explained,
+        ladder,
+    }
+}
+
+/// The spacing d (90th percentile of the finite nearest-neighbour
+/// distances) and the noise σ (median spread) of the points `ids`, or
+/// `fallback` (d, σ) for each that has no value.
+fn spacing_and_noise(
+    kind: StructureKind,
+    shapes: &[LocalShape],
+    ids: &[u32],
+    fallback: (f64, f64),
+) -> (f64, f64) {
+    let mut sp: Vec<f32> = ids
         .iter()
         .map(|&i| shapes[i as usize].spacing)
         .filter(|s| s.is_finite())
         .collect();
-    let spacing = if sp.is_empty() {
-        spacing_median
+    let d = if sp.is_empty() {
+        fallback.0
     } else {
         quantile(&mut sp, 0.9)
     };
-    let mut noise_v: Vec<f32> = structure
+    let mut nv: Vec<f32> = ids
         .iter()
         .map(|&i| shapes[i as usize].spread(kind))
         .collect();
-    let noise = if noise_v.is_empty() {
-        0.0
+    let sigma = if nv.is_empty() {
+        fallback.1
     } else {
-        quantile(&mut noise_v, 0.5)
+        quantile(&mut nv, 0.5)
     };
+    (d, sigma)
+}
+
+/// The cloud-wide α, λ₂, λ₃ and nb_c (module doc, steps 4–5) from its
+/// spacing and noise, with their reasons; given values kept.
+fn cloud_params(
+    kind: StructureKind,
+    spacing: f64,
+    noise: f64,
+    given: &Given,
+) -> (Param, Param, Param, Param) {
     let (alpha, l2, l3) = scales(kind, spacing, noise, given);
     let param = |value: f64, given: Option<f64>, why: String| Param {
         value,
@@ -675,15 +745,25 @@ fn estimate_with(
                 .into()
         },
     };
-    // Modes of the structure-like axes.
+    (alpha_p, lambda2_p, lambda3_p, min_size_p)
+}
+
+/// The modes of the axes of the structure-like points `structure`
+/// (module doc, step 2) that are concentrated: at least
+/// [`MODE_CONCENTRATION`] of the points within the cone of a mode have
+/// their axis within its kernel.
+fn concentrated_modes(
+    kind: StructureKind,
+    shapes: &[LocalShape],
+    structure: &[u32],
+    off: &dyn Fn(usize) -> bool,
+) -> Vec<Mode> {
     let axes: Vec<[f64; 3]> = structure
         .iter()
         .map(|&i| axis64(&shapes[i as usize], kind))
         .collect();
     let min_support = MODE_MIN_POINTS.max(structure.len() / 1000);
     let mut found: Vec<Mode> = modes(&axes, MODE_KERNEL_DEG.to_radians(), min_support);
-    // Keep the concentrated modes: at least MODE_CONCENTRATION of the
-    // points within the cone of a mode have their axis within the kernel.
     let cos_cone = CONE_DEG.to_radians().cos();
     found.retain(|m| {
         let in_cone = shapes
@@ -693,14 +773,25 @@ fn estimate_with(
             .count();
         m.support as f64 >= MODE_CONCENTRATION * in_cone as f64
     });
-    // Members: a point joins the modes within the cone of its axis, except
-    // those more than MARGIN_DEG farther than its nearest mode (so the
-    // shoulders of a large mode, local maxima made by the blurred normals
-    // near its edges, do not scan its points again).
+    found
+}
+
+/// The members of each mode (module doc, step 3): a point joins the modes
+/// within the cone of its axis, except those more than [`MARGIN_DEG`]
+/// farther than its nearest mode (so the shoulders of a large mode, local
+/// maxima made by the blurred normals near its edges, do not scan its
+/// points again).
+fn mode_members(
+    kind: StructureKind,
+    shapes: &[LocalShape],
+    found: &[Mode],
+    off: &dyn Fn(usize) -> bool,
+) -> Vec<Vec<u32>> {
+    let cos_cone = CONE_DEG.to_radians().cos();
     let margin = MARGIN_DEG.to_radians();
     let mut member_of: Vec<Vec<u32>> = vec![Vec::new(); found.len()];
     let mut ang: Vec<f64> = vec![0.0; found.len()];
-    for i in 0..n as u32 {
+    for i in 0..shapes.len() as u32 {
         if off(i as usize) {
             continue;
         }
@@ -716,87 +807,43 @@ fn estimate_with(
             }
         }
     }
-    let explained = explained_share(kind, shapes, &member_of, &off);
-    let mut mode_scans = Vec::with_capacity(found.len());
-    for (m, members) in found.into_iter().zip(member_of) {
-        let core: Vec<u32> = members
-            .iter()
-            .copied()
-            .filter(|&i| shapes[i as usize].score(kind) >= SCORE_MIN)
-            .collect();
-        let mut sp: Vec<f32> = core
-            .iter()
-            .map(|&i| shapes[i as usize].spacing)
-            .filter(|s| s.is_finite())
-            .collect();
-        let d = if sp.is_empty() {
-            spacing
-        } else {
-            quantile(&mut sp, 0.9)
-        };
-        let mut nv: Vec<f32> = core
-            .iter()
-            .map(|&i| shapes[i as usize].spread(kind))
-            .collect();
-        let sigma = if nv.is_empty() {
-            noise
-        } else {
-            quantile(&mut nv, 0.5)
-        };
-        let (mut a, mut l2, mut l3) = scales(kind, d, sigma, given);
-        let (mut members, mut d) = (members, d);
-        if kind == StructureKind::Lines
-            && given.alpha.is_none()
-            && given.lambda3.is_none()
-            && C_NOISE * sigma >= C_REACH * d
-        {
-            let step = TUBE_STEP * a;
-            members = thin_along(points, &members, m.axis, step, TUBE_WIDTH * a);
-            d = step;
-            (a, l2, l3) = scales(kind, d, sigma, given);
-        }
-        mode_scans.push(ModeScan {
-            axis: m.axis,
-            support: m.support,
-            points: members,
-            spacing: d,
-            noise: sigma,
-            alpha: a,
-            lambda2: l2,
-            lambda3: l3,
-            rotations: mode_rotations(kind, m.axis, l2, l3, m2),
-        });
-    }
-    let ladder = (explained < EXPLAINED_MIN
+    member_of
+}
+
+/// The scan of mode `m` over its `members`, of spacing d and noise σ
+/// (module doc, step 4): its α, λ and rotations, a thick line's members
+/// thinned along its direction.
+fn mode_scan(
+    kind: StructureKind,
+    points: &[[f64; 3]],
+    m: Mode,
+    members: Vec<u32>,
+    (d, sigma): (f64, f64),
+    given: &Given,
+    m2: u32,
+) -> ModeScan {
+    let (mut a, mut l2, mut l3) = scales(kind, d, sigma, given);
+    let (mut members, mut d) = (members, d);
+    if kind == StructureKind::Lines
         && given.alpha.is_none()
-        && given.lambda2.is_none()
         && given.lambda3.is_none()
-        && spacing_median.is_finite()
-        && spacing_median > 0.0)
-        .then(|| {
-            ladder(
-                spacing_median,
-                (0..n as u32).filter(|&i| !off(i as usize)).collect(),
-            )
-        });
-    let (alpha_p, lambda2_p, lambda3_p) = match &ladder {
-        None => (alpha_p, lambda2_p, lambda3_p),
-        Some(l) => ladder_params(kind, l, explained, spacing_median),
-    };
-    Estimate {
-        kind,
-        points: n,
-        spacing_median,
-        spacing,
-        noise,
-        structure_fraction: structure.len() as f64 / n.max(1) as f64,
-        alpha: alpha_p,
-        lambda2: lambda2_p,
-        lambda3: lambda3_p,
-        min_size: min_size_p,
-        modes: mode_scans,
-        explained,
-        ladder,
+        && C_NOISE * sigma >= C_REACH * d
+    {
+        let step = TUBE_STEP * a;
+        members = thin_along(points, &members, m.axis, step, TUBE_WIDTH * a);
+        d = step;
+        (a, l2, l3) = scales(kind, d, sigma, given);
+    }
+    ModeScan {
+        axis: m.axis,
+        support: m.support,
+        points: members,
+        spacing: d,
+        noise: sigma,
+        alpha: a,
+        lambda2: l2,
+        lambda3: l3,
+        rotations: mode_rotations(kind, m.axis, l2, l3, m2),
     }
 }
 

@@ -46,7 +46,9 @@ impl fmt::Display for DetectError {
             DetectError::OutOfRange { index } => write!(
                 f,
                 "point {index} has a coordinate outside 1e-30..1e50 in magnitude (or 0), \
-                 the range of exact arithmetic: rescale the data"
+                 the range of exact arithmetic for detection (narrower than the triangulation's \
+                 1e-60..1e55, so that the points mapped by the ellipsoids stay inside it): rescale \
+                 the data"
             ),
             DetectError::Orientations(e) => write!(f, "orientations: {e}"),
             DetectError::Anisotropy(e) => write!(f, "anisotropy: {e}"),
