@@ -706,12 +706,16 @@ fn summary(
         ));
     }
     o.push_str(&format!(
-        "  {} orientations in {:.2} s; union {} simplices; {} part(s) kept, {} rejected by the significance test\n\n",
+        "  {} orientations in {:.2} s; union {} simplices; {} part(s) kept, {} rejected by the significance test{}\n\n",
         det.stats.orientations,
         seconds,
         det.stats.union_simplices,
         det.num_parts(),
-        det.stats.rejected_parts
+        det.stats.rejected_parts,
+        match det.stats.surface_lines {
+            0 => String::new(),
+            n => format!(", {n} inside a surface (scanner rows, creases)"),
+        }
     ));
     o.push_str(&part_table(det));
     let bg = det.labels.iter().filter(|&&l| l < 0).count();

@@ -208,6 +208,7 @@ pub fn detection_json(det: &Detection, d: &Detector) -> Value {
             "kept_simplices": s.kept_simplices,
             "structure_simplices": s.structure_simplices,
             "rejected_parts": s.rejected_parts,
+            "surface_lines": s.surface_lines,
         },
         "structures": structures_json(det),
         "parts": det.num_parts(),

@@ -157,6 +157,9 @@ pub struct RunStats {
     pub structure_simplices: usize,
     /// Candidate parts rejected by the significance test.
     pub rejected_parts: usize,
+    /// Line parts dropped because they lie inside a surface (its sampling
+    /// pattern: a scanner's rings at a grazing angle).
+    pub surface_lines: usize,
 }
 
 /// The result of [`super::detector::Detector::run`].

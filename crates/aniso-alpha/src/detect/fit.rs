@@ -200,8 +200,10 @@ fn unit(u: [f64; 3]) -> [f64; 3] {
     [u[0] / n, u[1] / n, u[2] / n]
 }
 
-/// Centroid and covariance of `n` points given by `get`.
-fn moments(n: usize, get: &dyn Fn(usize) -> [f64; 3]) -> ([f64; 3], Mat3) {
+/// Centroid and covariance (divided by `n`) of `n` points given by `get`:
+/// the one place the detector forms a second-moment matrix from points.
+pub(crate) fn moments(n: usize, get: impl Fn(usize) -> [f64; 3]) -> ([f64; 3], Mat3) {
+    let nf = n as f64;
     let mut c = [0.0; 3];
     for i in 0..n {
         let p = get(i);
@@ -209,8 +211,7 @@ fn moments(n: usize, get: &dyn Fn(usize) -> [f64; 3]) -> ([f64; 3], Mat3) {
             c[k] += p[k];
         }
     }
-    let inv = 1.0 / n as f64;
-    c = [c[0] * inv, c[1] * inv, c[2] * inv];
+    c = c.map(|x| x / nf);
     let mut m = [[0.0; 3]; 3];
     for i in 0..n {
         let p = get(i);
@@ -223,7 +224,7 @@ fn moments(n: usize, get: &dyn Fn(usize) -> [f64; 3]) -> ([f64; 3], Mat3) {
     }
     for r in 0..3 {
         for s in r..3 {
-            m[r][s] *= inv;
+            m[r][s] /= nf;
             m[s][r] = m[r][s];
         }
     }

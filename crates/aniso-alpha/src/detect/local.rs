@@ -226,31 +226,7 @@ fn any_orthogonal(u: [f64; 3]) -> [f64; 3] {
 /// Principal standard deviations (descending) and axes (rows, matching) of
 /// the points `ids`.
 fn pca(points: &[[f64; 3]], ids: &[(f64, u32)]) -> ([f64; 3], [[f64; 3]; 3]) {
-    let n = ids.len() as f64;
-    let mut c = [0.0; 3];
-    for &(_, i) in ids {
-        let p = points[i as usize];
-        for k in 0..3 {
-            c[k] += p[k];
-        }
-    }
-    c = c.map(|x| x / n);
-    let mut m = [[0.0; 3]; 3];
-    for &(_, i) in ids {
-        let p = points[i as usize];
-        let d = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
-        for r in 0..3 {
-            for s in r..3 {
-                m[r][s] += d[r] * d[s];
-            }
-        }
-    }
-    for r in 0..3 {
-        for s in r..3 {
-            m[r][s] /= n;
-            m[s][r] = m[r][s];
-        }
-    }
+    let (_, m) = super::fit::moments(ids.len(), |k| points[ids[k].1 as usize]);
     let (vals, vecs) = eigen_sym3(m);
     (vals.map(|v| v.max(0.0).sqrt()), vecs)
 }

@@ -67,14 +67,15 @@ impl Regime {
     }
 
     /// Whether the scan's path filter follows straight chains through
-    /// ramifications (`scan::straight_filter`): short lines with
-    /// orientations from a sampler. Not with the data's orientations: the
-    /// automatic mode is for real scans, whose scanner rows (straight
-    /// chains of points across every surface) would be followed too
-    /// (measured on the simulated street: 199 → 569 parts, precision
-    /// 0.47 → 0.21).
+    /// ramifications (`scan::straight_filter`): short lines, whatever the
+    /// orientations. A thin cable sampled densely (points closer than its
+    /// width and noise) makes a web of edges at its α, which the paper's
+    /// filter deletes whole (the simulated street's cables: 5% of their
+    /// points found). The scanner rows that straight chains also follow
+    /// across surfaces are the assembly's to drop (lines inside a surface,
+    /// docs/method.md §4).
     pub(crate) fn follows_straight_chains(&self) -> bool {
-        self.keeps_short_lines() && !self.from_data
+        self.keeps_short_lines()
     }
 
     /// Whether a candidate's claim radius may widen with its noise (the

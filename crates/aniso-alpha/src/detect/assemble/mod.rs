@@ -37,6 +37,7 @@
 
 mod candidates;
 mod claims;
+mod embedded;
 mod footprint;
 mod merging;
 mod same;
@@ -171,6 +172,8 @@ pub(crate) fn level<S: Shape>(
     if let Some(log10_epsilon) = regime.significance() {
         stats.rejected_parts += significance::reject::<S>(&mut parts, &cands, cloud, log10_epsilon);
     }
+    // 4b. Lines inside a surface.
+    stats.surface_lines += S::reject_in_surface(&mut parts, &cands, cloud);
     Ok(Level {
         cands,
         claims,

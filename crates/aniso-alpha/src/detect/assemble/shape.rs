@@ -6,10 +6,12 @@
 //! part gets. As CGAL's Shape_detection region types do, each shape
 //! carries its own rules and the stages call them.
 
+use super::super::cloud::Cloud;
 use super::super::detection::Primitive;
 use super::super::fit::LineFit;
 use super::super::outline::outline;
 use super::super::scan::Face;
+use super::embedded;
 use super::footprint::Footprint;
 use super::same::{joint_line_keeps, same_primitive, Piece};
 use super::widen::{CLAIM_RADII, MAX_WIDEN_BACKGROUND};
@@ -89,6 +91,15 @@ pub(crate) trait Shape: Face {
         _angle_deg: f64,
     ) {
     }
+    /// Drops the parts that lie inside a surface, its sampling rather than
+    /// a structure of this shape; how many went. By default none.
+    fn reject_in_surface(
+        _parts: &mut Vec<Draft>,
+        _cands: &[Candidate],
+        _cloud: &Cloud<'_>,
+    ) -> usize {
+        0
+    }
     /// A part's outline (or segment) and mesh.
     fn outline(fit: &Primitive, members: &[u32], cell: f64, points: &[[f64; 3]]) -> PartShape;
 }
@@ -138,6 +149,12 @@ impl Shape for [u32; 2] {
     /// A path of nb_c edges has nb_c + 1 points.
     fn min_vertices(nb_c: u32) -> usize {
         nb_c as usize + 1
+    }
+
+    /// A line inside a surface is the surface's sampling
+    /// ([`embedded::reject_lines`]).
+    fn reject_in_surface(parts: &mut Vec<Draft>, cands: &[Candidate], cloud: &Cloud<'_>) -> usize {
+        embedded::reject_lines(parts, cands, cloud)
     }
 
     /// Pieces of one noisy line are one ([`joint_line_keeps`]), and so are

@@ -1,0 +1,298 @@
+//! Stage 4b of the assembly (docs/method.md §4, "Lines inside a surface"):
+//! a line part that lies inside a surface is that surface's sampling, not a
+//! line, and goes.
+//!
+//! A scanner samples a surface along rings; far from the scanner, at a
+//! grazing angle, the rings lie much farther apart than the points along a
+//! ring, and each ring is a significant line under a uniform background.
+//! The other side of the same fact: the points around such a "line"
+//! (within half its length across it) form a plane that contains it, where
+//! a pole, a cable or a line in clutter has nothing around it, or clutter
+//! without a plane, or a plane that it stands off.
+//!
+//! The test, for a line part of length L with claim radius τ, looks at
+//! the points that are not its members, within L of its axis (the rings
+//! of a surface seen at a grazing angle lie up to a line's length apart)
+//! and projecting onto the middle 80% of its span (so that the ground at a
+//! pole's foot or the structure at a line's ends does not count). A
+//! surface that holds the line meets them in sheets: half-planes bounded
+//! by the axis (one for the edge of a surface, two for a plane through the
+//! line or for a crease where two surfaces meet). The line lies inside a
+//! surface when at most two such sheets, each of points within τ of it
+//! and spread along the line (a structure crossing the line, as a pole
+//! through a crossbar, is not a sheet along it), hold at least as many
+//! points as the line and at least half of the points around it.
+//!
+//! Planes have no such test (a plane inside a volume is what the
+//! significance test already weighs).
+
+use super::super::cloud::Cloud;
+use super::{Candidate, Draft};
+use crate::geometry::{dot, sub};
+use crate::par::map_ranges;
+
+/// Share of the span at each end left out of the surroundings.
+const END_SHARE: f64 = 0.1;
+
+/// Drops the line parts that lie inside a surface (module doc); how many
+/// went. Parts in parallel.
+pub(super) fn reject_lines(
+    parts: &mut Vec<Draft>,
+    cands: &[Candidate],
+    cloud: &Cloud<'_>,
+) -> usize {
+    let inside = map_ranges(parts.len(), Vec::new, |buf: &mut Vec<u32>, pi| {
+        let p = &parts[pi];
+        in_surface(p, cands[p.cand].tau, cloud, buf)
+    });
+    let before = parts.len();
+    let mut it = inside.into_iter();
+    parts.retain(|_| !it.next().unwrap_or(false));
+    before - parts.len()
+}
+
+/// Whether the line part `p` of claim radius `tau` lies inside a surface
+/// (module doc); `around` is a buffer for the surrounding points.
+fn in_surface(p: &Draft, tau: f64, cloud: &Cloud<'_>, around: &mut Vec<u32>) -> bool {
+    let super::Primitive::Line(f) = &p.fit else {
+        return false;
+    };
+    let points = cloud.points();
+    let (mut t0, mut t1) = (f64::INFINITY, f64::NEG_INFINITY);
+    for &v in &p.members {
+        let t = dot(sub(points[v as usize], f.centroid), f.direction);
+        t0 = t0.min(t);
+        t1 = t1.max(t);
+    }
+    let length = t1 - t0;
+    if length.is_nan() || length <= 0.0 {
+        return false;
+    }
+    let (lo, hi) = (t0 + END_SHARE * length, t1 - END_SHARE * length);
+    let radius = length;
+    let mid = 0.5 * (t0 + t1);
+    let centre = [0, 1, 2].map(|k| f.centroid[k] + mid * f.direction[k]);
+    let reach = (radius * radius + 0.25 * (hi - lo) * (hi - lo)).sqrt();
+    around.clear();
+    let copies = cloud.copies();
+    cloud.index().within(&centre, reach, |v| {
+        if !copies.is_first(v as usize) || p.members.binary_search(&v).is_ok() {
+            return;
+        }
+        let d = sub(points[v as usize], f.centroid);
+        let t = dot(d, f.direction);
+        if t < lo || t > hi {
+            return;
+        }
+        let across = dot(d, d) - t * t;
+        if across <= radius * radius {
+            around.push(v);
+        }
+    });
+    if around.len() < p.members.len() {
+        return false;
+    }
+    let (u, w) = across_axes(f.direction);
+    // Each surrounding point: its place along the axis, and where it lies
+    // across it (angle and distance).
+    let placed: Vec<(f64, f64, f64)> = around
+        .iter()
+        .map(|&v| {
+            let d = sub(points[v as usize], f.centroid);
+            let (x, y) = (dot(d, u), dot(d, w));
+            (dot(d, f.direction), y.atan2(x), x.hypot(y))
+        })
+        .collect();
+    let mut taken = vec![false; placed.len()];
+    let mut on_sheets = 0;
+    for _ in 0..2 {
+        let Some(phi) = best_half_plane(&placed, &taken, tau) else {
+            break;
+        };
+        let sheet: Vec<usize> = (0..placed.len())
+            .filter(|&i| !taken[i] && on_half_plane(placed[i], phi, tau))
+            .collect();
+        let along: Vec<f64> = sheet.iter().map(|&i| placed[i].0).collect();
+        if spread(&along) * 2.0 < spread_uniform(lo, hi) {
+            continue; // a crossing structure, not a sheet along the line
+        }
+        for &i in &sheet {
+            taken[i] = true;
+        }
+        on_sheets += sheet.len();
+    }
+    on_sheets >= p.members.len() && 2 * on_sheets >= placed.len()
+}
+
+/// Two unit vectors across the direction `d`.
+fn across_axes(d: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+    let a = if d[0].abs() < 0.9 {
+        [1.0, 0.0, 0.0]
+    } else {
+        [0.0, 1.0, 0.0]
+    };
+    let u = crate::geometry::cross(d, a);
+    let n = dot(u, u).sqrt();
+    let u = u.map(|x| x / n);
+    (u, crate::geometry::cross(d, u))
+}
+
+/// Whether the point (along, angle, distance) across the axis lies within
+/// `tol` of the half-plane at angle `phi` bounded by the axis.
+fn on_half_plane((_, theta, r): (f64, f64, f64), phi: f64, tol: f64) -> bool {
+    let (s, c) = (theta - phi).sin_cos();
+    r <= tol || (c > 0.0 && r * s.abs() <= tol)
+}
+
+/// Number of angle bins of the half-plane search (1°).
+const ANGLE_BINS: usize = 360;
+
+/// The angle of the half-plane bounded by the axis that holds the most of
+/// the points not `taken` (each within `tol`), from a histogram of angles
+/// in which a point counts for every bin within its angular tolerance;
+/// `None` when no point is left.
+fn best_half_plane(placed: &[(f64, f64, f64)], taken: &[bool], tol: f64) -> Option<f64> {
+    use std::f64::consts::PI;
+    let bins = ANGLE_BINS as isize;
+    let width = 2.0 * PI / ANGLE_BINS as f64;
+    let mut diff = vec![0i64; ANGLE_BINS + 1];
+    let mut any = false;
+    for (&(_, theta, r), _) in placed.iter().zip(taken).filter(|(_, &t)| !t) {
+        any = true;
+        let reach = if r <= tol { PI } else { (tol / r).asin() };
+        let centre = ((theta + PI) / width).floor() as isize;
+        let half = (reach / width).ceil() as isize;
+        if 2 * half + 1 >= bins {
+            diff[0] += 1;
+            diff[ANGLE_BINS] -= 1;
+            continue;
+        }
+        let (a, b) = (
+            (centre - half).rem_euclid(bins) as usize,
+            (centre + half + 1).rem_euclid(bins) as usize,
+        );
+        diff[a] += 1;
+        diff[b] -= 1;
+        if a >= b {
+            // The range wraps past the last bin.
+            diff[ANGLE_BINS] -= 1;
+            diff[0] += 1;
+        }
+    }
+    if !any {
+        return None;
+    }
+    let (mut run, mut best, mut at) = (0i64, i64::MIN, 0usize);
+    for (i, d) in diff.iter().take(ANGLE_BINS).enumerate() {
+        run += d;
+        if run > best {
+            best = run;
+            at = i;
+        }
+    }
+    Some((at as f64 + 0.5) * width - PI)
+}
+
+/// The standard deviation of `xs` (0 for fewer than two).
+fn spread(xs: &[f64]) -> f64 {
+    if xs.len() < 2 {
+        return 0.0;
+    }
+    let n = xs.len() as f64;
+    let m = xs.iter().sum::<f64>() / n;
+    (xs.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / n).sqrt()
+}
+
+/// The standard deviation of points spread evenly over `[lo, hi]`.
+fn spread_uniform(lo: f64, hi: f64) -> f64 {
+    (hi - lo) / 12f64.sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::super::cloud::{Cloud, Copies};
+    use super::super::super::detection::Primitive;
+    use super::super::super::fit::fit_line;
+    use super::*;
+
+    /// A line of 40 points along x at height `z`, spacing 0.05.
+    fn line_at(y: f64, z: f64) -> Vec<[f64; 3]> {
+        (0..40).map(|i| [i as f64 * 0.05, y, z]).collect()
+    }
+
+    fn run(points: &[[f64; 3]], members: Vec<u32>, tau: f64) -> bool {
+        let copies = Copies::none(points.len());
+        let cloud = Cloud::new(points, &copies);
+        let mv: Vec<[f64; 3]> = members.iter().map(|&v| points[v as usize]).collect();
+        let fit = Primitive::Line(fit_line(&mv).expect("a line"));
+        let part = Draft::with_candidate(points, members, fit, 0, (tau, 0.1)).0;
+        in_surface(&part, tau, &cloud, &mut Vec::new())
+    }
+
+    #[test]
+    fn a_ring_among_rings_lies_in_its_surface() {
+        // Rings 0.4 apart on the ground, the middle one the part.
+        let mut pts = Vec::new();
+        for r in -3..=3 {
+            pts.extend(line_at(r as f64 * 0.4, 0.0));
+        }
+        let members: Vec<u32> = (120..160).collect();
+        assert!(run(&pts, members, 0.01));
+    }
+
+    #[test]
+    fn a_crease_or_a_surface_edge_lies_in_its_surface() {
+        // The foot of a wall: rings on the ground (y < 0) and on the wall
+        // (z > 0), the corner ring the part.
+        let mut pts = line_at(0.0, 0.0);
+        for r in 1..=4 {
+            pts.extend(line_at(-(r as f64) * 0.4, 0.0));
+            pts.extend(line_at(0.0, r as f64 * 0.4));
+        }
+        assert!(run(&pts, (0..40).collect(), 0.01));
+        // The edge of the ground alone.
+        let mut pts = line_at(0.0, 0.0);
+        for r in 1..=4 {
+            pts.extend(line_at(-(r as f64) * 0.4, 0.0));
+        }
+        assert!(run(&pts, (0..40).collect(), 0.01));
+    }
+
+    #[test]
+    fn a_line_above_a_plane_or_alone_stands_free() {
+        // The same rings, and the part 0.5 above the middle one: off the plane.
+        let mut pts = Vec::new();
+        for r in -3..=3 {
+            pts.extend(line_at(r as f64 * 0.4, 0.0));
+        }
+        let first = pts.len() as u32;
+        pts.extend(line_at(0.0, 0.5));
+        let members: Vec<u32> = (first..first + 40).collect();
+        assert!(!run(&pts, members, 0.01));
+        // Alone: nothing around it.
+        let alone = line_at(0.0, 0.0);
+        assert!(!run(&alone, (0..40).collect(), 0.01));
+    }
+
+    #[test]
+    fn a_line_crossing_another_or_in_scattered_points_stands_free() {
+        // A perpendicular line through its middle (a crossbar on a pole):
+        // the surroundings are linear.
+        let mut pts = line_at(0.0, 0.0);
+        pts.extend((0..80).map(|i| [1.0, 0.0, -2.0 + i as f64 * 0.05]));
+        assert!(!run(&pts, (0..40).collect(), 0.01));
+        // Scattered points around it (a uniform background).
+        let mut pts = line_at(0.0, 0.0);
+        let mut s = 12345u64;
+        let mut rnd = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..400 {
+            pts.push([rnd() * 2.0, rnd() * 2.0 - 1.0, rnd() * 2.0 - 1.0]);
+        }
+        assert!(!run(&pts, (0..40).collect(), 0.01));
+    }
+}
