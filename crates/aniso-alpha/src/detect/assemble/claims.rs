@@ -67,10 +67,15 @@ impl Claims {
                         }
                     },
                 );
+                // Held until every candidate is done: no growth slack.
+                claims.shrink_to_fit();
                 claims
             },
         );
-        let mut claims: Vec<Claim> = per_cand.into_iter().flatten().collect();
+        let mut claims: Vec<Claim> = Vec::with_capacity(per_cand.iter().map(Vec::len).sum());
+        for c in per_cand {
+            claims.extend(c);
+        }
         claims.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.cmp(&b.1)));
         Claims(claims)
     }
@@ -100,8 +105,13 @@ impl Claims {
 
     /// The distinct pairs (a < b) of what `of` maps two candidates claimed
     /// by one point to, sorted; `None` and equal images are left out.
+    /// Every point of a large plane repeats the same few pairs, so the list
+    /// is deduplicated whenever it has doubled: its memory follows the
+    /// distinct pairs, not the claims.
     pub(super) fn shared(&self, of: impl Fn(u32) -> Option<u32>) -> Vec<(u32, u32)> {
+        const FIRST_DEDUP: usize = 1 << 12;
         let mut pairs: Vec<(u32, u32)> = Vec::new();
+        let mut dedup_at = FIRST_DEDUP;
         for here in self.by_point() {
             for (k, a) in here.iter().enumerate() {
                 for b in &here[k + 1..] {
@@ -111,6 +121,11 @@ impl Claims {
                         }
                     }
                 }
+            }
+            if pairs.len() >= dedup_at {
+                pairs.sort_unstable();
+                pairs.dedup();
+                dedup_at = (2 * pairs.len()).max(FIRST_DEDUP);
             }
         }
         pairs.sort_unstable();
