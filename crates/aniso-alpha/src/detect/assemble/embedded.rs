@@ -23,6 +23,9 @@
 //! through a crossbar, is not a sheet along it), hold at least as many
 //! points as the line and at least half of the points around it.
 //!
+//! Rows are lines too: the middle one of three coplanar parallel cables
+//! with nothing else around them lies inside their "surface" as well.
+//!
 //! Planes have no such test (a plane inside a volume is what the
 //! significance test already weighs).
 
@@ -272,6 +275,16 @@ mod tests {
         // Alone: nothing around it.
         let alone = line_at(0.0, 0.0);
         assert!(!run(&alone, (0..40).collect(), 0.01));
+        // A cable 1.2 above densely sampled ground (rows 0.05 apart, within
+        // the window of radius 1.95): one row lies right below it, most of
+        // the ground does not lie in a half-plane bounded by the cable.
+        let mut pts = Vec::new();
+        for r in -40..=40 {
+            pts.extend(line_at(r as f64 * 0.05, 0.0));
+        }
+        let first = pts.len() as u32;
+        pts.extend(line_at(0.0, 1.2));
+        assert!(!run(&pts, (first..first + 40).collect(), 0.01));
     }
 
     #[test]
