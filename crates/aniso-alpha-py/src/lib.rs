@@ -12,6 +12,7 @@
 mod convert;
 mod errors;
 mod options;
+mod progress;
 mod report;
 mod run;
 mod split;
@@ -169,8 +170,13 @@ pub(crate) fn extract_normals<'py>(n: &Bound<'py, PyAny>) -> PyResult<Points<'py
 /// (alpha, lambda2, lambda3, min_size, sampler, m1, m2, step, epsilon,
 /// tile), built into a detector as the CLI builds its flags
 /// ([`DetectOptions::build`](aniso_alpha::options::DetectOptions::build)).
+///
+/// `progress`, when given, is called as `progress(done, total)` after each
+/// orientation scanned, from the worker threads (the GIL taken for the
+/// call); returning `False` cancels the run, and an exception it raises
+/// cancels the run and is raised again from here.
 #[pyfunction]
-#[pyo3(signature = (points, structure, options = None, threads = None, normals = None))]
+#[pyo3(signature = (points, structure, options = None, threads = None, normals = None, progress = None))]
 fn detect<'py>(
     py: Python<'py>,
     points: &Bound<'py, PyAny>,
@@ -178,6 +184,7 @@ fn detect<'py>(
     options: Option<&Bound<'py, PyDict>>,
     threads: Option<i64>,
     normals: Option<&Bound<'py, PyAny>>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<DetectOut<'py>> {
     let options = options::detect_options(structure, options)?;
     let points = Points::extract(points)?;
@@ -188,10 +195,19 @@ fn detect<'py>(
     // The whole call (estimation included) runs on the pool of `detached`,
     // which the library's parallel loops use: no `Detector::threads`, which
     // would start a second pool.
+    let callback = progress.map(progress::Callback::new);
     let (det, json, warnings) = detached(py, threads, |n| {
-        let detector = options::build(&options, pts, normals)?;
+        let mut detector = options::build(&options, pts, normals)?;
+        if let Some(cb) = &callback {
+            detector = detector.progress(cb.tick());
+        }
         let warnings = run_warnings(&options, &detector, pts.len(), n, Style::Python);
-        let det = detector.run(pts).map_err(value_error)?;
+        let det = detector.run(pts).map_err(|e| {
+            callback
+                .as_ref()
+                .and_then(|cb| cb.error(&e))
+                .unwrap_or_else(|| value_error(e))
+        })?;
         let json = report::detection_json(&det, &detector);
         Ok((det, json, warnings))
     })?;

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass
-from typing import Any, Dict, Literal, Optional, Sequence, Tuple
+from typing import Any, Callable, Dict, Literal, Optional, Sequence, Tuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -211,6 +211,7 @@ def detect(
     normals: Optional[ArrayLike] = None,
     ignore_normals: bool = False,
     threads: Optional[int] = None,
+    progress: Optional[Callable[[int, int], Optional[bool]]] = None,
 ) -> Detection:
     """Finds lines or planes (and polyhedral surfaces) in ``points`` with
     anisotropic alpha-shapes (Bougleux, Melkemi & Elmoataz 2005), as
@@ -257,6 +258,13 @@ def detect(
             when ``points`` has normals (``--ignore-normals``).
         threads: threads to use (default: all cores); the result does not
             depend on it (``--threads``).
+        progress: called as ``progress(done, total)`` after each orientation
+            scanned (the CLI's progress bar), from the worker threads; it
+            returns ``False`` to cancel the run (``RuntimeError``), and an
+            exception it raises cancels the run and is raised again. A tqdm
+            bar: ``progress=lambda done, total: bar.update(1)`` with
+            ``tqdm(total=...)``, or set ``bar.total = total`` on the first
+            call.
 
     With ``alpha``, ``lambda3`` and ``min_size`` all given, this is the
     paper's run with explicit parameters (the box of orientations). With
@@ -317,7 +325,7 @@ def detect(
         tile=tile,
     )
     labels, part_labels, report, messages, native = _native.detect(
-        pts, structure, options, threads, nrm
+        pts, structure, options, threads, nrm, progress
     )
     _warn(messages)
     r = json.loads(report)

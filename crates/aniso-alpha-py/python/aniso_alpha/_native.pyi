@@ -2,7 +2,7 @@
 # (crates/aniso-alpha-py/src/lib.rs). The public, documented API is the
 # package `aniso_alpha`; these are its private building blocks.
 
-from typing import Any, Dict, List, Optional, Tuple
+from typing import Any, Callable, Dict, List, Optional, Tuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -36,6 +36,7 @@ def detect(
     options: Optional[Dict[str, Any]] = None,
     threads: Optional[int] = None,
     normals: Optional[ArrayLike] = None,
+    progress: Optional[Callable[[int, int], Optional[bool]]] = None,
 ) -> _DetectOut:
     """(labels, part_labels, JSON text of {"structures": [...], "parameters": {...}},
     warnings, the detection)."""

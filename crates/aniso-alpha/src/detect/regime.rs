@@ -120,7 +120,7 @@ mod tests {
         // Lines ignore normals.
         assert!(lines.claim_normals().is_none());
         let data_lines = Regime::new(StructureKind::Lines, Some(1.0), true, None);
-        assert!(data_lines.keeps_short_lines() && !data_lines.follows_straight_chains());
+        assert!(data_lines.keeps_short_lines() && data_lines.follows_straight_chains());
         assert!(!data_lines.scans_every_point());
         let paper = Regime::new(StructureKind::Lines, None, false, None);
         assert!(!paper.keeps_short_lines() && !paper.widens_claims());
