@@ -8,10 +8,15 @@ any binary PLY (e.g. an airborne tile of the corpus, scripts/corpus/) and
 the ground of every copy is then one plane across the tiles, and every
 roof has a coplanar twin in each copy (the case where merging coplanar
 parts was quadratic). Prints wall time, peak RSS, microseconds per point,
-planes found per copy and, with `--timings`, the CLI's phases.
+planes found per copy and the CLI's phases (`--timings`). With `--peer`
+(scripts/peers/cgal_shapes.cpp), CGAL's Efficient RANSAC runs on the same
+cloud in the same loop (`--peer-args`, e.g. the scan's best preset of
+scripts/bench_corpus.py), and the table gets its wall time, peak RSS and
+our ratios to them.
 
     python3 scripts/bench_scaling.py [--bin target/release/aniso-alpha] [--copies 1,4,16,32]
-        [--scan FILE.ply --spacing 1] [--timeout S]
+        [--scan FILE.ply --spacing 1] [--timeout S] [--threads N]
+        [--peer cgal_shapes --peer-args "--epsilon 0.15 --cluster-epsilon 0.49 --min-points 100"]
 
 Needs numpy and GNU time (/usr/bin/time) for the peak RSS.
 """
@@ -44,6 +49,8 @@ def main():
     ap.add_argument("--spacing", type=float, default=1.5,
                     help="copy pitch in units of the scan's extent (1: edge to edge)")
     ap.add_argument("--timeout", type=float, default=None, help="seconds per run (then: > timeout)")
+    ap.add_argument("--peer", default=None, help="CGAL peer binary (scripts/peers/cgal_shapes.cpp)")
+    ap.add_argument("--peer-args", default="", help="its options, one string")
     a = ap.parse_args()
     if a.scan:
         v = read_any_ply(a.scan)
@@ -52,8 +59,9 @@ def main():
         pts, _ = read_ply(os.path.join(ROOT, "crates/aniso-alpha/tests/fixtures/real/ball.ply"))
     lo, hi = pts.min(0), pts.max(0)
     pitch = a.spacing * (hi - lo)
-    print("| copies | points | wall s | peak RSS MiB | µs / point | parts | parts / copy | phases (s) |")
-    print("|---:|---:|---:|---:|---:|---:|---:|---|")
+    peer_cols = " RANSAC wall s | RANSAC RSS MiB | wall / RANSAC | RSS / RANSAC |" if a.peer else ""
+    print("| copies | points | wall s | peak RSS MiB | µs / point | parts | parts / copy | phases (s) |" + peer_cols)
+    print("|---:|---:|---:|---:|---:|---:|---:|---|" + ("---:|" * 4 if a.peer else ""))
     with tempfile.TemporaryDirectory() as tmp:
         for c in map(int, a.copies.split(",")):
             side = int(np.ceil(np.sqrt(c)))
@@ -78,8 +86,20 @@ def main():
             phases = next((json.loads(x) for x in lines if x.startswith("{")), {})
             ph = ", ".join(f"{k} {v:.1f}" for k, v in phases.items() if k != "total")
             parts = sum(len(s.get("parts", [])) for s in json.load(open(rep))["structures"])
-            print(f"| {c} | {len(cloud)} | {wall:.2f} | {rss:.0f} | {1e6 * wall / len(cloud):.1f} | {parts} | {parts / c:.1f} | {ph} |",
-                  flush=True)
+            peer = ""
+            if a.peer:
+                pw, prss = run_peer(a, f, os.path.join(tmp, "peer.txt"))
+                peer = f" {pw:.2f} | {prss:.0f} | {wall / pw:.2f} | {rss / prss:.2f} |"
+            print(f"| {c} | {len(cloud)} | {wall:.2f} | {rss:.0f} | {1e6 * wall / len(cloud):.1f} | {parts} | {parts / c:.1f} | {ph} |"
+                  + peer, flush=True)
+
+
+def run_peer(a, xyz, labels):
+    """Wall time and peak RSS (MiB) of CGAL's Efficient RANSAC on `xyz`."""
+    args = ["/usr/bin/time", "-f", "%M", a.peer, "ransac", xyz, labels, *a.peer_args.split()]
+    t = time.perf_counter()
+    r = subprocess.run(args, check=True, capture_output=True, text=True)
+    return time.perf_counter() - t, int(r.stderr.strip().splitlines()[-1]) / 1024
 
 
 if __name__ == "__main__":
