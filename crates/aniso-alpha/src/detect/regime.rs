@@ -48,6 +48,16 @@ impl Regime {
         self.log10_epsilon
     }
 
+    /// Whether line parts lying inside a surface are dropped
+    /// (`assemble::embedded`): lines with the data's orientations, the
+    /// automatic mode for real scans, whose scanners sample surfaces in
+    /// rows. With the user's scale and a sampler (the paper's runs) a row
+    /// of points is a line: three parallel lines in a plane, the paper's
+    /// Fig. 12, are three lines.
+    pub(crate) fn drops_lines_inside_surfaces(&self) -> bool {
+        self.kind == StructureKind::Lines && self.from_data
+    }
+
     /// Whether every orientation looks at every point (a sampler's or
     /// explicit rotations), so that the pruning's candidate pairs can be
     /// found once for all of them; the data's modes each look at their
@@ -121,6 +131,7 @@ mod tests {
         assert!(lines.claim_normals().is_none());
         let data_lines = Regime::new(StructureKind::Lines, Some(1.0), true, None);
         assert!(data_lines.keeps_short_lines() && data_lines.follows_straight_chains());
+        assert!(data_lines.drops_lines_inside_surfaces() && !lines.drops_lines_inside_surfaces());
         assert!(!data_lines.scans_every_point());
         let paper = Regime::new(StructureKind::Lines, None, false, None);
         assert!(!paper.keeps_short_lines() && !paper.widens_claims());

@@ -23,8 +23,10 @@
 //! through a crossbar, is not a sheet along it), hold at least as many
 //! points as the line and at least half of the points around it.
 //!
-//! Rows are lines too: the middle one of three coplanar parallel cables
-//! with nothing else around them lies inside their "surface" as well.
+//! Rows are lines too: three coplanar parallel cables with nothing else
+//! around them lie inside their "surface" as well. So the stage runs in
+//! the automatic mode only (`Regime::drops_lines_inside_surfaces`), and
+//! with the user's scale and a sampler every row stays a line.
 //!
 //! Planes have no such test (a plane inside a volume is what the
 //! significance test already weighs).

@@ -173,7 +173,9 @@ pub(crate) fn level<S: Shape>(
         stats.rejected_parts += significance::reject::<S>(&mut parts, &cands, cloud, log10_epsilon);
     }
     // 4b. Lines inside a surface.
-    stats.surface_lines += S::reject_in_surface(&mut parts, &cands, cloud);
+    if regime.drops_lines_inside_surfaces() {
+        stats.surface_lines += S::reject_in_surface(&mut parts, &cands, cloud);
+    }
     Ok(Level {
         cands,
         claims,
