@@ -50,7 +50,10 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "corpus"))
-from common import load_manifest, prepared_path, read_ply  # noqa: E402
+from common import load_manifest, prepared_path, read_ply, write_results  # noqa: E402
+
+sys.path.insert(1, os.path.dirname(os.path.abspath(__file__)))
+from bench_real import score  # noqa: E402  (the scores of every plane benchmark)
 
 RANSAC = "CGAL Efficient RANSAC"
 REGION = "CGAL region growing"
@@ -71,28 +74,6 @@ def timed(cmd, env=None):
             if "Maximum resident set size" in line:
                 rss = int(line.split(":")[1]) / 1024
     return wall, rss, r.stdout
-
-
-def plane_scores(truth, pred, min_true=1000):
-    tp = int(np.sum((truth >= 0) & (pred >= 0)))
-    fp = int(np.sum((truth < 0) & (pred >= 0)))
-    fn = int(np.sum((truth >= 0) & (pred < 0)))
-    p = tp / max(tp + fp, 1)
-    r = tp / max(tp + fn, 1)
-    f1 = 2 * p * r / max(p + r, 1e-12)
-    found = big = 0
-    for t, c in zip(*np.unique(truth[truth >= 0], return_counts=True)):
-        if c < min_true:
-            continue
-        big += 1
-        m = truth == t
-        ps, cs = np.unique(pred[m & (pred >= 0)], return_counts=True)
-        if len(ps):
-            j = np.argmax(cs)
-            if 2 * cs[j] >= c and 2 * cs[j] > np.sum(pred == ps[j]):
-                found += 1
-    return {"precision": round(p, 4), "recall": round(r, 4), "f1": round(f1, 4), "found": found, "big": big,
-            "parts": int(len(np.unique(pred[pred >= 0])))}
 
 
 def class_recall(cls, pred, names):
@@ -153,7 +134,7 @@ def bench_scan(scan, a, have_cgal, have_o3d):
         if do_planes:
             wall, rss, _ = timed([a.bin, "detect", ply, "--structure", "planes", "--part-labels", out, "--quiet"])
             pred = np.loadtxt(out, dtype=np.int64)
-            m = {"wall_s": round(wall, 3), "rss_mib": round(rss, 1), "planes": plane_scores(plane, pred)}
+            m = {"wall_s": round(wall, 3), "rss_mib": round(rss, 1), "planes": score(plane, pred, digits=4)}
             if "classes" in scan["scores"]:
                 m["classes"] = class_recall(cls, pred, scan["classes"])
             res["methods"][OURS] = m
@@ -161,7 +142,7 @@ def bench_scan(scan, a, have_cgal, have_o3d):
             wall, rss, _ = timed([a.bin, "detect", ply, "--structure", "lines", "--part-labels", out, "--quiet"])
             pred = np.loadtxt(out, dtype=np.int64)
             res["methods"].setdefault(OURS, {})["lines"] = {"wall_s": round(wall, 3), "rss_mib": round(rss, 1),
-                                                            **plane_scores(line, pred, min_true=10 ** 9)}
+                                                            **score(line, pred, min_true=10 ** 9, digits=4)}
         if not (a.peers and do_planes):
             return res
         sp = spacing(xyz)
@@ -187,7 +168,7 @@ def bench_scan(scan, a, have_cgal, have_o3d):
                 wall, rss, _ = timed([sys.executable, worker, xyzf, str(p["distance"]), str(p["min_points"]), out])
                 runs.append((OPEN3D, p, wall, rss, np.loadtxt(out, dtype=np.int64)))
         for name, p, wall, rss, pred in runs:
-            s = plane_scores(plane, pred)
+            s = score(plane, pred, digits=4)
             best = res["methods"].get(name)
             entry = {"wall_s": round(wall, 3), "rss_mib": round(rss, 1), "planes": s,
                      "preset": p or "CGAL defaults", "presets_tried": (best or {}).get("presets_tried", 0) + 1}
@@ -313,14 +294,7 @@ def main():
     for split in ("train", "heldout"):
         if split in by_split:
             out += fmt_table(by_split[split], split)
-    text = "\n".join(out)
-    print(text)
-    if a.md:
-        with open(a.md, "w") as f:
-            f.write(text + "\n")
-    if a.json:
-        with open(a.json, "w") as f:
-            json.dump({"bin": a.bin, "peers": a.peers, "jobs": a.jobs, "scans": rows}, f, indent=1)
+    write_results("\n".join(out), a.md, a.json, {"bin": a.bin, "peers": a.peers, "jobs": a.jobs, "scans": rows})
 
 
 if __name__ == "__main__":

@@ -100,7 +100,11 @@ def read_ply(path, normals=False):
     return xyz, labels, nrm
 
 
-def score(truth, pred, min_true=1000):
+def score(truth, pred, min_true=1000, digits=3):
+    """Per-point precision, recall and F1 of "in a plane" (rounded to
+    `digits`), the labelled planes of at least `min_true` points that one
+    part holds at least half of (and at least half of that part is theirs),
+    their number, and the parts."""
     tp = np.sum((truth >= 0) & (pred >= 0))
     fp = np.sum((truth < 0) & (pred >= 0))
     fn = np.sum((truth >= 0) & (pred < 0))
@@ -119,8 +123,8 @@ def score(truth, pred, min_true=1000):
             if 2 * cs[j] >= c and 2 * cs[j] > np.sum(pred == ps[j]):
                 found += 1
     parts = len(np.unique(pred[pred >= 0]))
-    return dict(precision=round(float(p), 3), recall=round(float(r), 3), f1=round(float(f1), 3),
-                found=found, big=big, parts=parts)
+    return dict(precision=round(float(p), digits), recall=round(float(r), digits), f1=round(float(f1), digits),
+                found=found, big=big, parts=int(parts))
 
 
 def run_ours(binary, ply, out, extra=()):

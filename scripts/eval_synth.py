@@ -30,6 +30,9 @@ import tempfile
 import time
 from concurrent.futures import ThreadPoolExecutor
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "corpus"))
+from common import write_results  # noqa: E402
+
 SEEDS = {"train": [1, 2, 3, 4, 5], "heldout": [101, 102, 103, 104, 105]}
 KINDS = {
     "lines": ("lines", []),
@@ -132,14 +135,7 @@ def main():
            f"{time.perf_counter() - t0:.0f} s (jobs {a.jobs})", ""]
     for m in a.modes:
         out += table(rows, m, splits, a.kinds, a.variants)
-    text = "\n".join(out)
-    print(text)
-    if a.md:
-        with open(a.md, "w") as f:
-            f.write(text + "\n")
-    if a.json:
-        with open(a.json, "w") as f:
-            json.dump({"bin": a.bin, "seeds": seeds, "runs": rows}, f, indent=1)
+    write_results("\n".join(out), a.md, a.json, {"bin": a.bin, "seeds": seeds, "runs": rows})
 
 
 if __name__ == "__main__":

@@ -82,3 +82,15 @@ def sha256(path):
         for chunk in iter(lambda: f.read(1 << 20), b""):
             h.update(chunk)
     return h.hexdigest()
+
+
+def write_results(text, md, json_path, payload):
+    """Prints the tables `text`, and writes them to `md` and `payload` to
+    `json_path` where those are given (the benchmark scripts' outputs)."""
+    print(text)
+    if md:
+        with open(md, "w") as f:
+            f.write(text + "\n")
+    if json_path:
+        with open(json_path, "w") as f:
+            json.dump(payload, f, indent=1)
