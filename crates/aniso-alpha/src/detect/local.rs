@@ -212,7 +212,8 @@ pub fn eigen_sym3(a: [[f64; 3]; 3]) -> ([f64; 3], [[f64; 3]; 3]) {
     ([l1, l2, l3], [v1, v2, v3])
 }
 
-fn any_orthogonal(u: [f64; 3]) -> [f64; 3] {
+/// A unit vector orthogonal to the unit vector `u`.
+pub(crate) fn any_orthogonal(u: [f64; 3]) -> [f64; 3] {
     let t = if u[0].abs() < 0.9 {
         [1.0, 0.0, 0.0]
     } else {

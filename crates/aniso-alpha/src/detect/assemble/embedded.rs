@@ -6,7 +6,7 @@
 //! grazing angle, the rings lie much farther apart than the points along a
 //! ring, and each ring is a significant line under a uniform background.
 //! The other side of the same fact: the points around such a "line"
-//! (within half its length across it) form a plane that contains it, where
+//! (within its length across it) form a plane that contains it, where
 //! a pole, a cable or a line in clutter has nothing around it, or clutter
 //! without a plane, or a plane that it stands off.
 //!
@@ -32,8 +32,10 @@
 //! significance test already weighs).
 
 use super::super::cloud::Cloud;
+use super::super::local::any_orthogonal;
+use super::shape::span;
 use super::{Candidate, Draft};
-use crate::geometry::{dot, sub};
+use crate::geometry::{cross, dot, sub};
 use crate::par::map_ranges;
 
 /// Share of the span at each end left out of the surroundings.
@@ -46,7 +48,7 @@ pub(super) fn reject_lines(
     cands: &[Candidate],
     cloud: &Cloud<'_>,
 ) -> usize {
-    let inside = map_ranges(parts.len(), Vec::new, |buf: &mut Vec<u32>, pi| {
+    let inside = map_ranges(parts.len(), Vec::new, |buf: &mut Vec<Placed>, pi| {
         let p = &parts[pi];
         in_surface(p, cands[p.cand].tau, cloud, buf)
     });
@@ -56,19 +58,18 @@ pub(super) fn reject_lines(
     before - parts.len()
 }
 
+/// A point around a line: its place along the axis, and where it lies
+/// across it (angle and distance).
+type Placed = (f64, f64, f64);
+
 /// Whether the line part `p` of claim radius `tau` lies inside a surface
-/// (module doc); `around` is a buffer for the surrounding points.
-fn in_surface(p: &Draft, tau: f64, cloud: &Cloud<'_>, around: &mut Vec<u32>) -> bool {
+/// (module doc); `placed` is a buffer for the surrounding points.
+fn in_surface(p: &Draft, tau: f64, cloud: &Cloud<'_>, placed: &mut Vec<Placed>) -> bool {
     let super::Primitive::Line(f) = &p.fit else {
         return false;
     };
     let points = cloud.points();
-    let (mut t0, mut t1) = (f64::INFINITY, f64::NEG_INFINITY);
-    for &v in &p.members {
-        let t = dot(sub(points[v as usize], f.centroid), f.direction);
-        t0 = t0.min(t);
-        t1 = t1.max(t);
-    }
+    let (t0, t1) = span(f, &p.members, points);
     let length = t1 - t0;
     if length.is_nan() || length <= 0.0 {
         return false;
@@ -78,7 +79,9 @@ fn in_surface(p: &Draft, tau: f64, cloud: &Cloud<'_>, around: &mut Vec<u32>) -> 
     let mid = 0.5 * (t0 + t1);
     let centre = [0, 1, 2].map(|k| f.centroid[k] + mid * f.direction[k]);
     let reach = (radius * radius + 0.25 * (hi - lo) * (hi - lo)).sqrt();
-    around.clear();
+    let u = any_orthogonal(f.direction);
+    let w = cross(f.direction, u);
+    placed.clear();
     let copies = cloud.copies();
     cloud.index().within(&centre, reach, |v| {
         if !copies.is_first(v as usize) || p.members.binary_search(&v).is_ok() {
@@ -86,32 +89,19 @@ fn in_surface(p: &Draft, tau: f64, cloud: &Cloud<'_>, around: &mut Vec<u32>) -> 
         }
         let d = sub(points[v as usize], f.centroid);
         let t = dot(d, f.direction);
-        if t < lo || t > hi {
-            return;
-        }
-        let across = dot(d, d) - t * t;
-        if across <= radius * radius {
-            around.push(v);
+        let (x, y) = (dot(d, u), dot(d, w));
+        let r = x.hypot(y);
+        if (lo..=hi).contains(&t) && r <= radius {
+            placed.push((t, y.atan2(x), r));
         }
     });
-    if around.len() < p.members.len() {
+    if placed.len() < p.members.len() {
         return false;
     }
-    let (u, w) = across_axes(f.direction);
-    // Each surrounding point: its place along the axis, and where it lies
-    // across it (angle and distance).
-    let placed: Vec<(f64, f64, f64)> = around
-        .iter()
-        .map(|&v| {
-            let d = sub(points[v as usize], f.centroid);
-            let (x, y) = (dot(d, u), dot(d, w));
-            (dot(d, f.direction), y.atan2(x), x.hypot(y))
-        })
-        .collect();
     let mut taken = vec![false; placed.len()];
     let mut on_sheets = 0;
     for _ in 0..2 {
-        let Some(phi) = best_half_plane(&placed, &taken, tau) else {
+        let Some(phi) = best_half_plane(placed, &taken, tau) else {
             break;
         };
         let sheet: Vec<usize> = (0..placed.len())
@@ -129,22 +119,9 @@ fn in_surface(p: &Draft, tau: f64, cloud: &Cloud<'_>, around: &mut Vec<u32>) -> 
     on_sheets >= p.members.len() && 2 * on_sheets >= placed.len()
 }
 
-/// Two unit vectors across the direction `d`.
-fn across_axes(d: [f64; 3]) -> ([f64; 3], [f64; 3]) {
-    let a = if d[0].abs() < 0.9 {
-        [1.0, 0.0, 0.0]
-    } else {
-        [0.0, 1.0, 0.0]
-    };
-    let u = crate::geometry::cross(d, a);
-    let n = dot(u, u).sqrt();
-    let u = u.map(|x| x / n);
-    (u, crate::geometry::cross(d, u))
-}
-
 /// Whether the point (along, angle, distance) across the axis lies within
 /// `tol` of the half-plane at angle `phi` bounded by the axis.
-fn on_half_plane((_, theta, r): (f64, f64, f64), phi: f64, tol: f64) -> bool {
+fn on_half_plane((_, theta, r): Placed, phi: f64, tol: f64) -> bool {
     let (s, c) = (theta - phi).sin_cos();
     r <= tol || (c > 0.0 && r * s.abs() <= tol)
 }
@@ -156,7 +133,7 @@ const ANGLE_BINS: usize = 360;
 /// the points not `taken` (each within `tol`), from a histogram of angles
 /// in which a point counts for every bin within its angular tolerance;
 /// `None` when no point is left.
-fn best_half_plane(placed: &[(f64, f64, f64)], taken: &[bool], tol: f64) -> Option<f64> {
+fn best_half_plane(placed: &[Placed], taken: &[bool], tol: f64) -> Option<f64> {
     use std::f64::consts::PI;
     let bins = ANGLE_BINS as isize;
     let width = 2.0 * PI / ANGLE_BINS as f64;

@@ -134,7 +134,7 @@ fn count_sides(offsets: impl Iterator<Item = u8>) -> (usize, usize) {
 }
 
 /// The extreme positions of `members` along the line `f`.
-fn span(f: &LineFit, members: &[u32], points: &[[f64; 3]]) -> (f64, f64) {
+pub(super) fn span(f: &LineFit, members: &[u32], points: &[[f64; 3]]) -> (f64, f64) {
     let (mut t0, mut t1) = (f64::INFINITY, f64::NEG_INFINITY);
     for &v in members {
         let t = dot(sub(points[v as usize], f.centroid), f.direction);
