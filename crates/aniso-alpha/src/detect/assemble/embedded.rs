@@ -193,8 +193,6 @@ fn spread_uniform(lo: f64, hi: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::super::super::cloud::{Cloud, Copies};
-    use super::super::super::detection::Primitive;
-    use super::super::super::fit::fit_line;
     use super::*;
 
     /// A line of 40 points along x at height `z`, spacing 0.05.
@@ -205,9 +203,7 @@ mod tests {
     fn run(points: &[[f64; 3]], members: Vec<u32>, tau: f64) -> bool {
         let copies = Copies::none(points.len());
         let cloud = Cloud::new(points, &copies);
-        let mv: Vec<[f64; 3]> = members.iter().map(|&v| points[v as usize]).collect();
-        let fit = Primitive::Line(fit_line(&mv).expect("a line"));
-        let part = Draft::with_candidate(points, members, fit, 0, (tau, 0.1)).0;
+        let part = Draft::line(points, members, 0, (tau, 0.1)).0;
         in_surface(&part, tau, &cloud, &mut Vec::new())
     }
 

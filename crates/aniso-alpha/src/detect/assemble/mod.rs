@@ -133,6 +133,33 @@ impl Draft {
         };
         (d, c)
     }
+
+    /// [`Draft::with_candidate`] with the line fitted to `members`.
+    fn line(
+        points: &[[f64; 3]],
+        members: Vec<u32>,
+        cand: usize,
+        scale: (f64, f64),
+    ) -> (Draft, Candidate) {
+        let fit = Primitive::Line(
+            super::fit::fit_line_indices(points, &members).expect("a line through the members"),
+        );
+        Draft::with_candidate(points, members, fit, cand, scale)
+    }
+}
+
+/// For the stages' tests: 2,000 uniform background points in a 100-unit
+/// cube (from `seed`) and 30 points aligned along x, 2 apart, after them;
+/// the points and the first aligned one's index.
+#[cfg(test)]
+fn cube_with_a_line(seed: u64) -> (Vec<[f64; 3]>, u32) {
+    let mut rng = crate::rng::SplitMix64::new(seed);
+    let mut pts: Vec<[f64; 3]> = (0..2000)
+        .map(|_| [0, 1, 2].map(|_| 100.0 * rng.uniform()))
+        .collect();
+    let n = pts.len() as u32;
+    pts.extend((0..30).map(|i| [20.0 + 2.0 * i as f64, 50.0, 50.0]));
+    (pts, n)
 }
 
 /// The parts one scale (level) of a run found, before they meet the other

@@ -130,9 +130,7 @@ fn rest_of<S: Shape>(
 mod tests {
     use super::*;
     use crate::detect::cloud::Copies;
-    use crate::detect::fit::fit_line_indices;
     use crate::detect::StructureKind;
-    use crate::rng::SplitMix64;
 
     /// A part of the points `members` fitted as a line, its candidate
     /// numbered `cand` (τ 0.5, cell 5), with log₁₀ NFA `nfa`.
@@ -142,8 +140,7 @@ mod tests {
         cand: usize,
         nfa: f64,
     ) -> (Draft, super::super::Candidate) {
-        let fit = Primitive::Line(fit_line_indices(pts, &members).unwrap());
-        let (mut d, c) = Draft::with_candidate(pts, members, fit, cand, (0.5, 5.0));
+        let (mut d, c) = Draft::line(pts, members, cand, (0.5, 5.0));
         d.log10_nfa = nfa;
         (d, c)
     }
@@ -151,12 +148,7 @@ mod tests {
     #[test]
     fn the_most_significant_part_wins_and_what_a_chance_part_keeps_is_tested_again() {
         // 2,000 background points in a 100-unit cube and 30 aligned points.
-        let mut rng = SplitMix64::new(5);
-        let mut pts: Vec<[f64; 3]> = (0..2000)
-            .map(|_| [0, 1, 2].map(|_| 100.0 * rng.uniform()))
-            .collect();
-        let n = pts.len() as u32;
-        pts.extend((0..30).map(|i| [20.0 + 2.0 * i as f64, 50.0, 50.0]));
+        let (pts, n) = super::super::cube_with_a_line(5);
         let copies = Copies::none(pts.len());
         let cloud = Cloud::new(&pts, &copies);
         let regime = Regime::new(StructureKind::Lines, Some(1.0), false, None);

@@ -114,15 +114,11 @@ fn part_nfa<S: Shape>(
 mod tests {
     use super::*;
     use crate::detect::cloud::Copies;
-    use crate::detect::detection::Primitive;
-    use crate::detect::fit::fit_line_indices;
-    use crate::rng::SplitMix64;
 
     /// A part of the points `members` of `pts` fitted as a line, with its
     /// candidate (τ 0.5, cell 5).
     fn line_part(pts: &[[f64; 3]], members: Vec<u32>, cand: usize) -> (Draft, Candidate) {
-        let fit = Primitive::Line(fit_line_indices(pts, &members).unwrap());
-        Draft::with_candidate(pts, members, fit, cand, (0.5, 5.0))
+        Draft::line(pts, members, cand, (0.5, 5.0))
     }
 
     #[test]
@@ -130,12 +126,7 @@ mod tests {
         // 2,000 background points in a 100-unit cube, 30 exactly aligned
         // points, and three background points that happen to be nearly
         // aligned (a chance "line").
-        let mut rng = SplitMix64::new(11);
-        let mut pts: Vec<[f64; 3]> = (0..2000)
-            .map(|_| [0, 1, 2].map(|_| 100.0 * rng.uniform()))
-            .collect();
-        let n = pts.len() as u32;
-        pts.extend((0..30).map(|i| [20.0 + 2.0 * i as f64, 50.0, 50.0]));
+        let (mut pts, n) = super::super::cube_with_a_line(11);
         pts.extend([[10.0, 10.0, 10.0], [13.0, 10.2, 10.0], [16.0, 9.9, 10.1]]);
         let copies = Copies::none(pts.len());
         let cloud = Cloud::new(&pts, &copies);

@@ -206,14 +206,11 @@ fn simplices<S: Shape>(
 mod tests {
     use super::*;
     use crate::detect::cloud::Copies;
-    use crate::detect::detection::Primitive;
-    use crate::detect::fit::fit_line_indices;
 
     /// A part on the points `members`, fitted as a line, and its
     /// candidate (number `cand`).
     fn part(pts: &[[f64; 3]], members: Vec<u32>, cand: usize) -> (Draft, Candidate) {
-        let fit = Primitive::Line(fit_line_indices(pts, &members).unwrap());
-        Draft::with_candidate(pts, members, fit, cand, (0.1, 1.0))
+        Draft::line(pts, members, cand, (0.1, 1.0))
     }
 
     #[test]
