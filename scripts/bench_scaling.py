@@ -23,6 +23,7 @@ Needs numpy and GNU time (/usr/bin/time) for the peak RSS.
 import argparse
 import json
 import os
+import signal
 import subprocess
 import tempfile
 import time
@@ -48,7 +49,7 @@ def main():
     ap.add_argument("--scan", default=None, help="a binary PLY to copy (default: CGAL's ball)")
     ap.add_argument("--spacing", type=float, default=1.5,
                     help="copy pitch in units of the scan's extent (1: edge to edge)")
-    ap.add_argument("--timeout", type=float, default=None, help="seconds per run (then: > timeout)")
+    ap.add_argument("--timeout", type=float, default=None, help="seconds per run, ours and the peer's (then: > timeout)")
     ap.add_argument("--peer", default=None, help="CGAL peer binary (scripts/peers/cgal_shapes.cpp)")
     ap.add_argument("--peer-args", default="", help="its options, one string")
     a = ap.parse_args()
@@ -76,7 +77,7 @@ def main():
                 args += ["--threads", a.threads]
             t = time.perf_counter()
             try:
-                r = subprocess.run(args, check=True, capture_output=True, text=True, timeout=a.timeout)
+                r = run_group(args, a.timeout)
             except subprocess.TimeoutExpired:
                 print(f"| {c} | {len(cloud)} | > {a.timeout:.0f} | | | | | |", flush=True)
                 continue
@@ -88,17 +89,36 @@ def main():
             parts = sum(len(s.get("parts", [])) for s in json.load(open(rep))["structures"])
             peer = ""
             if a.peer:
-                pw, prss = run_peer(a, f, os.path.join(tmp, "peer.txt"))
-                peer = f" {pw:.2f} | {prss:.0f} | {wall / pw:.2f} | {rss / prss:.2f} |"
+                try:
+                    pw, prss = run_peer(a, f, os.path.join(tmp, "peer.txt"))
+                    peer = f" {pw:.2f} | {prss:.0f} | {wall / pw:.2f} | {rss / prss:.2f} |"
+                except subprocess.TimeoutExpired:
+                    peer = f" > {a.timeout:.0f} | | < {wall / a.timeout:.2f} | |"
             print(f"| {c} | {len(cloud)} | {wall:.2f} | {rss:.0f} | {1e6 * wall / len(cloud):.1f} | {parts} | {parts / c:.1f} | {ph} |"
                   + peer, flush=True)
+
+
+def run_group(args, timeout):
+    """`args` to completion (stdout and stderr captured), or killed with
+    every process it started after `timeout` seconds (GNU time's child
+    too), raising subprocess.TimeoutExpired."""
+    p = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        out, err = p.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        os.killpg(p.pid, signal.SIGKILL)
+        p.communicate()
+        raise
+    if p.returncode != 0:
+        raise subprocess.CalledProcessError(p.returncode, args, out, err)
+    return subprocess.CompletedProcess(args, p.returncode, out, err)
 
 
 def run_peer(a, xyz, labels):
     """Wall time and peak RSS (MiB) of CGAL's Efficient RANSAC on `xyz`."""
     args = ["/usr/bin/time", "-f", "%M", a.peer, "ransac", xyz, labels, *a.peer_args.split()]
     t = time.perf_counter()
-    r = subprocess.run(args, check=True, capture_output=True, text=True)
+    r = run_group(args, a.timeout)
     return time.perf_counter() - t, int(r.stderr.strip().splitlines()[-1]) / 1024
 
 

@@ -692,6 +692,15 @@ fn summary(
             modes.len(),
             if d.kind() == StructureKind::Planes { "normal" } else { "direction" }
         ));
+        for m in modes.iter().filter(|m| m.thinned_from.is_some()) {
+            o.push_str(&format!(
+                "  a thick line mode: 3 x noise {:.4} is over its reach, lambda would be 1; its {} members were thinned to one chain of {} along it (lambda {:.0})\n",
+                m.noise,
+                m.thinned_from.unwrap_or(0),
+                m.points.len(),
+                m.lambda3
+            ));
+        }
     }
     if let (StructureKind::Planes, Some(n)) = (d.kind(), d.normals_given()) {
         o.push_str(&format!(
@@ -706,7 +715,7 @@ fn summary(
         ));
     }
     o.push_str(&format!(
-        "  {} orientations in {:.2} s; union {} simplices; {} part(s) kept, {} rejected by the significance test{}\n\n",
+        "  {} orientations in {:.2} s; union {} simplices; {} part(s) kept, {} rejected by the significance test{}{}\n\n",
         det.stats.orientations,
         seconds,
         det.stats.union_simplices,
@@ -715,6 +724,11 @@ fn summary(
         match det.stats.surface_lines {
             0 => String::new(),
             n => format!(", {n} inside a surface (scanner rows, creases)"),
+        },
+        match (det.stats.out_of_proportion, d.kind()) {
+            (0, _) => String::new(),
+            (n, StructureKind::Planes) => format!(", {n} narrower than their ellipsoid (strips: wires, poles, edges)"),
+            (n, StructureKind::Lines) => format!(", {n} shorter or thicker than their ellipsoid (blobs)"),
         }
     ));
     o.push_str(&part_table(det));

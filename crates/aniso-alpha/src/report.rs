@@ -63,17 +63,7 @@ pub fn parameters_json(d: &Detector) -> Value {
         OrientationSet::Data(modes) => json!({
             "kind": "data",
             "count": d.orientation_count().unwrap_or(0),
-            "modes": modes.iter().map(|m| json!({
-                "axis": m.axis.map(num),
-                "support": m.support,
-                "points": m.points.len(),
-                "spacing": num(m.spacing),
-                "noise": num(m.noise),
-                "alpha": num(m.alpha),
-                "lambda2": num(m.lambda2),
-                "lambda3": num(m.lambda3),
-                "rotations": m.rotations.len(),
-            })).collect::<Vec<_>>(),
+            "modes": modes.iter().map(mode_json).collect::<Vec<_>>(),
         }),
     };
     if let Some(l) = d.ladder() {
@@ -117,9 +107,32 @@ pub fn parameters_json(d: &Detector) -> Value {
             "noise": num(e.noise),
             "structure_fraction": num(e.structure_fraction),
             "explained": num(e.explained),
+            "emptied_modes": e.emptied_modes.iter().map(mode_json).collect::<Vec<_>>(),
         });
     }
     v
+}
+
+/// One mode of the data orientation set as the report writes it.
+fn mode_json(m: &crate::detect::ModeScan) -> Value {
+    json!({
+        "axis": m.axis.map(num),
+        "support": m.support,
+        "points": m.points.len(),
+        "spacing": num(m.spacing),
+        "noise": num(m.noise),
+        "alpha": num(m.alpha),
+        "lambda2": num(m.lambda2),
+        "lambda3": num(m.lambda3),
+        "rotations": m.rotations.len(),
+        "thinned_from": m.thinned_from,
+        "background_per_ellipsoid": num(m.background_per_ellipsoid),
+        "own_scale": m.own_scale.map(|o| json!({
+            "alpha": num(o.alpha),
+            "lambda3": num(o.lambda3),
+            "background_per_ellipsoid": num(o.background_per_ellipsoid),
+        })),
+    })
 }
 
 fn point(p: [f64; 3]) -> Value {
@@ -209,6 +222,7 @@ pub fn detection_json(det: &Detection, d: &Detector) -> Value {
             "structure_simplices": s.structure_simplices,
             "rejected_parts": s.rejected_parts,
             "surface_lines": s.surface_lines,
+            "out_of_proportion": s.out_of_proportion,
         },
         "structures": structures_json(det),
         "parts": det.num_parts(),

@@ -160,6 +160,10 @@ pub struct RunStats {
     /// Line parts dropped because they lie inside a surface (its sampling
     /// pattern: a scanner's rings at a grazing angle).
     pub surface_lines: usize,
+    /// Parts dropped for lacking their shape's proportions at the scale
+    /// of their ellipsoid: planes narrower than it is long, lines shorter
+    /// than it or less elongated.
+    pub out_of_proportion: usize,
 }
 
 /// The result of [`super::detector::Detector::run`].

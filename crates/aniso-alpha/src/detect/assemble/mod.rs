@@ -25,6 +25,9 @@
 //! 5. **One primitive, one part** (`merging`). Planar parts that are one
 //!    plane but lie apart become one part in several pieces; a line keeps
 //!    its segments apart ([`Shape::merge_apart`]).
+//!    **Proportions** (`proportions`): a plane holds as many rows of
+//!    points across as its ellipsoid is long in spacings, a line is longer
+//!    than its ellipsoid and as elongated; the others go.
 //! 6. **Structures** (`structures`). Parts that share claimed points and
 //!    do not cross each other are facets of one structure; structures and
 //!    their parts are numbered by size, each part gets its outline and
@@ -40,6 +43,7 @@ mod claims;
 mod embedded;
 mod footprint;
 mod merging;
+mod proportions;
 mod same;
 mod select;
 mod shape;
@@ -219,7 +223,7 @@ pub(crate) fn finish<S: Shape>(
     regime: &Regime,
     mut levels: Vec<Level<S>>,
     settings: &Settings,
-    stats: RunStats,
+    mut stats: RunStats,
 ) -> Detection {
     let Level {
         cands,
@@ -233,6 +237,8 @@ pub(crate) fn finish<S: Shape>(
     };
     // 5. One primitive, one part.
     S::merge_apart(&mut parts, &cands, cloud.points(), settings.part_angle_deg);
+    // 5b. Proportions at the ellipsoid's scale.
+    stats.out_of_proportion += proportions::reject(&mut parts, &cands, cloud.points());
     // 6. Structures, outlines, labels.
     structures::detection::<S>(cloud, regime.kind(), &parts, &cands, &claims, &kept, stats)
 }
