@@ -692,13 +692,15 @@ fn summary(
             modes.len(),
             if d.kind() == StructureKind::Planes { "normal" } else { "direction" }
         ));
-        for m in modes.iter().filter(|m| m.thinned_from.is_some()) {
+        let thick: Vec<String> = modes
+            .iter()
+            .filter_map(|m| m.thinned_from.map(|n| format!("{n} -> {}", m.points.len())))
+            .collect();
+        if !thick.is_empty() {
             o.push_str(&format!(
-                "  a thick line mode: 3 x noise {:.4} is over its reach, lambda would be 1; its {} members were thinned to one chain of {} along it (lambda {:.0})\n",
-                m.noise,
-                m.thinned_from.unwrap_or(0),
-                m.points.len(),
-                m.lambda3
+                "  {} thick line mode(s) (3 x noise over the reach: lambda would be 1): members thinned to one chain along each ({}), lambda 4\n",
+                thick.len(),
+                thick.join(", ")
             ));
         }
     }

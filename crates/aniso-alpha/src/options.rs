@@ -317,9 +317,6 @@ pub fn run_warnings(
             ignored_normals_reason(g.agreement)
         ));
     }
-    if let Some(e) = detector.estimate() {
-        out.extend(mode_scale_warnings(e));
-    }
     let orientations = detector.orientation_count().unwrap_or(0);
     let work = points as f64 * orientations as f64;
     if work > HUGE_RUN {
@@ -332,59 +329,6 @@ pub fn run_warnings(
             match options.sampler_used() {
                 SamplerChoice::Fibonacci => style.name("step"),
                 _ => format!("{}, {}", style.name("m1"), style.name("m2")),
-            }
-        ));
-    }
-    out
-}
-
-/// What the check of the modes' scales against the background did
-/// (docs/method.md §8, step 4c): modes whose own ellipsoid held background
-/// points and took the cloud's scale, and modes left out.
-fn mode_scale_warnings(e: &crate::detect::Estimate) -> Vec<String> {
-    let axes = match e.kind {
-        StructureKind::Planes => "normals",
-        StructureKind::Lines => "directions",
-    };
-    let mut out = Vec::new();
-    let rescaled: Vec<_> = e
-        .modes
-        .iter()
-        .filter_map(|m| m.own_scale.map(|o| (m, o)))
-        .collect();
-    if !rescaled.is_empty() {
-        let worst = rescaled
-            .iter()
-            .map(|(_, o)| o.background_per_ellipsoid)
-            .fold(0.0, f64::max);
-        out.push(format!(
-            "{} mode(s) of the local {axes} (of {} to {} points) got a scale whose ellipsoid holds up \
-             to {worst:.1} background points, where it must hold none (alpha below the distance to the \
-             background): they were scanned at the cloud's alpha {:.4} and lambda {:.2} instead",
-            rescaled.len(),
-            rescaled.iter().map(|(m, _)| m.points.len()).min().unwrap_or(0),
-            rescaled.iter().map(|(m, _)| m.points.len()).max().unwrap_or(0),
-            e.alpha.value,
-            e.lambda3.value
-        ));
-    }
-    if !e.emptied_modes.is_empty() {
-        out.push(format!(
-            "{} mode(s) of the local {axes} (of {} points in all) were left out of the scan: their own \
-             ellipsoids hold background points, and the cloud's scale is no {} scale either{}",
-            e.emptied_modes.len(),
-            e.emptied_modes
-                .iter()
-                .map(|m| m.thinned_from.unwrap_or(m.points.len()))
-                .sum::<usize>(),
-            match e.kind {
-                StructureKind::Planes => "plane",
-                StructureKind::Lines => "line",
-            },
-            if e.ladder.is_some() {
-                "; the scale ladder scans the cloud instead"
-            } else {
-                ""
             }
         ));
     }

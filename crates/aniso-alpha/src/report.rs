@@ -107,7 +107,6 @@ pub fn parameters_json(d: &Detector) -> Value {
             "noise": num(e.noise),
             "structure_fraction": num(e.structure_fraction),
             "explained": num(e.explained),
-            "emptied_modes": e.emptied_modes.iter().map(mode_json).collect::<Vec<_>>(),
         });
     }
     v
@@ -126,12 +125,6 @@ fn mode_json(m: &crate::detect::ModeScan) -> Value {
         "lambda3": num(m.lambda3),
         "rotations": m.rotations.len(),
         "thinned_from": m.thinned_from,
-        "background_per_ellipsoid": num(m.background_per_ellipsoid),
-        "own_scale": m.own_scale.map(|o| json!({
-            "alpha": num(o.alpha),
-            "lambda3": num(o.lambda3),
-            "background_per_ellipsoid": num(o.background_per_ellipsoid),
-        })),
     })
 }
 

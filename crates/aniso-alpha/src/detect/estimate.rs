@@ -49,16 +49,6 @@
 //!      TUBE_STEP·α to twice that apart; the spacing becomes that step and λ =
 //!      C_REACH·step/α = 4. The assembly's claims give the parts back every
 //!      input point within α of their segment.
-//!    * **empty ellipsoids** (step 4c; the paper's Observation 3: α below
-//!      the distance to the background): the points that are not a
-//!      mode's members, at their mean density over the cloud's bounding
-//!      box, are expected fewer than [`BACKGROUND_PER_ELLIPSOID_MAX`] times
-//!      in one of its ellipsoids. A mode resting on a few scattered points
-//!      (σ and d large) fails: it takes the cloud's scale instead (the α
-//!      and λ of all structure-like points) if that is a scale of its
-//!      kind (for lines λ > 1: a ball sees no direction), and is left out
-//!      otherwise ([`Estimate::emptied_modes`]). With α or λ given, the
-//!      user's scale stands.
 //! 5. **nb_c** = [`NB_C_AUTO`]: the path filter then only cuts spurs and
 //!    fins of a few simplices; what is chance is decided by the
 //!    significance test ([`super::significance`]).
@@ -138,14 +128,6 @@ pub const TUBE_STEP: f64 = 2.0;
 /// cross-section keeps one point wherever it is cut.
 pub const TUBE_WIDTH: f64 = 4.0;
 
-/// A mode's ellipsoid must be empty of background (the paper's
-/// Observation 3: α below the distance from a structure to the
-/// background): at most this many points that are not its members
-/// expected in one ellipsoid, at their mean density. One: an ellipsoid
-/// that holds a background point on average joins the background to the
-/// structure everywhere, and the mode's scale cannot tell them apart.
-pub const BACKGROUND_PER_ELLIPSOID_MAX: f64 = 1.0;
-
 /// The path filter's nb_c in the automatic mode.
 pub const NB_C_AUTO: u32 = 4;
 
@@ -202,25 +184,6 @@ pub struct ModeScan {
     /// For a thick line (module doc, step 4b): its members before the
     /// thinning, whose own scale gave λ = 1.
     pub thinned_from: Option<usize>,
-    /// The points that are not its members expected in one of its
-    /// ellipsoids, at their mean density over the cloud's bounding box
-    /// (module doc, step 4c).
-    pub background_per_ellipsoid: f64,
-    /// The mode's own scale, when its ellipsoid was not empty of
-    /// background and the cloud's scale replaced it (module doc, step 4c).
-    pub own_scale: Option<OwnScale>,
-}
-
-/// A mode's own α and λ₃ and the background its ellipsoid held, kept when
-/// the cloud's scale replaced them.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct OwnScale {
-    /// α.
-    pub alpha: f64,
-    /// λ₃.
-    pub lambda3: f64,
-    /// Points that are not the mode's members expected in one ellipsoid.
-    pub background_per_ellipsoid: f64,
 }
 
 /// What was estimated from a cloud.
@@ -248,9 +211,6 @@ pub struct Estimate {
     pub min_size: Param,
     /// The data orientation set.
     pub modes: Vec<ModeScan>,
-    /// Modes left out of the scan because their ellipsoids are not empty
-    /// of background (module doc, step 4c).
-    pub emptied_modes: Vec<ModeScan>,
     /// Share of the points the modes explain: structure-like members of a
     /// mode, over the points that can be structure (for lines, those not
     /// on surfaces).
@@ -661,53 +621,20 @@ fn estimate_with(
     let (alpha_p, lambda2_p, lambda3_p, min_size_p) = cloud_params(kind, spacing, noise, given);
     let found = concentrated_modes(kind, shapes, &structure, &off);
     let member_of = mode_members(kind, shapes, &found, &off);
-    let room = BackgroundRoom::new(points, spacing_median, (0..n).filter(|&i| !off(i)).count());
-    let user_scale = given.alpha.is_some() || given.lambda2.is_some() || given.lambda3.is_some();
-    // A line ellipsoid with λ = 1 is a ball: the cloud has no line scale
-    // to lend a mode then.
-    let cloud_is_a_scale = kind == StructureKind::Planes || lambda3_p.value > 1.0;
-    let (mode_scans, emptied, kept_members) = check_emptiness(
-        found.into_iter().zip(member_of).map(|(m, members)| {
+    let explained = explained_share(kind, shapes, &member_of, &off);
+    let mode_scans: Vec<ModeScan> = found
+        .into_iter()
+        .zip(member_of)
+        .map(|(m, members)| {
             let core: Vec<u32> = members
                 .iter()
                 .copied()
                 .filter(|&i| shapes[i as usize].score(kind) >= SCORE_MIN)
                 .collect();
             let (d, sigma) = spacing_and_noise(kind, shapes, &core, (spacing, noise));
-            let count = members.len();
-            let mut scan = mode_scan(kind, points, m, members.clone(), (d, sigma), given, m2);
-            scan.background_per_ellipsoid = room.per_ellipsoid(&scan, count);
-            if scan.background_per_ellipsoid >= BACKGROUND_PER_ELLIPSOID_MAX && !user_scale {
-                let own = OwnScale {
-                    alpha: scan.alpha,
-                    lambda3: scan.lambda3,
-                    background_per_ellipsoid: scan.background_per_ellipsoid,
-                };
-                if cloud_is_a_scale {
-                    let cloud_scale = Given {
-                        alpha: Some(alpha_p.value),
-                        lambda2: Some(lambda2_p.value),
-                        lambda3: Some(lambda3_p.value),
-                        ..*given
-                    };
-                    scan = mode_scan(
-                        kind,
-                        points,
-                        m,
-                        members.clone(),
-                        (d, sigma),
-                        &cloud_scale,
-                        m2,
-                    );
-                    scan.background_per_ellipsoid = room.per_ellipsoid(&scan, count);
-                }
-                scan.own_scale = Some(own);
-            }
-            (scan, members)
-        }),
-        user_scale,
-    );
-    let explained = explained_share(kind, shapes, &kept_members, &off);
+            mode_scan(kind, points, m, members, (d, sigma), given, m2)
+        })
+        .collect();
     let ladder = (explained < EXPLAINED_MIN
         && given.alpha.is_none()
         && given.lambda2.is_none()
@@ -736,7 +663,6 @@ fn estimate_with(
         lambda3: lambda3_p,
         min_size: min_size_p,
         modes: mode_scans,
-        emptied_modes: emptied,
         explained,
         ladder,
     }
@@ -804,8 +730,7 @@ fn cloud_params(
     let lambda3_why = if kind == StructureKind::Lines && l3 <= 1.0 && given.lambda3.is_none() {
         format!(
             "{lambda_why} = 1: a ball, no line scale (the locally linear points are as thick as \
-             they are far apart); each mode takes its own scale, a thick line's members thinned \
-             along it, and a mode without one is left out"
+             they are far apart); each mode takes its own, a thick line's members thinned along it"
         )
     } else {
         lambda_why.clone()
@@ -933,62 +858,7 @@ fn mode_scan(
         lambda3: l3,
         rotations: mode_rotations(kind, m.axis, l2, l3, m2),
         thinned_from,
-        background_per_ellipsoid: f64::NAN,
-        own_scale: None,
     }
-}
-
-/// The points that can be background of a mode (those not left out) and
-/// the room they fill: the cloud's bounding box, each side at least the
-/// median spacing (a flat scan is one spacing thick, not zero).
-struct BackgroundRoom {
-    points: usize,
-    volume: f64,
-}
-
-impl BackgroundRoom {
-    fn new(points: &[[f64; 3]], spacing: f64, candidates: usize) -> Self {
-        let (lo, hi) = crate::geometry::bounding_box(points);
-        let floor = if spacing.is_finite() { spacing } else { 0.0 };
-        let volume = (0..3).map(|k| (hi[k] - lo[k]).max(floor)).product();
-        BackgroundRoom {
-            points: candidates,
-            volume,
-        }
-    }
-
-    /// The points that are not among the `members` members of `scan`
-    /// expected in one of its ellipsoids (semi-axes α, α·λ₂, α·λ₃).
-    fn per_ellipsoid(&self, scan: &ModeScan, members: usize) -> f64 {
-        let rho = self.points.saturating_sub(members) as f64 / self.volume;
-        let v = 4.0 / 3.0 * std::f64::consts::PI * scan.alpha.powi(3) * scan.lambda2 * scan.lambda3;
-        if rho == 0.0 {
-            0.0
-        } else {
-            rho * v
-        }
-    }
-}
-
-/// The mode scans whose ellipsoids are empty of background (module doc,
-/// step 4c: fewer than [`BACKGROUND_PER_ELLIPSOID_MAX`] expected), those
-/// that are not (with α or λ given, none: the user's scale is kept), and
-/// the members of the kept ones, for the share they explain.
-fn check_emptiness(
-    scans: impl Iterator<Item = (ModeScan, Vec<u32>)>,
-    user_scale: bool,
-) -> (Vec<ModeScan>, Vec<ModeScan>, Vec<Vec<u32>>) {
-    let (mut kept, mut emptied, mut members) = (Vec::new(), Vec::new(), Vec::new());
-    for (scan, m) in scans {
-        let bg = scan.background_per_ellipsoid;
-        if user_scale || bg < BACKGROUND_PER_ELLIPSOID_MAX || bg.is_nan() {
-            kept.push(scan);
-            members.push(m);
-        } else {
-            emptied.push(scan);
-        }
-    }
-    (kept, emptied, members)
 }
 
 /// The share of the points that can be structure (not `off`) that are

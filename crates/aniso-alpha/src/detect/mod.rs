@@ -40,7 +40,7 @@
 // (the main ones also at the crate root).
 pub use detection::{Detection, Part, Primitive, RunStats, Structure};
 pub use detector::{DetectError, Detector, Mat3, OrientationSet, LAMBDA_RANGE};
-pub use estimate::{Estimate, Given, GivenNormals, Ladder, ModeScan, OwnScale, Param};
+pub use estimate::{Estimate, Given, GivenNormals, Ladder, ModeScan, Param};
 pub use fit::{LineFit, PlaneFit};
 pub use orientations::{OrientationError, Sampler, MAX_ORIENTATIONS};
 pub use split::{Members, Plan, SplitJob, Step, Tile, TileOutput};

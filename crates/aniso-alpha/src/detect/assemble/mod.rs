@@ -26,8 +26,8 @@
 //!    plane but lie apart become one part in several pieces; a line keeps
 //!    its segments apart ([`Shape::merge_apart`]).
 //!    **Proportions** (`proportions`): a plane holds as many rows of
-//!    points across as its ellipsoid is long in spacings, a line is longer
-//!    than its ellipsoid and as elongated; the others go.
+//!    points across as its ellipsoid is long in spacings, a line is as
+//!    elongated as its ellipsoid; the others go.
 //! 6. **Structures** (`structures`). Parts that share claimed points and
 //!    do not cross each other are facets of one structure; structures and
 //!    their parts are numbered by size, each part gets its outline and
