@@ -58,6 +58,18 @@ impl Regime {
         self.kind == StructureKind::Lines && self.from_data
     }
 
+    /// Whether parts must have their shape's proportions at the scale of
+    /// their ellipsoid (`assemble::proportions`): with the data's
+    /// orientations, the automatic mode for real scans, whose dense
+    /// surfaces hold wires and the sides of poles as strips a few points
+    /// across. With a sampler (the user's scale, or the scale ladder of
+    /// the paper's sparse scenes) a part of a few dozen points is judged
+    /// by the significance test alone: the smallest faces of the paper's
+    /// polyhedron are about four rows across, at the rule's threshold.
+    pub(crate) fn checks_proportions(&self) -> bool {
+        self.from_data
+    }
+
     /// Whether every orientation looks at every point (a sampler's or
     /// explicit rotations), so that the pruning's candidate pairs can be
     /// found once for all of them; the data's modes each look at their

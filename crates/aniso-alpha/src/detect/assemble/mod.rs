@@ -25,7 +25,7 @@
 //! 5. **One primitive, one part** (`merging`). Planar parts that are one
 //!    plane but lie apart become one part in several pieces; a line keeps
 //!    its segments apart ([`Shape::merge_apart`]).
-//!    **Proportions** (`proportions`): a plane holds as many rows of
+//!    **Proportions** (`proportions`; with the data's orientations): a plane holds as many rows of
 //!    points across as its ellipsoid is long in spacings, a line is as
 //!    elongated as its ellipsoid; the others go.
 //! 6. **Structures** (`structures`). Parts that share claimed points and
@@ -238,7 +238,9 @@ pub(crate) fn finish<S: Shape>(
     // 5. One primitive, one part.
     S::merge_apart(&mut parts, &cands, cloud.points(), settings.part_angle_deg);
     // 5b. Proportions at the ellipsoid's scale.
-    stats.out_of_proportion += proportions::reject(&mut parts, &cands, cloud.points());
+    if regime.checks_proportions() {
+        stats.out_of_proportion += proportions::reject(&mut parts, &cands, cloud.points());
+    }
     // 6. Structures, outlines, labels.
     structures::detection::<S>(cloud, regime.kind(), &parts, &cands, &claims, &kept, stats)
 }
