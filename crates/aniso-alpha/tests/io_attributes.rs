@@ -5,7 +5,7 @@
 // Rows of every PLY scalar type, and loops over parallel columns.
 #![allow(clippy::type_complexity, clippy::needless_range_loop)]
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use crate::common;
 use common::TempDir;
@@ -304,6 +304,7 @@ const REAL: [&str; 11] = [
 #[cfg(feature = "las")]
 mod las_files {
     use super::*;
+    use std::path::PathBuf;
 
     fn fixture(name: &str) -> PathBuf {
         Path::new(FIXTURES).join(name)

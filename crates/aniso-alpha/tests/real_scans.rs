@@ -496,21 +496,8 @@ fn a_pole_among_surfaces_is_a_line() {
     // whose local directions are anything in their plane, are left out of
     // the line modes (docs/method.md §8).
     let mut rng = SplitMix64::new(0x901e);
-    let mut points = Vec::new();
     let noise = |r: &mut SplitMix64| 0.01 * (r.uniform() - 0.5) * 2.0;
-    for i in 0..200 {
-        for j in 0..200 {
-            let e = noise(&mut rng);
-            points.push([i as f64 * 0.1, j as f64 * 0.1, e]);
-        }
-    }
-    for i in 0..200 {
-        for k in 1..80 {
-            let e = noise(&mut rng);
-            points.push([i as f64 * 0.1, 20.0 + e, k as f64 * 0.1]);
-        }
-    }
-    let first_pole = points.len();
+    let (mut points, first_pole) = street_corner(&mut rng);
     let (cx, cy, r) = (10.0, 10.0, 0.1);
     for k in 0..300 {
         for a in 0..31 {
