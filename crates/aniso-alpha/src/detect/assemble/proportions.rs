@@ -20,8 +20,8 @@
 //!   the paper's sparse scenes the significance test may choose a reach
 //!   larger than a small plane's own spacing.
 //! * **A line is one-dimensional at that scale**: its thickness is at
-//!   most its length over the elongation λ = c/τ
-//!   of the ellipsoid (with a widened claim radius τ, a smaller λ): a part
+//!   most its length over the elongation λ = c/τ of the ellipsoid (with
+//!   a widened claim radius τ, a smaller λ): a part
 //!   less elongated than the ellipsoid that found it is a blob, a patch
 //!   of a surface or a clump of clutter.
 //!
@@ -31,6 +31,10 @@
 //! across are √(W² + s²)/s for a width W and spacing s: r rows of points
 //! s apart have W = s·√(r² − 1), and each row stands for a band s wide.
 //! No constant: the sizes are the ellipsoid's own.
+//!
+//! The stage runs with the data's orientations (real scans:
+//! `Regime::checks_proportions`); with a sampler the paper's smallest
+//! faces, about four rows across, are the significance test's to judge.
 
 use super::super::detection::Primitive;
 use super::super::fit::PlaneFit;
