@@ -730,7 +730,7 @@ fn summary(
         match (det.stats.out_of_proportion, d.kind()) {
             (0, _) => String::new(),
             (n, StructureKind::Planes) => format!(", {n} narrower than their ellipsoid (strips: wires, poles, edges)"),
-            (n, StructureKind::Lines) => format!(", {n} shorter or thicker than their ellipsoid (blobs)"),
+            (n, StructureKind::Lines) => format!(", {n} less elongated than their ellipsoid (blobs)"),
         }
     ));
     o.push_str(&part_table(det));

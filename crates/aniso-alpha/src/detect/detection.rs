@@ -161,8 +161,8 @@ pub struct RunStats {
     /// pattern: a scanner's rings at a grazing angle).
     pub surface_lines: usize,
     /// Parts dropped for lacking their shape's proportions at the scale
-    /// of their ellipsoid: planes narrower than it is long, lines shorter
-    /// than it or less elongated.
+    /// of their ellipsoid: planes narrower than it is long, lines less
+    /// elongated than it.
     pub out_of_proportion: usize,
 }
 

@@ -37,10 +37,11 @@
 //! faces, about four rows across, are the significance test's to judge.
 
 use super::super::detection::Primitive;
-use super::super::fit::PlaneFit;
+use super::super::fit::{moments, PlaneFit};
 use super::super::local::any_orthogonal;
 use super::shape::span;
 use super::{Candidate, Draft};
+use crate::aniso::Mat3;
 use crate::geometry::{cross, dot, sub};
 use std::collections::HashSet;
 
@@ -77,8 +78,9 @@ pub(super) fn proportioned(
     match fit {
         Primitive::Plane(f) => {
             let n = members.len().max(1) as f64;
-            let length = UNIFORM_WIDTH * rms_along(members, points, f.centroid, f.axes[0]);
-            let width = UNIFORM_WIDTH * rms_along(members, points, f.centroid, f.axes[1]);
+            let c = covariance(members, points);
+            let length = UNIFORM_WIDTH * quadratic(c, f.axes[0], f.axes[0]).max(0.0).sqrt();
+            let width = UNIFORM_WIDTH * quadratic(c, f.axes[1], f.axes[1]).max(0.0).sqrt();
             if width.is_nan() || width <= 0.0 {
                 return false;
             }
@@ -90,7 +92,7 @@ pub(super) fn proportioned(
         Primitive::Line(f) => {
             let (t0, t1) = span(f, members, points);
             let thickness =
-                UNIFORM_WIDTH * largest_rms_across(members, points, f.centroid, f.direction);
+                UNIFORM_WIDTH * largest_rms_across(covariance(members, points), f.direction);
             let elongation = cell / tau;
             let excess = thickness * elongation - (t1 - t0);
             excess <= 0.0 || excess.is_nan()
@@ -116,40 +118,29 @@ fn covered_area(members: &[u32], points: &[[f64; 3]], f: &PlaneFit, cell: f64) -
     cells.len() as f64 * cell * cell
 }
 
-/// The root mean square of the members' offsets from `origin` along the
-/// unit vector `axis`.
-fn rms_along(members: &[u32], points: &[[f64; 3]], origin: [f64; 3], axis: [f64; 3]) -> f64 {
-    let ss: f64 = members
-        .iter()
-        .map(|&v| dot(sub(points[v as usize], origin), axis).powi(2))
-        .sum();
-    (ss / members.len().max(1) as f64).sqrt()
+/// The covariance of the members (divided by their number), from
+/// [`moments`].
+fn covariance(members: &[u32], points: &[[f64; 3]]) -> Mat3 {
+    moments(members.len(), |k| points[members[k] as usize]).1
 }
 
-/// The largest root mean square spread of the members across the line
-/// through `origin` along the unit `direction`: the square root of the
-/// larger eigenvalue of their 2×2 covariance across it.
-fn largest_rms_across(
-    members: &[u32],
-    points: &[[f64; 3]],
-    origin: [f64; 3],
-    direction: [f64; 3],
-) -> f64 {
+/// uᵀ·C·w.
+fn quadratic(c: Mat3, u: [f64; 3], w: [f64; 3]) -> f64 {
+    dot(u, [dot(c[0], w), dot(c[1], w), dot(c[2], w)])
+}
+
+/// The largest root mean square spread across the unit `direction` of
+/// points of covariance `c`: the square root of the larger eigenvalue of
+/// their 2×2 covariance across it.
+fn largest_rms_across(c: Mat3, direction: [f64; 3]) -> f64 {
     let u = any_orthogonal(direction);
     let w = cross(direction, u);
-    let (mut suu, mut suw, mut sww) = (0.0, 0.0, 0.0);
-    for &v in members {
-        let d = sub(points[v as usize], origin);
-        let (a, b) = (dot(d, u), dot(d, w));
-        suu += a * a;
-        suw += a * b;
-        sww += b * b;
-    }
-    let n = members.len().max(1) as f64;
-    let (a, b, c) = (suu / n, suw / n, sww / n);
-    let half_trace = 0.5 * (a + c);
-    let det = a * c - b * b;
-    (half_trace + (half_trace * half_trace - det).max(0.0).sqrt()).sqrt()
+    let (a, b, d) = (quadratic(c, u, u), quadratic(c, u, w), quadratic(c, w, w));
+    let half_trace = 0.5 * (a + d);
+    let det = a * d - b * b;
+    (half_trace + (half_trace * half_trace - det).max(0.0).sqrt())
+        .max(0.0)
+        .sqrt()
 }
 
 #[cfg(test)]
