@@ -19,6 +19,14 @@ Scenes (dimensions in metres):
           window recesses in its walls, on a ground plane, scanned from
           three stations outside; trees (random blobs of points) as
           clutter; range noise 1 cm.
+  airborne  a 120 x 120 m block seen from an aircraft 300 m up: the
+          ground, a large flat-roofed hall, five gable-roofed houses and a
+          mono-pitch shed at random azimuths (each roof face and wall a
+          plane), trees as clutter; one flight strip along y whose
+          scanner sweeps across track, so that the points lie on scan
+          lines 0.8-1.4 m apart with 0.3-0.5 m between points along a
+          line (the anisotropic pattern of airborne tiles); range noise
+          3 cm.
   street  a street with 5 poles (cylinders, radius 8-15 cm, 6-8 m tall,
           each with a crossbar), cables sagging between their tops, a
           facade and the ground, scanned from two stations; labels are the
@@ -188,6 +196,84 @@ def house(rng):
     return np.vstack([pts[keep], trees]), np.concatenate([labels[keep], -np.ones(len(trees), np.int64)])
 
 
+def _rotated_box_walls(s, c, R, lx, ly, h, lab):
+    """The four walls of a footprint lx x ly centred at c, rotated by R
+    (2 x 2), from z = 0 to h: one label each; returns the next label."""
+    corners = [np.array([-lx / 2, -ly / 2]), np.array([lx / 2, -ly / 2]),
+               np.array([lx / 2, ly / 2]), np.array([-lx / 2, ly / 2])]
+    for a, b in zip(corners, corners[1:] + corners[:1]):
+        pa = np.r_[c + R @ a, 0.0]
+        u = np.r_[R @ (b - a), 0.0]
+        s.quad(pa, u, [0, 0, h], lab)
+        lab += 1
+    return lab
+
+
+def airborne(rng):
+    s = Scene()
+    lab = 0
+    size = 120.0
+    s.quad([-10, -10, 0], [size + 20, 0, 0], [0, size + 20, 0], lab); lab += 1   # ground
+    # A flat-roofed hall, 30-45 x 25-35 m, 8-12 m high.
+    lx, ly, h = rng.uniform(30, 45), rng.uniform(25, 35), rng.uniform(8, 12)
+    c = np.array([35.0, 40.0]) + rng.uniform(-5, 5, 2)
+    th = rng.uniform(0, np.pi / 2)
+    R = np.array([[np.cos(th), -np.sin(th)], [np.sin(th), np.cos(th)]])
+    lab = _rotated_box_walls(s, c, R, lx, ly, h, lab)
+    s.quad(np.r_[c + R @ [-lx / 2, -ly / 2], h], np.r_[R @ [lx, 0], 0], np.r_[R @ [0, ly], 0], lab); lab += 1
+    # Gable-roofed houses (ridge along the local x axis) and one shed.
+    sites = [[85, 25], [85, 60], [95, 95], [55, 95], [20, 90], [25, 10]]
+    for i, site in enumerate(sites):
+        lx, ly = rng.uniform(8, 14), rng.uniform(6, 10)
+        h, hr = rng.uniform(4, 7), rng.uniform(2, 4)
+        c = np.asarray(site, float) + rng.uniform(-3, 3, 2)
+        th = rng.uniform(0, 2 * np.pi)
+        R = np.array([[np.cos(th), -np.sin(th)], [np.sin(th), np.cos(th)]])
+        lab = _rotated_box_walls(s, c, R, lx, ly, h, lab)
+        if i == len(sites) - 1:
+            # Mono-pitch shed: one slope from h to h + hr across the footprint.
+            s.quad(np.r_[c + R @ [-lx / 2, -ly / 2], h], np.r_[R @ [lx, 0], 0],
+                   np.r_[R @ [0, ly], hr], lab); lab += 1
+            continue
+        for side in (-1, 1):
+            eave = np.r_[c + R @ [-lx / 2, side * ly / 2], h]
+            s.quad(eave, np.r_[R @ [lx, 0], 0], np.r_[R @ [0, -side * ly / 2], hr], lab); lab += 1
+    # One strip along y, 300 m up, sweeping across track (a zig-zag).
+    along = rng.uniform(0.8, 1.4)
+    across = rng.uniform(0.3, 0.5)
+    H = 300.0
+    xs = np.arange(-5, size + 5, across)
+    rows = np.arange(-5, size + 5, along)
+    X, Y = np.meshgrid(xs, rows)
+    # The sweep's slant: each line drifts one line spacing along y over the swath.
+    Y = Y + along * (X - X.min()) / (X.max() - X.min()) * np.where(np.arange(len(rows)) % 2 == 0, 1, -1)[:, None]
+    X = X + rng.normal(0, across * 0.05, X.shape)
+    target = np.stack([X.ravel(), Y.ravel(), np.zeros(X.size)], -1)
+    origin = np.stack([np.full(X.size, size / 2), Y.ravel(), np.full(X.size, H)], -1)
+    import open3d as o3d
+
+    v, t, labs = s.arrays()
+    rs = o3d.t.geometry.RaycastingScene()
+    rs.add_triangles(o3d.core.Tensor(v.astype(np.float32)), o3d.core.Tensor(t.astype(np.uint32)))
+    d = target - origin
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    ans = rs.cast_rays(o3d.core.Tensor(np.hstack([origin, d]).astype(np.float32)))
+    th_ = ans["t_hit"].numpy().astype(float)
+    pid = ans["primitive_ids"].numpy()
+    ok = np.isfinite(th_)
+    r = th_[ok] + rng.normal(0, 0.03, ok.sum())
+    pts = origin[ok] + r[:, None] * d[ok]
+    labels = labs[pid[ok]]
+    # Trees: blobs of foliage points above the ground.
+    trees = []
+    for cx, cy in rng.uniform(5, size - 5, (8, 2)):
+        k = int(rng.integers(150, 400))
+        trees.append(np.array([cx, cy, rng.uniform(5, 9)]) + rng.normal(0, 1.0, (k, 3)) * [2.0, 2.0, 1.5])
+    trees = np.vstack(trees)
+    keep = np.all((pts[:, :2] >= 0) & (pts[:, :2] <= size), axis=1)
+    return np.vstack([pts[keep], trees]), np.concatenate([labels[keep], -np.ones(len(trees), np.int64)])
+
+
 def street(rng):
     s = Scene()
     lab = 0
@@ -218,12 +304,12 @@ def street(rng):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("scene", choices=["room", "house", "street"])
+    ap.add_argument("scene", choices=["room", "house", "airborne", "street"])
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--output", required=True)
     a = ap.parse_args()
     rng = np.random.default_rng(a.seed)
-    pts, labels = {"room": room, "house": house, "street": street}[a.scene](rng)
+    pts, labels = {"room": room, "house": house, "airborne": airborne, "street": street}[a.scene](rng)
     # Shuffle (scanner order would make every neighbour query trivial).
     perm = rng.permutation(len(pts))
     pts, labels = pts[perm], labels[perm]

@@ -696,6 +696,12 @@ fn summary(
             .iter()
             .filter_map(|m| m.thinned_from.map(|n| format!("{n} -> {}", m.points.len())))
             .collect();
+        let rescaled = modes.iter().filter(|m| m.cloud_scale).count();
+        if rescaled > 0 {
+            o.push_str(&format!(
+                "  {rescaled} thick plane mode(s) (3 x noise over the reach: lambda would be 1, a ball): scanned at the cloud's spacing and noise\n"
+            ));
+        }
         if !thick.is_empty() {
             o.push_str(&format!(
                 "  {} thick line mode(s) (3 x noise over the reach: lambda would be 1): members thinned to one chain along each ({}), lambda 4\n",

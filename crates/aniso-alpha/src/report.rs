@@ -125,6 +125,7 @@ fn mode_json(m: &crate::detect::ModeScan) -> Value {
         "lambda3": num(m.lambda3),
         "rotations": m.rotations.len(),
         "thinned_from": m.thinned_from,
+        "cloud_scale": m.cloud_scale,
     })
 }
 

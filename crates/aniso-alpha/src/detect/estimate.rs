@@ -49,6 +49,15 @@
 //!      TUBE_STEP·α to twice that apart; the spacing becomes that step and λ =
 //!      C_REACH·step/α = 4. The assembly's claims give the parts back every
 //!      input point within α of their segment.
+//!    * **thick planes** (k = 2, when C_NOISE·σ ≥ C_REACH·d, so λ would be
+//!      1 while the cloud's own spacing and noise give λ > 1): the mode's
+//!      members are not a plane at their own spacing (a few hundred points
+//!      whose neighbourhoods straddle two faces of a small roof, or the
+//!      blurred normals around a window recess): their ellipsoid would be
+//!      a ball of several spacings, bridging what lies apart. The mode is
+//!      scanned at the cloud's spacing and noise instead, and the report
+//!      says so (`cloud_scale`). Where the cloud itself gives λ = 1 (every
+//!      plane as noisy as it is sparse), the mode keeps its own.
 //! 5. **nb_c** = [`NB_C_AUTO`]: the path filter then only cuts spurs and
 //!    fins of a few simplices; what is chance is decided by the
 //!    significance test ([`super::significance`]).
@@ -184,6 +193,9 @@ pub struct ModeScan {
     /// For a thick line (module doc, step 4b): its members before the
     /// thinning, whose own scale gave λ = 1.
     pub thinned_from: Option<usize>,
+    /// For a thick plane (module doc, step 4c): its own spacing and noise
+    /// gave λ = 1, and it is scanned at the cloud's.
+    pub cloud_scale: bool,
 }
 
 /// What was estimated from a cloud.
@@ -619,7 +631,7 @@ fn estimate_with(
         .collect();
     let (spacing, noise) = spacing_and_noise(kind, shapes, &structure, (spacing_median, 0.0));
     let (alpha_p, lambda2_p, lambda3_p, min_size_p) = cloud_params(kind, spacing, noise, given);
-    let found = concentrated_modes(kind, shapes, &structure, &off);
+    let found = concentrated_modes(kind, shapes, &structure);
     let member_of = mode_members(kind, shapes, &found, &off);
     let explained = explained_share(kind, shapes, &member_of, &off);
     let mode_scans: Vec<ModeScan> = found
@@ -632,7 +644,16 @@ fn estimate_with(
                 .filter(|&i| shapes[i as usize].score(kind) >= SCORE_MIN)
                 .collect();
             let (d, sigma) = spacing_and_noise(kind, shapes, &core, (spacing, noise));
-            mode_scan(kind, points, m, members, (d, sigma), given, m2)
+            mode_scan(
+                kind,
+                points,
+                m,
+                members,
+                (d, sigma),
+                (spacing, noise),
+                given,
+                m2,
+            )
         })
         .collect();
     let ladder = (explained < EXPLAINED_MIN
@@ -761,30 +782,51 @@ fn cloud_params(
 
 /// The modes of the axes of the structure-like points `structure`
 /// (module doc, step 2) that are concentrated: at least
-/// [`MODE_CONCENTRATION`] of the points within the cone of a mode have
+/// [`MODE_CONCENTRATION`] of the points that would be its members have
 /// their axis within its kernel.
-fn concentrated_modes(
-    kind: StructureKind,
-    shapes: &[LocalShape],
-    structure: &[u32],
-    off: &dyn Fn(usize) -> bool,
-) -> Vec<Mode> {
+///
+/// The modes are taken densest first, and a point counts for a mode as
+/// [`mode_members`] makes it a member: within [`CONE_DEG`] of it and at
+/// most [`MARGIN_DEG`] farther from it than from the nearest mode already
+/// kept. So a small roof whose pitch is within the cone of the ground's
+/// normal is judged on its own points, not on the ground's (which belong
+/// to the ground's mode), while a peak of edge normals, spread between two
+/// planes, still finds few of its cone's points in its kernel.
+fn concentrated_modes(kind: StructureKind, shapes: &[LocalShape], structure: &[u32]) -> Vec<Mode> {
     let axes: Vec<[f64; 3]> = structure
         .iter()
         .map(|&i| axis64(&shapes[i as usize], kind))
         .collect();
     let min_support = MODE_MIN_POINTS.max(structure.len() / 1000);
-    let mut found: Vec<Mode> = modes(&axes, MODE_KERNEL_DEG.to_radians(), min_support);
+    let found: Vec<Mode> = modes(&axes, MODE_KERNEL_DEG.to_radians(), min_support);
     let cos_cone = CONE_DEG.to_radians().cos();
-    found.retain(|m| {
-        let in_cone = shapes
+    let (sin_margin, cos_margin) = MARGIN_DEG.to_radians().sin_cos();
+    // Per point: its axis, and the cosine of the largest angle at which a
+    // mode still takes it (its angle to the nearest kept mode plus the
+    // margin; -1 while no mode is kept: any angle).
+    let mut candidates: Vec<([f64; 3], f64)> = axes.iter().map(|&a| (a, -1.0)).collect();
+    let mut kept = Vec::new();
+    for m in found {
+        let members = candidates
             .iter()
-            .enumerate()
-            .filter(|&(i, s)| !off(i) && dot(axis64(s, kind), m.axis).abs() >= cos_cone)
+            .filter(|&&(a, limit)| {
+                let c = dot(a, m.axis).abs();
+                c >= cos_cone && c >= limit
+            })
             .count();
-        m.support as f64 >= MODE_CONCENTRATION * in_cone as f64
-    });
-    found
+        if (m.support as f64) < MODE_CONCENTRATION * members as f64 {
+            continue;
+        }
+        for (a, limit) in candidates.iter_mut() {
+            // cos(angle + margin) for the angle to this mode, when it is
+            // nearer than every mode kept before.
+            let c = dot(*a, m.axis).abs().min(1.0);
+            let angle_plus_margin = c * cos_margin - (1.0 - c * c).max(0.0).sqrt() * sin_margin;
+            *limit = limit.max(angle_plus_margin);
+        }
+        kept.push(m);
+    }
+    kept
 }
 
 /// The members of each mode (module doc, step 3): a point joins the modes
@@ -823,28 +865,37 @@ fn mode_members(
 
 /// The scan of mode `m` over its `members`, of spacing d and noise σ
 /// (module doc, step 4): its α, λ and rotations, a thick line's members
-/// thinned along its direction.
+/// thinned along its direction, a thick plane at the `cloud`'s (d, σ).
+#[allow(clippy::too_many_arguments)]
 fn mode_scan(
     kind: StructureKind,
     points: &[[f64; 3]],
     m: Mode,
     members: Vec<u32>,
     (d, sigma): (f64, f64),
+    cloud: (f64, f64),
     given: &Given,
     m2: u32,
 ) -> ModeScan {
     let (mut a, mut l2, mut l3) = scales(kind, d, sigma, given);
-    let (mut members, mut d) = (members, d);
+    let (mut members, mut d, mut sigma) = (members, d, sigma);
     let mut thinned_from = None;
-    if kind == StructureKind::Lines
-        && given.alpha.is_none()
-        && given.lambda3.is_none()
-        && C_NOISE * sigma >= C_REACH * d
-    {
+    let mut cloud_scale = false;
+    let estimated = given.alpha.is_none() && given.lambda2.is_none() && given.lambda3.is_none();
+    let ball = |d: f64, sigma: f64| C_NOISE * sigma >= C_REACH * d;
+    if kind == StructureKind::Lines && estimated && ball(d, sigma) {
         let step = TUBE_STEP * a;
         thinned_from = Some(members.len());
         members = thin_along(points, &members, m.axis, step, TUBE_WIDTH * a);
         d = step;
+        (a, l2, l3) = scales(kind, d, sigma, given);
+    } else if kind == StructureKind::Planes
+        && estimated
+        && ball(d, sigma)
+        && !ball(cloud.0, cloud.1)
+    {
+        (d, sigma) = cloud;
+        cloud_scale = true;
         (a, l2, l3) = scales(kind, d, sigma, given);
     }
     ModeScan {
@@ -858,6 +909,7 @@ fn mode_scan(
         lambda3: l3,
         rotations: mode_rotations(kind, m.axis, l2, l3, m2),
         thinned_from,
+        cloud_scale,
     }
 }
 
@@ -929,6 +981,75 @@ fn ladder(d: f64, points: Vec<u32>) -> Ladder {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_thick_plane_mode_is_scanned_at_the_cloud_s_scale() {
+        let m = Mode {
+            axis: [0.0, 0.0, 1.0],
+            support: 100,
+        };
+        let pts = [[0.0; 3]; 4];
+        let given = Given::default();
+        // The mode's own σ = d: 3σ over the reach 2d, λ would be 1.
+        let own = (0.5, 0.5);
+        let cloud = (0.4, 0.01);
+        let s = mode_scan(
+            StructureKind::Planes,
+            &pts,
+            m,
+            vec![0, 1, 2, 3],
+            own,
+            cloud,
+            &given,
+            1,
+        );
+        assert!(s.cloud_scale);
+        assert_eq!((s.spacing, s.noise), cloud);
+        let (a, l2, l3) = scales(StructureKind::Planes, cloud.0, cloud.1, &given);
+        assert_eq!((s.alpha, s.lambda2, s.lambda3), (a, l2, l3));
+        assert!(s.lambda2 > 1.0);
+        assert_eq!(s.points.len(), 4);
+        // A cloud as thick as the mode: the mode keeps its own ball.
+        let s = mode_scan(
+            StructureKind::Planes,
+            &pts,
+            m,
+            vec![0, 1, 2, 3],
+            own,
+            (0.4, 0.4),
+            &given,
+            1,
+        );
+        assert!(!s.cloud_scale);
+        assert_eq!((s.spacing, s.noise, s.lambda2), (0.5, 0.5, 1.0));
+        // A thin mode keeps its own scale; a given α keeps the mode's own.
+        let s = mode_scan(
+            StructureKind::Planes,
+            &pts,
+            m,
+            vec![0, 1, 2, 3],
+            (0.5, 0.01),
+            cloud,
+            &given,
+            1,
+        );
+        assert!(!s.cloud_scale && s.spacing == 0.5);
+        let alpha = Given {
+            alpha: Some(1.0),
+            ..Given::default()
+        };
+        let s = mode_scan(
+            StructureKind::Planes,
+            &pts,
+            m,
+            vec![0, 1, 2, 3],
+            own,
+            cloud,
+            &alpha,
+            1,
+        );
+        assert!(!s.cloud_scale && s.alpha == 1.0);
+    }
 
     #[test]
     fn thin_along_keeps_one_chain_per_tube() {
