@@ -190,3 +190,58 @@ def test_normals_equal_in_process(client):
     assert not np.array_equal(plain.part_labels, ref.part_labels)
     with pytest.raises(ValueError, match="normals"):
         distributed.detect(pts, "planes", tile=2.0, client=client, normals=normals[:5])
+
+
+def killing_cluster(marker, always=False):
+    """A 2-process LocalCluster whose workers kill their own process when a
+    tile task starts: once (the first task of the run, the marker file
+    records it) or every time (``always``). The nannies start a new worker
+    in its place, as a cluster's would."""
+    from dask.distributed import Client, LocalCluster, WorkerPlugin
+
+    class KillOnTile(WorkerPlugin):  # defined here: pickled by value
+        name = "kill-on-tile"
+
+        def transition(self, key, start, finish, **kwargs):
+            if finish != "executing" or "_run_tile" not in str(key):
+                return
+            if not always:
+                try:
+                    os.close(os.open(marker, os.O_CREAT | os.O_EXCL))
+                except FileExistsError:
+                    return
+            os._exit(1)
+
+    cluster = LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+    )
+    c = Client(cluster)
+    c.register_plugin(KillOnTile())
+    return c, cluster
+
+
+def test_a_worker_killed_mid_run_gives_the_same_labels(tmp_path):
+    """The first tile task kills its worker (its scattered points are lost
+    with it): the tile is sent again and the result is aa.detect's."""
+    pts = room(11)
+    ref = aa.detect(pts, "planes")
+    marker = tmp_path / "killed"
+    c, cluster = killing_cluster(str(marker))
+    try:
+        det = distributed.detect(pts, "planes", tile=3.0, client=c)
+    finally:
+        c.close()
+        cluster.close()
+    assert marker.exists(), "no worker was killed: the test tested nothing"
+    assert_same(det, ref)
+
+
+def test_a_tile_that_always_kills_its_worker_is_a_clear_error(tmp_path):
+    pts = room(13)
+    c, cluster = killing_cluster(str(tmp_path / "unused"), always=True)
+    try:
+        with pytest.raises(distributed.TileLost, match=r"was lost 3 times"):
+            distributed.detect(pts, "planes", tile=100.0, client=c)
+    finally:
+        c.close()
+        cluster.close()

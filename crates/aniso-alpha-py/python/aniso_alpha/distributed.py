@@ -29,7 +29,8 @@ from __future__ import annotations
 import json
 import math
 import os
-from typing import Any, List, Optional, Sequence, Tuple, Union
+import time
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Type, Union
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -39,7 +40,7 @@ from ._api import Structure, detect_input, detect_options
 from ._io import Cloud, PathLike, _warn, read
 from ._results import Detection
 
-__all__ = ["detect", "load", "plan"]
+__all__ = ["TileLost", "detect", "load", "plan"]
 
 Source = Union[PathLike, Sequence[PathLike], ArrayLike, Any]
 
@@ -232,6 +233,8 @@ def detect(
     Raises:
         ValueError: as :func:`aniso_alpha.detect`, and a bad ``tile``.
         ImportError: ``dask.distributed`` is not installed.
+        TileLost: a tile's worker was lost :data:`TILE_ATTEMPTS` times
+            (a tile lost fewer times is sent again: the result is the same).
 
     Two planes of a grid, cut into tiles of side 8 (smaller than the
     planes), on a LocalCluster of 2 processes:
@@ -287,28 +290,91 @@ def detect(
     return Detection(labels, part_labels, r["structures"], r["parameters"], list(messages), native)
 
 
+# A tile whose task is lost this many times (its worker died, its scattered
+# points with it) ends the run with an error naming it.
+TILE_ATTEMPTS = 3
+
+
+class TileLost(RuntimeError):
+    """A tile's task failed :data:`TILE_ATTEMPTS` times because its worker
+    was lost (killed, out of memory, disconnected): the run stops, with the
+    tile's cell and the last error."""
+
+
+def _lost_worker_errors() -> Tuple[Type[BaseException], ...]:
+    """The exceptions a task's result raises when its worker (or the data
+    scattered to it) was lost, rather than when the task itself failed."""
+    import asyncio
+    import concurrent.futures
+
+    from distributed.comm.core import CommClosedError
+    from distributed.scheduler import KilledWorker
+
+    return (
+        KilledWorker,
+        CommClosedError,
+        asyncio.CancelledError,
+        concurrent.futures.CancelledError,
+        OSError,
+    )
+
+
 def _run(
     client: Any, p: "_native.Plan", points: NDArray[np.float64], task_threads: int
 ) -> List[Tuple[Any, ...]]:
     """Runs every tile of ``p`` on ``client``'s workers, at most a few tiles
     per worker in flight (the driver never holds every tile's copy of its
-    points at once); returns the tiles' outputs in completion order."""
+    points at once); returns the tiles' outputs in completion order.
+
+    A tile whose worker is lost (its task and the points scattered to it
+    go with it) is sent again from the driver's copy of the cloud, up to
+    :data:`TILE_ATTEMPTS` times; the job spec is scattered again if every
+    worker holding it is gone. A tile's output depends on its points only,
+    so the labels are those of an undisturbed run. An error raised by the
+    task itself (not a lost worker) is raised as it is."""
     from dask.distributed import as_completed
 
-    [spec] = client.scatter([p.step_spec()], broadcast=True)
+    lost_errors = _lost_worker_errors()
     tiles = iter(p.tiles(points))
     limit = 2 * _workers(client) + 2
     outputs: List[Tuple[Any, ...]] = []
+    attempts: Dict[str, Tuple[Tuple[Any, ...], int]] = {}
 
-    def submit(tile: Tuple[Any, ...]) -> Any:
+    def scatter(data: Any, broadcast: bool = False) -> Any:
+        """``client.scatter`` of one object, again (after a pause) when a
+        worker it was sent to is lost on the way."""
+        for attempt in range(1, TILE_ATTEMPTS + 1):
+            try:
+                return client.scatter([data], broadcast=broadcast)[0]
+            except lost_errors:
+                if attempt == TILE_ATTEMPTS:
+                    raise
+                time.sleep(0.5 * attempt)
+
+    def submit(tile: Tuple[Any, ...], tried: int = 0) -> Any:
         cell, ids = tile
-        payload = (cell, np.ascontiguousarray(points[ids]), ids, p.members(ids))
-        [data] = client.scatter([payload])
-        return client.submit(_run_tile, spec, data, task_threads, pure=False)
+        if spec_holder[0].status != "finished":
+            spec_holder[0] = scatter(p.step_spec(), broadcast=True)
+        data = scatter((cell, np.ascontiguousarray(points[ids]), ids, p.members(ids)))
+        future = client.submit(_run_tile, spec_holder[0], data, task_threads, pure=False)
+        attempts[future.key] = (tile, tried + 1)
+        return future
 
+    spec_holder = [scatter(p.step_spec(), broadcast=True)]
     pending = as_completed([submit(t) for _, t in zip(range(limit), tiles)])  # type: ignore[no-untyped-call]
     for done in pending:
-        faces, offsets, triangulated = done.result()
+        tile, tried = attempts.pop(done.key)
+        try:
+            faces, offsets, triangulated = done.result()
+        except lost_errors as e:
+            done.release()
+            if tried >= TILE_ATTEMPTS:
+                raise TileLost(
+                    f"tile {tuple(tile[0])} ({len(tile[1])} points) was lost {tried} times "
+                    f"(its worker died or left the cluster); last error: {type(e).__name__}: {e}"
+                ) from e
+            pending.add(submit(tile, tried))  # type: ignore[no-untyped-call]
+            continue
         # Unpickled from one frame, the arrays may be unaligned (see _run_tile).
         outputs.append(
             (
