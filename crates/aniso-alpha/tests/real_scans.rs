@@ -630,19 +630,20 @@ fn wires_beside_a_facade_are_no_planes() {
 fn small_roofs_at_every_azimuth_have_their_own_modes() {
     // An airborne-like block: ground on the scan pattern of a flight strip
     // (0.4 m between points along a scan line, 1 m between lines, 3 cm of
-    // noise) and six gable houses at azimuths 60° apart, their roofs
-    // pitched 18–35° (some within the 25° cone of the ground's normal),
+    // noise) and six gable houses whose ridges turn by 30° from one to the
+    // next (so their twelve faces look at twelve azimuths), their roofs
+    // pitched 24–39° (the first within the 25° cone of the ground's normal),
     // each face 10 × 4 m: about 100 points, 1% of the cloud. Each face's
     // normal is a mode of its own, judged on its own points, not on the
     // ground's (docs/method.md §8, "Modes"): every face is one part.
     let mut rng = SplitMix64::new(0xa1b0);
-    let pitches = [18.0f64, 22.0, 28.0, 35.0, 20.0, 31.0];
+    let pitches = [24.0f64, 27.0, 30.0, 33.0, 36.0, 39.0];
     let houses: Vec<([f64; 2], f64, f64)> = (0..6)
         .map(|k| {
             let c = [12.0 + 18.0 * (k % 3) as f64, 15.0 + 30.0 * (k / 3) as f64];
             (
                 (c),
-                (10.0 + 60.0 * k as f64).to_radians(),
+                (10.0 + 30.0 * k as f64).to_radians(),
                 pitches[k].to_radians(),
             )
         })
@@ -690,4 +691,35 @@ fn small_roofs_at_every_azimuth_have_their_own_modes() {
             pitches[face as usize / 2]
         );
     }
+}
+
+#[test]
+fn scan_lines_far_apart_are_one_plane() {
+    // Ground scanned as an airborne strip: points 0.3 m apart along scan
+    // lines 2.4 m apart (8 spacings), 3 cm of noise. The nearest
+    // neighbour is on the same line, so the spacing alone would give an
+    // ellipsoid that cannot reach the next line and every line would be a
+    // strip one point wide; half the row gap is what the reach must span
+    // (docs/method.md §8, "Scales per mode"): one plane holding the ground.
+    let mut rng = SplitMix64::new(0x11e5);
+    let mut points = Vec::new();
+    for j in 0..25 {
+        for i in 0..200 {
+            let (x, y) = (0.3 * i as f64, 2.4 * j as f64 + 0.004 * i as f64);
+            points.push([x, y, 0.03 * gauss(&mut rng)]);
+        }
+    }
+    let det = planes_from_the_data(&points);
+    let parts = det.part_labels();
+    let mut counts = std::collections::HashMap::new();
+    for &p in parts.iter().filter(|&&p| p >= 0) {
+        *counts.entry(p).or_insert(0usize) += 1;
+    }
+    let largest = counts.values().copied().max().unwrap_or(0);
+    assert!(
+        largest as f64 >= 0.9 * points.len() as f64,
+        "the largest part holds {largest} of {} points ({} parts)",
+        points.len(),
+        counts.len()
+    );
 }

@@ -26,7 +26,12 @@
 //!    * spacing d = the 90th percentile of their spacings (so that the
 //!      sparser, farther parts of a scan with mixed density are reached:
 //!      a scanner's density falls with the square of the range, and one
-//!      global median would leave the far walls in pieces);
+//!      global median would leave the far walls in pieces). For planes a
+//!      point's spacing is the larger of its nearest-neighbour distance
+//!      and half its row gap ([`LocalShape::row_gap`]): points on scan
+//!      lines far apart (an airborne strip) have their nearest neighbour
+//!      on their own line, and the triangles that join two lines g apart
+//!      have a circumradius of about g/2, which the reach must span;
 //!    * noise σ = the median of their spreads.
 //! 4. **α and λ** (per mode, λ₂ = λ₃ = λ):
 //!    * thickness: α ≥ [`C_NOISE`]·σ, so the ellipsoid's short semi-axis
@@ -89,7 +94,7 @@ use super::modes::{modes, Mode};
 use super::StructureKind;
 use crate::aniso::{completion_first_row, completion_third_row, Mat3};
 use crate::geometry::kdtree::KdTree;
-use crate::geometry::{dot, sub};
+use crate::geometry::{cross, dot, normalize, sub};
 
 /// Score (planarity or linearity) from which a point is structure-like: the
 /// midpoint of the features' range [0, 1].
@@ -631,7 +636,7 @@ fn estimate_with(
         .collect();
     let (spacing, noise) = spacing_and_noise(kind, shapes, &structure, (spacing_median, 0.0));
     let (alpha_p, lambda2_p, lambda3_p, min_size_p) = cloud_params(kind, spacing, noise, given);
-    let found = concentrated_modes(kind, shapes, &structure);
+    let found = concentrated_modes(kind, shapes, &structure, &off);
     let member_of = mode_members(kind, shapes, &found, &off);
     let explained = explained_share(kind, shapes, &member_of, &off);
     let mode_scans: Vec<ModeScan> = found
@@ -700,7 +705,7 @@ fn spacing_and_noise(
 ) -> (f64, f64) {
     let mut sp: Vec<f32> = ids
         .iter()
-        .map(|&i| shapes[i as usize].spacing)
+        .map(|&i| reach_spacing(kind, &shapes[i as usize]))
         .filter(|s| s.is_finite())
         .collect();
     let d = if sp.is_empty() {
@@ -718,6 +723,18 @@ fn spacing_and_noise(
         quantile(&mut nv, 0.5)
     };
     (d, sigma)
+}
+
+/// The spacing a point asks the reach to span: for planes, the larger of
+/// its nearest-neighbour distance and half its row gap (the circumradius
+/// of the triangles that join two scan lines a gap g apart is about g/2;
+/// on an isotropic sampling half the gap is under the spacing and nothing
+/// changes); for lines, the nearest-neighbour distance.
+fn reach_spacing(kind: StructureKind, s: &LocalShape) -> f32 {
+    match kind {
+        StructureKind::Planes if s.row_gap.is_finite() => s.spacing.max(0.5 * s.row_gap),
+        _ => s.spacing,
+    }
 }
 
 /// The cloud-wide α, λ₂, λ₃ and nb_c (module doc, steps 4–5) from its
@@ -740,10 +757,14 @@ fn cloud_params(
         format!(
             "max({C_NOISE}·noise, {C_REACH}·spacing/{LAMBDA_MAX}) with noise {noise:.4} (median spread \
              across the local {}s) and spacing {spacing:.4} (90th percentile of the nearest-neighbour \
-             distances of structure-like points)",
+             distances of structure-like points{})",
             match kind {
                 StructureKind::Planes => "plane",
                 StructureKind::Lines => "line",
+            },
+            match kind {
+                StructureKind::Planes => ", or half the gap to the next scan line where larger",
+                StructureKind::Lines => "",
             }
         ),
     );
@@ -782,17 +803,29 @@ fn cloud_params(
 
 /// The modes of the axes of the structure-like points `structure`
 /// (module doc, step 2) that are concentrated: at least
-/// [`MODE_CONCENTRATION`] of the points that would be its members have
-/// their axis within its kernel.
+/// [`MODE_CONCENTRATION`] of the points in their cone have their axis
+/// within the kernel, counted in one of two ways.
 ///
-/// The modes are taken densest first, and a point counts for a mode as
-/// [`mode_members`] makes it a member: within [`CONE_DEG`] of it and at
-/// most [`MARGIN_DEG`] farther from it than from the nearest mode already
-/// kept. So a small roof whose pitch is within the cone of the ground's
-/// normal is judged on its own points, not on the ground's (which belong
-/// to the ground's mode), while a peak of edge normals, spread between two
-/// planes, still finds few of its cone's points in its kernel.
-fn concentrated_modes(kind: StructureKind, shapes: &[LocalShape], structure: &[u32]) -> Vec<Mode> {
+/// * Over every point within [`CONE_DEG`] of the mode (the rule measured
+///   on the building and polyhedron scans).
+/// * Over the structure-like points that would be its members, as
+///   [`mode_members`] makes them: within the cone and at most
+///   [`MARGIN_DEG`] farther from it than from the nearest denser mode
+///   already kept. So a small roof whose pitch lies within the cone of the
+///   ground's normal is judged on its own points, not on the ground's or
+///   the trees'. Counted so, a peak of blurred edge normals is
+///   concentrated too (the faces' points belong to the faces' modes), so
+///   this way is closed to a peak that lies on the arc between two kept
+///   modes ([`between_kept`]): the normals of an edge blend its two
+///   faces'.
+///
+/// The modes are taken densest first.
+fn concentrated_modes(
+    kind: StructureKind,
+    shapes: &[LocalShape],
+    structure: &[u32],
+    off: &dyn Fn(usize) -> bool,
+) -> Vec<Mode> {
     let axes: Vec<[f64; 3]> = structure
         .iter()
         .map(|&i| axis64(&shapes[i as usize], kind))
@@ -801,20 +834,34 @@ fn concentrated_modes(kind: StructureKind, shapes: &[LocalShape], structure: &[u
     let found: Vec<Mode> = modes(&axes, MODE_KERNEL_DEG.to_radians(), min_support);
     let cos_cone = CONE_DEG.to_radians().cos();
     let (sin_margin, cos_margin) = MARGIN_DEG.to_radians().sin_cos();
-    // Per point: its axis, and the cosine of the largest angle at which a
-    // mode still takes it (its angle to the nearest kept mode plus the
-    // margin; -1 while no mode is kept: any angle).
+    let all: Vec<[f64; 3]> = shapes
+        .iter()
+        .enumerate()
+        .filter(|&(i, _)| !off(i))
+        .map(|(_, s)| axis64(s, kind))
+        .collect();
+    // Per structure-like point: its axis, and the cosine of the largest
+    // angle at which a mode still takes it (its angle to the nearest kept
+    // mode plus the margin; -1 while no mode is kept: any angle).
     let mut candidates: Vec<([f64; 3], f64)> = axes.iter().map(|&a| (a, -1.0)).collect();
-    let mut kept = Vec::new();
+    let mut kept: Vec<Mode> = Vec::new();
     for m in found {
-        let members = candidates
+        let concentrated = |count: usize| m.support as f64 >= MODE_CONCENTRATION * count as f64;
+        let in_cone = all
             .iter()
-            .filter(|&&(a, limit)| {
-                let c = dot(a, m.axis).abs();
-                c >= cos_cone && c >= limit
-            })
+            .filter(|&&a| dot(a, m.axis).abs() >= cos_cone)
             .count();
-        if (m.support as f64) < MODE_CONCENTRATION * members as f64 {
+        let keep = concentrated(in_cone) || {
+            let members = candidates
+                .iter()
+                .filter(|&&(a, limit)| {
+                    let c = dot(a, m.axis).abs();
+                    c >= cos_cone && c >= limit
+                })
+                .count();
+            concentrated(members) && !between_kept(m.axis, &kept)
+        };
+        if !keep {
             continue;
         }
         for (a, limit) in candidates.iter_mut() {
@@ -827,6 +874,37 @@ fn concentrated_modes(kind: StructureKind, shapes: &[LocalShape], structure: &[u
         kept.push(m);
     }
     kept
+}
+
+/// Whether axis `m` lies on the arc between two of the `kept` axes: within
+/// the mode kernel ([`MODE_KERNEL_DEG`]) of their great circle, between
+/// them, and farther than the kernel from each (axes without sign: each
+/// kept axis is taken on `m`'s side).
+fn between_kept(m: [f64; 3], kept: &[Mode]) -> bool {
+    let h = MODE_KERNEL_DEG.to_radians();
+    let toward = |a: [f64; 3]| if dot(a, m) < 0.0 { a.map(|x| -x) } else { a };
+    let angle = |u: [f64; 3], v: [f64; 3]| dot(u, v).clamp(-1.0, 1.0).acos();
+    kept.iter().enumerate().any(|(i, a)| {
+        kept[i + 1..].iter().any(|b| {
+            let (a, b) = (toward(a.axis), toward(b.axis));
+            let Some(n) = normalize(cross(a, b)) else {
+                return false;
+            };
+            let off_circle = dot(m, n);
+            if off_circle.abs() > h.sin() {
+                return false;
+            }
+            let Some(p) = normalize([
+                m[0] - off_circle * n[0],
+                m[1] - off_circle * n[1],
+                m[2] - off_circle * n[2],
+            ]) else {
+                return false;
+            };
+            let (ap, pb) = (angle(a, p), angle(p, b));
+            ap > h && pb > h && ap + pb <= angle(a, b) + 1e-9
+        })
+    })
 }
 
 /// The members of each mode (module doc, step 3): a point joins the modes

@@ -28,6 +28,9 @@
 //! let shapes = local_shapes(&pts, StructureKind::Planes);
 //! assert!(shapes.iter().all(|s| s.normal[2].abs() > 0.99 && s.planarity() > 0.5));
 //! assert!(shapes.iter().all(|s| (s.spacing - 1.0).abs() < 1e-6));
+//! // On a grid the nearest neighbour across (45° or more away from the
+//! // nearest one) is as near: the row gap is the spacing.
+//! assert!(shapes.iter().all(|s| (s.row_gap - 1.0).abs() < 1e-6));
 //! ```
 
 use super::StructureKind;
@@ -62,6 +65,12 @@ pub struct LocalShape {
     /// Distance to the nearest other point with other coordinates (∞ when
     /// there is none).
     pub spacing: f32,
+    /// Distance to the nearest neighbour at least 45° away from the
+    /// direction of the nearest one (either way): on a scan line, the
+    /// gap to the next line; on an isotropic sampling, about the spacing.
+    /// The farthest of the neighbours when none is (the gap is at least
+    /// that); ∞ when there is no neighbour.
+    pub row_gap: f32,
 }
 
 impl LocalShape {
@@ -251,7 +260,30 @@ fn shape_of(points: &[[f64; 3]], nb: &[(f64, u32)], scale: usize, spacing: f32) 
         sigma: to_f32(sigma),
         scale: scale as u8,
         spacing,
+        row_gap: f32::INFINITY,
     }
+}
+
+/// The row gap of `q` among its neighbours `nb` (squared distances,
+/// ascending; see [`LocalShape::row_gap`]).
+fn row_gap(points: &[[f64; 3]], q: &[f64; 3], nb: &[(f64, u32)]) -> f32 {
+    let offset = |j: u32| {
+        let p = points[j as usize];
+        [p[0] - q[0], p[1] - q[1], p[2] - q[2]]
+    };
+    let mut rest = nb.iter().filter(|&&(d, _)| d > 0.0);
+    let Some(&(d0, first)) = rest.next() else {
+        return f32::INFINITY;
+    };
+    let u = offset(first);
+    // |cos| ≤ cos 45° ⟺ 2·(u·v)² ≤ |u|²·|v|².
+    rest.find(|&&(d, j)| {
+        let v = offset(j);
+        let uv = u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+        2.0 * uv * uv <= d0 * d
+    })
+    .map_or(nb[nb.len() - 1].0, |&(d, _)| d)
+    .sqrt() as f32
 }
 
 /// The local shape of every point (see the module doc). Deterministic;
@@ -306,8 +338,12 @@ pub fn local_shapes(points: &[[f64; 3]], kind: StructureKind) -> Vec<LocalShape>
             .map(|&(d, _)| d)
             .find(|&d| d > 0.0)
             .map_or(f32::INFINITY, |d| d.sqrt() as f32);
+        let gap = row_gap(points, q, nb);
         let mut best = if nb.len() >= 3 {
-            shape_of(points, nb, 0, spacing)
+            LocalShape {
+                row_gap: gap,
+                ..shape_of(points, nb, 0, spacing)
+            }
         } else {
             LocalShape {
                 normal: [0.0, 0.0, 1.0],
@@ -315,6 +351,7 @@ pub fn local_shapes(points: &[[f64; 3]], kind: StructureKind) -> Vec<LocalShape>
                 sigma: [0.0; 3],
                 scale: 0,
                 spacing,
+                row_gap: gap,
             }
         };
         let mut score = best.score(kind);
@@ -331,7 +368,11 @@ pub fn local_shapes(points: &[[f64; 3]], kind: StructureKind) -> Vec<LocalShape>
             let s = c.score(kind);
             if s > score {
                 score = s;
-                best = LocalShape { spacing, ..c };
+                best = LocalShape {
+                    spacing,
+                    row_gap: gap,
+                    ..c
+                };
             }
             if s >= GOOD {
                 break;
@@ -428,6 +469,33 @@ mod tests {
         spread.sort_by(|a, b| a.partial_cmp(b).unwrap());
         let median = spread[spread.len() / 2];
         assert!((1.5..2.5).contains(&median), "noise estimate {median}");
+    }
+
+    #[test]
+    fn row_gap_is_the_distance_between_scan_lines() {
+        // Lines 1.5 apart, points 0.3 apart along them: the nearest
+        // neighbour is on the line, the row gap is the next line.
+        let pts: Vec<[f64; 3]> = (0..8)
+            .flat_map(|j| (0..40).map(move |i| [0.3 * i as f64, 1.5 * j as f64, 0.0]))
+            .collect();
+        let shapes = local_shapes(&pts, StructureKind::Planes);
+        for (p, s) in pts.iter().zip(&shapes) {
+            assert!((s.spacing - 0.3).abs() < 1e-5);
+            if p[0] > 3.0 && p[0] < 9.0 {
+                assert!((s.row_gap - 1.5).abs() < 1e-5, "{p:?}: {}", s.row_gap);
+            }
+        }
+        // Lines farther apart than the neighbourhood reaches: the gap is at
+        // least its farthest neighbour (8 steps along the line).
+        let pts: Vec<[f64; 3]> = (0..3)
+            .flat_map(|j| (0..60).map(move |i| [0.3 * i as f64, 10.0 * j as f64, 0.0]))
+            .collect();
+        let shapes = local_shapes(&pts, StructureKind::Planes);
+        assert!(
+            (shapes[30].row_gap - 2.4).abs() < 1e-5,
+            "{}",
+            shapes[30].row_gap
+        );
     }
 
     #[test]
