@@ -351,16 +351,18 @@ def _run(
                     raise
                 time.sleep(0.5 * attempt)
 
+    spec = scatter(p.step_spec(), broadcast=True)
+
     def submit(tile: Tuple[Any, ...], tried: int = 0) -> Any:
+        nonlocal spec
         cell, ids = tile
-        if spec_holder[0].status != "finished":
-            spec_holder[0] = scatter(p.step_spec(), broadcast=True)
+        if spec.status != "finished":
+            spec = scatter(p.step_spec(), broadcast=True)
         data = scatter((cell, np.ascontiguousarray(points[ids]), ids, p.members(ids)))
-        future = client.submit(_run_tile, spec_holder[0], data, task_threads, pure=False)
+        future = client.submit(_run_tile, spec, data, task_threads, pure=False)
         attempts[future.key] = (tile, tried + 1)
         return future
 
-    spec_holder = [scatter(p.step_spec(), broadcast=True)]
     pending = as_completed([submit(t) for _, t in zip(range(limit), tiles)])  # type: ignore[no-untyped-call]
     for done in pending:
         tile, tried = attempts.pop(done.key)

@@ -1067,20 +1067,23 @@ mod tests {
             support: 100,
         };
         let pts = [[0.0; 3]; 4];
+        let scan = |own: (f64, f64), cloud: (f64, f64), given: &Given| {
+            mode_scan(
+                StructureKind::Planes,
+                &pts,
+                m,
+                vec![0, 1, 2, 3],
+                own,
+                cloud,
+                given,
+                1,
+            )
+        };
         let given = Given::default();
         // The mode's own σ = d: 3σ over the reach 2d, λ would be 1.
         let own = (0.5, 0.5);
         let cloud = (0.4, 0.01);
-        let s = mode_scan(
-            StructureKind::Planes,
-            &pts,
-            m,
-            vec![0, 1, 2, 3],
-            own,
-            cloud,
-            &given,
-            1,
-        );
+        let s = scan(own, cloud, &given);
         assert!(s.cloud_scale);
         assert_eq!((s.spacing, s.noise), cloud);
         let (a, l2, l3) = scales(StructureKind::Planes, cloud.0, cloud.1, &given);
@@ -1088,44 +1091,17 @@ mod tests {
         assert!(s.lambda2 > 1.0);
         assert_eq!(s.points.len(), 4);
         // A cloud as thick as the mode: the mode keeps its own ball.
-        let s = mode_scan(
-            StructureKind::Planes,
-            &pts,
-            m,
-            vec![0, 1, 2, 3],
-            own,
-            (0.4, 0.4),
-            &given,
-            1,
-        );
+        let s = scan(own, (0.4, 0.4), &given);
         assert!(!s.cloud_scale);
         assert_eq!((s.spacing, s.noise, s.lambda2), (0.5, 0.5, 1.0));
         // A thin mode keeps its own scale; a given α keeps the mode's own.
-        let s = mode_scan(
-            StructureKind::Planes,
-            &pts,
-            m,
-            vec![0, 1, 2, 3],
-            (0.5, 0.01),
-            cloud,
-            &given,
-            1,
-        );
+        let s = scan((0.5, 0.01), cloud, &given);
         assert!(!s.cloud_scale && s.spacing == 0.5);
         let alpha = Given {
             alpha: Some(1.0),
             ..Given::default()
         };
-        let s = mode_scan(
-            StructureKind::Planes,
-            &pts,
-            m,
-            vec![0, 1, 2, 3],
-            own,
-            cloud,
-            &alpha,
-            1,
-        );
+        let s = scan(own, cloud, &alpha);
         assert!(!s.cloud_scale && s.alpha == 1.0);
     }
 

@@ -34,8 +34,8 @@
 //! ```
 
 use super::StructureKind;
-use crate::geometry::cross;
 use crate::geometry::kdtree::KdTree;
+use crate::geometry::{cross, dot, sub};
 
 /// Neighbours per neighbourhood: the usual choice for PCA normals (CGAL's
 /// examples use 12–24, PCL's 10–30): enough for a stable covariance of 3
@@ -267,10 +267,7 @@ fn shape_of(points: &[[f64; 3]], nb: &[(f64, u32)], scale: usize, spacing: f32) 
 /// The row gap of `q` among its neighbours `nb` (squared distances,
 /// ascending; see [`LocalShape::row_gap`]).
 fn row_gap(points: &[[f64; 3]], q: &[f64; 3], nb: &[(f64, u32)]) -> f32 {
-    let offset = |j: u32| {
-        let p = points[j as usize];
-        [p[0] - q[0], p[1] - q[1], p[2] - q[2]]
-    };
+    let offset = |j: u32| sub(points[j as usize], *q);
     let mut rest = nb.iter().filter(|&&(d, _)| d > 0.0);
     let Some(&(d0, first)) = rest.next() else {
         return f32::INFINITY;
@@ -278,8 +275,7 @@ fn row_gap(points: &[[f64; 3]], q: &[f64; 3], nb: &[(f64, u32)]) -> f32 {
     let u = offset(first);
     // |cos| ≤ cos 45° ⟺ 2·(u·v)² ≤ |u|²·|v|².
     rest.find(|&&(d, j)| {
-        let v = offset(j);
-        let uv = u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+        let uv = dot(u, offset(j));
         2.0 * uv * uv <= d0 * d
     })
     .map_or(nb[nb.len() - 1].0, |&(d, _)| d)
