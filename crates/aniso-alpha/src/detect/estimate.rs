@@ -808,16 +808,19 @@ fn cloud_params(
 ///
 /// * Over every point within [`CONE_DEG`] of the mode (the rule measured
 ///   on the building and polyhedron scans).
-/// * Over the structure-like points that would be its members, as
-///   [`mode_members`] makes them: within the cone and at most
-///   [`MARGIN_DEG`] farther from it than from the nearest denser mode
-///   already kept. So a small roof whose pitch lies within the cone of the
-///   ground's normal is judged on its own points, not on the ground's or
-///   the trees'. Counted so, a peak of blurred edge normals is
+/// * Over its own structure-like points: within the cone and nearer to
+///   it than to every denser mode already kept (the margin of
+///   [`mode_members`] is what a mode scans, not what it is judged on: with
+///   it, a roof pitched 18° from the ground counted the ground's blurred
+///   shoulder as its own). So a small roof whose pitch lies within the
+///   cone of the ground's normal is judged on its own points, not on the
+///   ground's or the trees'. Counted so, a peak of blurred edge normals is
 ///   concentrated too (the faces' points belong to the faces' modes), so
 ///   this way is closed to a peak that lies on the arc between two kept
 ///   modes ([`between_kept`]): the normals of an edge blend its two
-///   faces'.
+///   faces'. A peak of one step's edge (a pane recessed in a wall) beside
+///   a single mode passes; the pieces it finds at its inflated scale lie
+///   on the wall's points and the assembly absorbs them (claims.rs).
 ///
 /// The modes are taken densest first.
 fn concentrated_modes(
@@ -833,16 +836,15 @@ fn concentrated_modes(
     let min_support = MODE_MIN_POINTS.max(structure.len() / 1000);
     let found: Vec<Mode> = modes(&axes, MODE_KERNEL_DEG.to_radians(), min_support);
     let cos_cone = CONE_DEG.to_radians().cos();
-    let (sin_margin, cos_margin) = MARGIN_DEG.to_radians().sin_cos();
     let all: Vec<[f64; 3]> = shapes
         .iter()
         .enumerate()
         .filter(|&(i, _)| !off(i))
         .map(|(_, s)| axis64(s, kind))
         .collect();
-    // Per structure-like point: its axis, and the cosine of the largest
-    // angle at which a mode still takes it (its angle to the nearest kept
-    // mode plus the margin; -1 while no mode is kept: any angle).
+    // Per structure-like point: its axis, and the cosine of its angle to
+    // the nearest kept mode (-1 while no mode is kept): a peak counts the
+    // points nearer to it than to every kept mode.
     let mut candidates: Vec<([f64; 3], f64)> = axes.iter().map(|&a| (a, -1.0)).collect();
     let mut kept: Vec<Mode> = Vec::new();
     for m in found {
@@ -865,11 +867,7 @@ fn concentrated_modes(
             continue;
         }
         for (a, limit) in candidates.iter_mut() {
-            // cos(angle + margin) for the angle to this mode, when it is
-            // nearer than every mode kept before.
-            let c = dot(*a, m.axis).abs().min(1.0);
-            let angle_plus_margin = c * cos_margin - (1.0 - c * c).max(0.0).sqrt() * sin_margin;
-            *limit = limit.max(angle_plus_margin);
+            *limit = limit.max(dot(*a, m.axis).abs().min(1.0));
         }
         kept.push(m);
     }

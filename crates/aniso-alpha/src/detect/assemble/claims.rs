@@ -8,11 +8,16 @@
 //! Candidates that are one primitive ([`Shape::same`]) and share claimed
 //! points merge, until none do; then each point goes to the candidate it
 //! is nearest to (parts are disjoint), the candidates are refitted on
-//! their members, and claim again.
+//! their members, and claim again. A merged candidate claims with the
+//! widest radius of its pieces, except the radius of a piece it absorbed
+//! ([`absorbed`]: a coarser piece on its own points), which also links it
+//! to nothing else: a piece found at an edge's coarse scale would
+//! otherwise widen a wall's radius to take the panes recessed behind it.
 
 use super::super::cloud::Cloud;
 use super::super::detection::Primitive;
 use super::footprint::{for_near, Stamps};
+use super::same::absorbed;
 use super::{Candidate, Draft, Footprint, Shape};
 use crate::par::map_ranges;
 use crate::unionfind::UnionFind;
@@ -181,7 +186,7 @@ pub(super) fn settle<S: Shape>(
     let points = cloud.points();
     let mut claims = Claims::of(&cands, cloud, normals);
     while let Some(groups) = duplicates::<S>(&cands, &claims, angle_deg, points) {
-        cands = merged::<S>(cands, groups, points);
+        cands = merged::<S>(cands, &groups, points);
         claims = Claims::of(&cands, cloud, normals);
     }
     let members = claims.resolve(cands.len());
@@ -190,54 +195,77 @@ pub(super) fn settle<S: Shape>(
     (cands, claims)
 }
 
+/// Groups of candidates to merge: per root, its candidates (empty
+/// elsewhere), and per candidate whether another absorbed it.
+struct Groups {
+    sets: Vec<Vec<u32>>,
+    absorbed: Vec<bool>,
+}
+
 /// The groups of candidates that are one primitive and share claimed
-/// points (per root, its candidates; empty elsewhere), or `None` when no
-/// two are.
+/// points, or `None` when no two are. An absorbed candidate ([`absorbed`])
+/// joins the one that absorbs it and no other.
 fn duplicates<S: Shape>(
     cands: &[Candidate],
     claims: &Claims,
     angle_deg: f64,
     points: &[[f64; 3]],
-) -> Option<Vec<Vec<u32>>> {
+) -> Option<Groups> {
     let mut uf = UnionFind::new(cands.len());
+    let mut was_absorbed = vec![false; cands.len()];
     let mut merged = false;
     for (a, b) in claims.shared(Some) {
-        if uf.find(a) != uf.find(b)
-            && S::same(
-                cands[a as usize].piece(),
-                cands[b as usize].piece(),
-                angle_deg,
-                points,
-            )
-        {
+        if was_absorbed[a as usize] || was_absorbed[b as usize] || uf.find(a) == uf.find(b) {
+            continue;
+        }
+        let (pa, pb) = (cands[a as usize].piece(), cands[b as usize].piece());
+        if S::same(pa, pb, angle_deg, points) {
+            if let Some(a_is) = absorbed(pa, pb, points) {
+                was_absorbed[if a_is { a } else { b } as usize] = true;
+            }
             uf.union_min_root(a, b);
             merged = true;
         }
     }
-    merged.then(|| uf.sets())
+    merged.then(|| Groups {
+        sets: uf.sets(),
+        absorbed: was_absorbed,
+    })
 }
 
 /// One candidate per group: a group of one keeps its candidate; a larger
 /// one becomes the fit of its seeds with the largest claim radius and
-/// cell (dropped if it has no footprint).
-fn merged<S: Shape>(
-    cands: Vec<Candidate>,
-    groups: Vec<Vec<u32>>,
-    points: &[[f64; 3]],
-) -> Vec<Candidate> {
+/// cell of the candidates not absorbed (dropped if it has no footprint).
+fn merged<S: Shape>(cands: Vec<Candidate>, groups: &Groups, points: &[[f64; 3]]) -> Vec<Candidate> {
     let mut old: Vec<Option<Candidate>> = cands.into_iter().map(Some).collect();
     let mut next: Vec<Candidate> = Vec::new();
-    for g in groups.into_iter().filter(|g| !g.is_empty()) {
-        let group: Vec<Candidate> = g.iter().filter_map(|&c| old[c as usize].take()).collect();
+    for g in groups.sets.iter().filter(|g| !g.is_empty()) {
+        let group: Vec<(Candidate, bool)> = g
+            .iter()
+            .filter_map(|&c| {
+                old[c as usize]
+                    .take()
+                    .map(|x| (x, groups.absorbed[c as usize]))
+            })
+            .collect();
         if group.len() == 1 {
-            next.extend(group);
+            next.extend(group.into_iter().map(|(c, _)| c));
             continue;
         }
-        let mut seeds: Vec<u32> = group.iter().flat_map(|c| c.seeds.iter().copied()).collect();
+        let mut seeds: Vec<u32> = group
+            .iter()
+            .flat_map(|(c, _)| c.seeds.iter().copied())
+            .collect();
         seeds.sort_unstable();
         seeds.dedup();
-        let tau = group.iter().map(|c| c.tau).fold(0.0, f64::max);
-        let cell = group.iter().map(|c| c.cell).fold(0.0, f64::max);
+        let widest = |of: fn(&Candidate) -> f64| {
+            group
+                .iter()
+                .filter(|(_, absorbed)| !absorbed)
+                .map(|(c, _)| of(c))
+                .fold(0.0, f64::max)
+        };
+        let (tau, cell) = (widest(|c| c.tau), widest(|c| c.cell));
         let fit = S::fit(points, &seeds);
         if let Some(foot) = Footprint::new(&fit, points, &seeds, cell) {
             next.push(Candidate {
@@ -298,7 +326,7 @@ pub(super) fn parts<S: Shape>(
 mod tests {
     use super::*;
     use crate::detect::cloud::Copies;
-    use crate::detect::fit::fit_line_indices;
+    use crate::detect::fit::{fit_line_indices, fit_plane_indices};
 
     /// Claims of three candidates on five points.
     fn claims() -> Claims {
@@ -358,6 +386,53 @@ mod tests {
         assert_eq!(found[1].members, (21..28).collect::<Vec<u32>>());
         // Too few members: no part.
         assert_eq!(parts::<[u32; 2]>(&claims, cands.len(), &pts, 8).len(), 1);
+    }
+
+    #[test]
+    fn a_coarse_piece_on_a_plane_neither_widens_it_nor_links_it() {
+        // A plane z = 0 (21 × 21 points, τ 0.1); a 16-point piece of it
+        // found at a coarse scale (τ 1); a piece tilted 5° from x = 10
+        // to x = 14 (τ 1), one primitive with the coarse piece but not
+        // with the plane (rising to 0.35 above it).
+        let mut pts: Vec<[f64; 3]> = (0..21)
+            .flat_map(|i| (0..21).map(move |j| [i as f64, j as f64, 0.0]))
+            .collect();
+        let tilted: Vec<u32> = (0..5)
+            .flat_map(|i| (0..5).map(move |j| (i, j)))
+            .map(|(i, j)| {
+                let x = 10.0 + i as f64;
+                pts.push([x, 8.0 + j as f64, (x - 10.0) * 5f64.to_radians().tan()]);
+                (pts.len() - 1) as u32
+            })
+            .collect();
+        let copies = Copies::none(pts.len());
+        let cloud = Cloud::new(&pts, &copies);
+        let cand = |seeds: Vec<u32>, tau: f64| {
+            let fit = Primitive::Plane(fit_plane_indices(&pts, &seeds).unwrap());
+            let foot = Footprint::new(&fit, &pts, &seeds, 2.0).unwrap();
+            Candidate {
+                fit,
+                tau,
+                cell: 2.0,
+                seeds,
+                foot,
+            }
+        };
+        let coarse: Vec<u32> = (8..12)
+            .flat_map(|i| (8..12).map(move |j| i * 21 + j))
+            .collect();
+        let cands = vec![
+            cand((0..441).collect(), 0.1),
+            cand(coarse, 1.0),
+            cand(tilted.clone(), 1.0),
+        ];
+        let (cands, _) = settle::<[u32; 3]>(cands, &cloud, None, 10.0);
+        // The plane absorbed the coarse piece and kept its own radius; the
+        // tilted piece stays apart (with the widest radius it took both).
+        assert_eq!(cands.len(), 2);
+        assert_eq!(cands[0].tau, 0.1);
+        assert_eq!(cands[1].tau, 1.0);
+        assert!(tilted.iter().all(|v| cands[1].seeds.contains(v)));
     }
 
     #[test]

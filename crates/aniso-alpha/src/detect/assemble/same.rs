@@ -69,6 +69,26 @@ pub(super) fn same_primitive(a: Piece, b: Piece, angle_deg: f64, points: &[[f64;
     near as f64 >= SAME_SHARE * small.seeds.len() as f64
 }
 
+/// Of two pieces that are one primitive, the one the other absorbs: the
+/// smaller one (fewer seeds) when its claim radius is the wider and most
+/// of its points ([`SAME_SHARE`]) lie within the larger one's radius of
+/// the larger one's primitive: a piece found at a coarser scale (a mode
+/// whose own spacing and noise are inflated, as the blended normals along
+/// an edge) on points of a finer one. `Some(true)` when it is `a`.
+pub(super) fn absorbed(a: Piece, b: Piece, points: &[[f64; 3]]) -> Option<bool> {
+    let a_is_small = a.seeds.len() < b.seeds.len();
+    let (big, small) = if a_is_small { (b, a) } else { (a, b) };
+    if small.tau <= big.tau {
+        return None;
+    }
+    let near = small
+        .seeds
+        .iter()
+        .filter(|&&v| big.fit.distance(&points[v as usize]) <= big.tau)
+        .count();
+    (near as f64 >= SAME_SHARE * small.seeds.len() as f64).then_some(a_is_small)
+}
+
 /// Whether two pieces of a noisy line are one line: the line fitted to
 /// both keeps most of each one's points ([`SAME_SHARE`]) within the larger
 /// claim radius. Their own fits can be tens of degrees apart (three
