@@ -610,7 +610,7 @@ fn split_simplices(det: &Detection) -> (Vec<[u32; 2]>, Vec<[u32; 3]>) {
     let mut edges = Vec::new();
     let mut faces = Vec::new();
     for s in &det.simplices {
-        match s.as_slice() {
+        match s {
             [a, b] => edges.push([*a, *b]),
             [a, b, c] => faces.push([*a, *b, *c]),
             _ => {}

@@ -20,6 +20,7 @@ use tiny_skia::{
 };
 
 use crate::common::CliError;
+use aniso_alpha::detect::Simplices;
 
 /// Width of the pictures.
 pub const WIDTH: u32 = 1200;
@@ -293,7 +294,7 @@ pub fn detection_png(
     points: &[[f64; 3]],
     labels: &[i64],
     parts: Option<&[i64]>,
-    simplices: &[Vec<u32>],
+    simplices: &Simplices,
     outlines: &BTreeMap<(usize, usize), Vec<[f64; 3]>>,
 ) -> Result<Vec<u8>, CliError> {
     let (colors, members) = point_colors(labels, parts);
@@ -318,7 +319,7 @@ pub fn detection_png(
         }
     }
     // Planar parts: their outlines, far to near.
-    let planar = simplices.iter().any(|s| s.len() == 3);
+    let planar = simplices.size() == 3;
     if planar {
         let mut polys: Vec<(f64, [u8; 3], Vec<[f64; 3]>)> = Vec::new();
         for (&(k, j), m) in &members {
@@ -527,10 +528,13 @@ mod tests {
         let labels: Vec<i64> = (0..pts.len())
             .map(|i| if i < 100 { 0 } else { -1 })
             .collect();
-        let simplices: Vec<Vec<u32>> = vec![vec![0, 1, 10], vec![1, 11, 10], vec![2, 3]];
+        let simplices = Simplices::from_flat(3, vec![0, 1, 10, 1, 11, 10]);
         let a = detection_png(&pts, &labels, None, &simplices, &BTreeMap::new()).unwrap();
         let b = detection_png(&pts, &labels, None, &simplices, &BTreeMap::new()).unwrap();
         assert_eq!(a, b);
+        let edges = Simplices::from_flat(2, vec![2, 3]);
+        let c = detection_png(&pts, &labels, None, &edges, &BTreeMap::new()).unwrap();
+        assert_ne!(a, c);
         let pm = Pixmap::decode_png(&a).unwrap();
         assert_eq!((pm.width(), pm.height()), (WIDTH, HEIGHT));
         let want = structure_color(0);

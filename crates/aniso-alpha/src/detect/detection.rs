@@ -166,6 +166,89 @@ pub struct RunStats {
     pub out_of_proportion: usize,
 }
 
+/// Simplices with the same number of vertices each (2: edges, k = 1; 3:
+/// triangles, k = 2), stored flat: one `Vec<u32>` for all of them.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Simplices {
+    size: usize,
+    vertices: Vec<u32>,
+}
+
+impl Simplices {
+    /// No simplices, each to have `size` vertices (at least 1).
+    pub fn new(size: usize) -> Self {
+        assert!(size >= 1, "a simplex has at least one vertex");
+        Simplices {
+            size,
+            vertices: Vec::new(),
+        }
+    }
+
+    /// The simplices of `size` vertices each, laid end to end in
+    /// `vertices` (whose length must be a multiple of `size`).
+    pub fn from_flat(size: usize, vertices: Vec<u32>) -> Self {
+        assert!(size >= 1, "a simplex has at least one vertex");
+        assert_eq!(vertices.len() % size, 0, "not whole simplices");
+        Simplices { size, vertices }
+    }
+
+    /// The number of vertices of each simplex.
+    pub fn size(&self) -> usize {
+        self.size
+    }
+
+    /// The number of simplices.
+    pub fn len(&self) -> usize {
+        self.vertices.len() / self.size
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.vertices.is_empty()
+    }
+
+    /// Appends a simplex of [`Self::size`] vertices.
+    pub fn push(&mut self, simplex: &[u32]) {
+        assert_eq!(simplex.len(), self.size, "a simplex of another size");
+        self.vertices.extend_from_slice(simplex);
+    }
+
+    /// Simplex `i`, if there is one.
+    pub fn get(&self, i: usize) -> Option<&[u32]> {
+        self.vertices.get(i * self.size..(i + 1) * self.size)
+    }
+
+    /// The simplices in order.
+    pub fn iter(&self) -> std::slice::ChunksExact<'_, u32> {
+        self.vertices.chunks_exact(self.size)
+    }
+
+    /// The simplices in order, to change their vertices.
+    pub fn iter_mut(&mut self) -> std::slice::ChunksExactMut<'_, u32> {
+        self.vertices.chunks_exact_mut(self.size)
+    }
+
+    /// Every vertex of every simplex, simplex after simplex.
+    pub fn as_flat(&self) -> &[u32] {
+        &self.vertices
+    }
+}
+
+impl std::ops::Index<usize> for Simplices {
+    type Output = [u32];
+    fn index(&self, i: usize) -> &[u32] {
+        &self.vertices[i * self.size..(i + 1) * self.size]
+    }
+}
+
+impl<'a> IntoIterator for &'a Simplices {
+    type Item = &'a [u32];
+    type IntoIter = std::slice::ChunksExact<'a, u32>;
+    fn into_iter(self) -> Self::IntoIter {
+        self.iter()
+    }
+}
+
 /// The result of [`super::detector::Detector::run`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Detection {
@@ -173,8 +256,9 @@ pub struct Detection {
     pub kind: StructureKind,
     /// The simplices of the structures (from the union of the scanned
     /// anisotropic α-shapes): vertex index pairs (k = 1) or triples
-    /// (k = 2), ascending within each, sorted.
-    pub simplices: Vec<Vec<u32>>,
+    /// (k = 2), ascending within each, sorted; flat (a `Vec<u32>` per
+    /// simplex took 4–5 times the memory).
+    pub simplices: Simplices,
     /// The structure of each simplex.
     pub simplex_structure: Vec<u32>,
     /// The structures, largest first.
@@ -229,4 +313,40 @@ pub(crate) fn distinct_count(points: &[[f64; 3]]) -> usize {
     keys.sort_unstable();
     keys.dedup();
     keys.len()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Simplices;
+
+    #[test]
+    fn simplices_are_read_back_as_pushed() {
+        let mut s = Simplices::new(3);
+        assert!(s.is_empty());
+        s.push(&[0, 1, 2]);
+        s.push(&[1, 2, 5]);
+        assert_eq!((s.len(), s.size()), (2, 3));
+        assert_eq!(&s[1], &[1, 2, 5]);
+        assert_eq!(s.get(0), Some(&[0u32, 1, 2][..]));
+        assert_eq!(s.get(2), None);
+        let all: Vec<&[u32]> = s.iter().collect();
+        assert_eq!(all, [&[0, 1, 2][..], &[1, 2, 5][..]]);
+        for t in s.iter_mut() {
+            t[0] += 10;
+        }
+        assert_eq!(s.as_flat(), [10, 1, 2, 11, 2, 5]);
+        assert_eq!(s, Simplices::from_flat(3, vec![10, 1, 2, 11, 2, 5]));
+    }
+
+    #[test]
+    #[should_panic(expected = "a simplex of another size")]
+    fn a_simplex_of_another_size_is_refused() {
+        Simplices::new(2).push(&[0, 1, 2]);
+    }
+
+    #[test]
+    #[should_panic(expected = "not whole simplices")]
+    fn a_flat_list_of_part_of_a_simplex_is_refused() {
+        Simplices::from_flat(3, vec![0, 1]);
+    }
 }

@@ -38,7 +38,7 @@
 
 // The pipeline's types, flat: `aniso_alpha::detect::{Detector, Part, …}`
 // (the main ones also at the crate root).
-pub use detection::{Detection, Part, Primitive, RunStats, Structure};
+pub use detection::{Detection, Part, Primitive, RunStats, Simplices, Structure};
 pub use detector::{DetectError, Detector, Mat3, OrientationSet, LAMBDA_RANGE};
 pub use estimate::{Estimate, Given, GivenNormals, Ladder, ModeScan, Param};
 pub use fit::{LineFit, PlaneFit};

@@ -9,7 +9,7 @@
 //! its first occurrence.
 
 use super::super::cloud::Cloud;
-use super::super::detection::{Detection, Part, RunStats, Structure};
+use super::super::detection::{Detection, Part, RunStats, Simplices, Structure};
 use super::super::StructureKind;
 use super::claims::Claims;
 use super::shape::{crosses, PartShape};
@@ -173,13 +173,13 @@ fn simplices<S: Shape>(
     kept: &[S],
     vstruct: &[u32],
     vpart: &[u32],
-) -> (Vec<Vec<u32>>, Vec<u32>) {
+) -> (Simplices, Vec<u32>) {
     let part_index: Vec<(u32, u32)> = structures
         .iter()
         .enumerate()
         .flat_map(|(s, st)| (0..st.parts.len() as u32).map(move |p| (s as u32, p)))
         .collect();
-    let mut simplices: Vec<Vec<u32>> = Vec::new();
+    let mut simplices = Simplices::new(S::K + 1);
     let mut simplex_structure: Vec<u32> = Vec::new();
     for s in kept {
         let vs = s.as_ref();
@@ -196,7 +196,7 @@ fn simplices<S: Shape>(
                 .push(idx);
         }
         structures[st as usize].simplices.push(idx);
-        simplices.push(vs.to_vec());
+        simplices.push(vs);
         simplex_structure.push(st);
     }
     (simplices, simplex_structure)
@@ -260,7 +260,7 @@ mod tests {
         // and not across structures.
         assert_eq!(
             det.simplices,
-            [vec![0, 1], vec![9, 10], vec![10, 11], vec![17, 18]]
+            Simplices::from_flat(2, vec![0, 1, 9, 10, 10, 11, 17, 18])
         );
         assert_eq!(det.simplex_structure, [0, 0, 0, 1]);
         assert_eq!(poly.simplices, [0, 1, 2]);

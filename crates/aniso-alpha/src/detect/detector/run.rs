@@ -506,7 +506,7 @@ fn on_distinct(ids: &[u32], at: &[u32]) -> Vec<u32> {
 fn expand_distinct(mut det: Detection, copies: Copies) -> Detection {
     let distinct = copies.distinct();
     let to_input = |v: &mut u32| *v = distinct[*v as usize];
-    for s in &mut det.simplices {
+    for s in det.simplices.iter_mut() {
         s.iter_mut().for_each(to_input);
     }
     for st in &mut det.structures {
