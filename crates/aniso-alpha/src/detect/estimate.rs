@@ -848,20 +848,26 @@ fn concentrated_modes(
     let mut candidates: Vec<([f64; 3], f64)> = axes.iter().map(|&a| (a, -1.0)).collect();
     let mut kept: Vec<Mode> = Vec::new();
     for m in found {
-        let concentrated = |count: usize| m.support as f64 >= MODE_CONCENTRATION * count as f64;
-        let in_cone = all
-            .iter()
-            .filter(|&&a| dot(a, m.axis).abs() >= cos_cone)
-            .count();
-        let keep = concentrated(in_cone) || {
-            let members = candidates
+        // Concentrated over a count when the support is at least
+        // MODE_CONCENTRATION of it: the count is at most `most`, so each
+        // count stops once past it.
+        let most = (m.support as f64 / MODE_CONCENTRATION).floor() as usize;
+        let at_most = |hits: &mut dyn Iterator<Item = ()>| hits.take(most + 1).count() <= most;
+        let keep = at_most(
+            &mut all
                 .iter()
-                .filter(|&&(a, limit)| {
-                    let c = dot(a, m.axis).abs();
-                    c >= cos_cone && c >= limit
-                })
-                .count();
-            concentrated(members) && !between_kept(m.axis, &kept)
+                .filter(|&&a| dot(a, m.axis).abs() >= cos_cone)
+                .map(|_| ()),
+        ) || {
+            at_most(
+                &mut candidates
+                    .iter()
+                    .filter(|&&(a, limit)| {
+                        let c = dot(a, m.axis).abs();
+                        c >= cos_cone && c >= limit
+                    })
+                    .map(|_| ()),
+            ) && !between_kept(m.axis, &kept)
         };
         if !keep {
             continue;

@@ -21,6 +21,7 @@ use super::same::absorbed;
 use super::{Candidate, Draft, Footprint, Shape};
 use crate::par::map_ranges;
 use crate::unionfind::UnionFind;
+use std::collections::HashSet;
 
 /// With normals given, a point joins a plane only if |n_p · n| is at least
 /// this: 0.8, an angle of 36.9°. It is the default `normal_threshold` of
@@ -77,12 +78,7 @@ impl Claims {
                 claims
             },
         );
-        let mut claims: Vec<Claim> = Vec::with_capacity(per_cand.iter().map(Vec::len).sum());
-        for c in per_cand {
-            claims.extend(c);
-        }
-        claims.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.cmp(&b.1)));
-        Claims(claims)
+        Claims(by_point_then_candidate(points.len(), per_cand))
     }
 
     /// Claims already sorted by point, then candidate.
@@ -110,22 +106,31 @@ impl Claims {
 
     /// The distinct pairs (a < b) of what `of` maps two candidates claimed
     /// by one point to, sorted; `None` and equal images are left out.
-    /// Every point of a large plane repeats the same few pairs, so the list
-    /// is deduplicated whenever it has doubled: its memory follows the
-    /// distinct pairs, not the claims.
+    /// Every point of a large plane repeats the same few candidates (11
+    /// claims a point on a depth frame, before the merge), so each distinct
+    /// set of images gives its pairs once, and the list is deduplicated
+    /// whenever it has doubled: its memory follows the distinct pairs, not
+    /// the claims.
     pub(super) fn shared(&self, of: impl Fn(u32) -> Option<u32>) -> Vec<(u32, u32)> {
         const FIRST_DEDUP: usize = 1 << 12;
         let mut pairs: Vec<(u32, u32)> = Vec::new();
         let mut dedup_at = FIRST_DEDUP;
+        let mut seen: HashSet<Box<[u32]>> = HashSet::new();
+        let mut set: Vec<u32> = Vec::new();
         for here in self.by_point() {
-            for (k, a) in here.iter().enumerate() {
-                for b in &here[k + 1..] {
-                    if let (Some(x), Some(y)) = (of(a.1), of(b.1)) {
-                        if x != y {
-                            pairs.push((x.min(y), x.max(y)));
-                        }
-                    }
-                }
+            if here.len() < 2 {
+                continue;
+            }
+            set.clear();
+            set.extend(here.iter().filter_map(|c| of(c.1)));
+            set.sort_unstable();
+            set.dedup();
+            if set.len() < 2 || seen.contains(set.as_slice()) {
+                continue;
+            }
+            seen.insert(set.as_slice().into());
+            for (k, &x) in set.iter().enumerate() {
+                pairs.extend(set[k + 1..].iter().map(|&y| (x, y)));
             }
             if pairs.len() >= dedup_at {
                 pairs.sort_unstable();
@@ -151,6 +156,31 @@ impl Claims {
         }
         members
     }
+}
+
+/// The claims of each candidate in turn (`per_cand[c]`: candidate c's,
+/// each point at most once) on `n` points, ordered by point, then
+/// candidate: a counting sort by point, which keeps the candidates' order
+/// within each point.
+fn by_point_then_candidate(n: usize, per_cand: Vec<Vec<Claim>>) -> Vec<Claim> {
+    let mut start = vec![0usize; n + 1];
+    for c in &per_cand {
+        for &(p, _, _) in c {
+            start[p as usize + 1] += 1;
+        }
+    }
+    for i in 0..n {
+        start[i + 1] += start[i];
+    }
+    let mut claims: Vec<Claim> = vec![(0, 0, 0.0); start[n]];
+    for c in per_cand {
+        for claim in c {
+            let at = &mut start[claim.0 as usize];
+            claims[*at] = claim;
+            *at += 1;
+        }
+    }
+    claims
 }
 
 /// Whether point i's given normal lets it join `fit`: true without
@@ -345,6 +375,37 @@ mod tests {
     fn a_point_goes_to_its_nearest_claim() {
         // Point 1: candidates 1 and 2 tie at 0.2, the smaller one wins.
         assert_eq!(claims().resolve(3), [vec![0], vec![1, 3], vec![4]]);
+    }
+
+    #[test]
+    fn the_counting_sort_orders_claims_as_a_sort_does() {
+        // 30 candidates claiming random subsets of 200 points (fixed seed),
+        // each point at most once per candidate, in scrambled order.
+        let mut rng = crate::rng::SplitMix64::new(0xc1a1);
+        let mut per_cand: Vec<Vec<Claim>> = vec![Vec::new(); 30];
+        for (c, v) in (0..).zip(per_cand.iter_mut()) {
+            for p in (0..200u32).rev() {
+                if rng.uniform() < 0.3 {
+                    v.push((p, c, rng.uniform()));
+                }
+            }
+        }
+        let mut want: Vec<Claim> = per_cand.iter().flatten().copied().collect();
+        want.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.cmp(&b.1)));
+        assert_eq!(by_point_then_candidate(200, per_cand), want);
+    }
+
+    #[test]
+    fn points_with_the_same_candidates_give_their_pairs_once() {
+        // Many points claimed by candidates 0, 1 and 2; one by 2 and 3.
+        let mut v: Vec<Claim> = (0..50)
+            .flat_map(|p| (0..3).map(move |c| (p, c, 0.0)))
+            .collect();
+        v.extend([(50, 2, 0.0), (50, 3, 0.0)]);
+        let c = Claims(v);
+        assert_eq!(c.shared(Some), [(0, 1), (0, 2), (1, 2), (2, 3)]);
+        // Mapped: 0 and 1 are one, 3 is none.
+        assert_eq!(c.shared(|x| (x != 3).then_some(x.max(1))), [(1, 2)]);
     }
 
     #[test]
