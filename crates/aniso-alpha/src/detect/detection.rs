@@ -175,7 +175,10 @@ pub struct Simplices {
 }
 
 impl Simplices {
-    /// No simplices, each to have `size` vertices (at least 1).
+    /// No simplices, each to have `size` vertices.
+    ///
+    /// # Panics
+    /// If `size` is 0.
     pub fn new(size: usize) -> Self {
         assert!(size >= 1, "a simplex has at least one vertex");
         Simplices {
@@ -185,7 +188,10 @@ impl Simplices {
     }
 
     /// The simplices of `size` vertices each, laid end to end in
-    /// `vertices` (whose length must be a multiple of `size`).
+    /// `vertices`.
+    ///
+    /// # Panics
+    /// If `size` is 0 or the length of `vertices` is not a multiple of it.
     pub fn from_flat(size: usize, vertices: Vec<u32>) -> Self {
         assert!(size >= 1, "a simplex has at least one vertex");
         assert_eq!(vertices.len() % size, 0, "not whole simplices");
@@ -207,7 +213,10 @@ impl Simplices {
         self.vertices.is_empty()
     }
 
-    /// Appends a simplex of [`Self::size`] vertices.
+    /// Appends a simplex.
+    ///
+    /// # Panics
+    /// If it does not have [`Self::size`] vertices.
     pub fn push(&mut self, simplex: &[u32]) {
         assert_eq!(simplex.len(), self.size, "a simplex of another size");
         self.vertices.extend_from_slice(simplex);
