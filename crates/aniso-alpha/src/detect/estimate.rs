@@ -94,7 +94,7 @@ use super::modes::{modes, Mode};
 use super::StructureKind;
 use crate::aniso::{completion_first_row, completion_third_row, Mat3};
 use crate::geometry::kdtree::KdTree;
-use crate::geometry::{cross, dot, normalize, sub};
+use crate::geometry::{cross, dot, normalize, scale, sub};
 
 /// Score (planarity or linearity) from which a point is structure-like: the
 /// midpoint of the features' range [0, 1].
@@ -850,25 +850,15 @@ fn concentrated_modes(
     for m in found {
         // Concentrated over a count when the support is at least
         // MODE_CONCENTRATION of it: the count is at most `most`, so each
-        // count stops once past it.
+        // count stops at the hit past it.
         let most = (m.support as f64 / MODE_CONCENTRATION).floor() as usize;
-        let at_most = |hits: &mut dyn Iterator<Item = ()>| hits.take(most + 1).count() <= most;
-        let keep = at_most(
-            &mut all
-                .iter()
-                .filter(|&&a| dot(a, m.axis).abs() >= cos_cone)
-                .map(|_| ()),
-        ) || {
-            at_most(
-                &mut candidates
-                    .iter()
-                    .filter(|&&(a, limit)| {
-                        let c = dot(a, m.axis).abs();
-                        c >= cos_cone && c >= limit
-                    })
-                    .map(|_| ()),
-            ) && !between_kept(m.axis, &kept)
-        };
+        let mut in_cone = all.iter().filter(|&&a| dot(a, m.axis).abs() >= cos_cone);
+        let mut own = candidates.iter().filter(|&&(a, limit)| {
+            let c = dot(a, m.axis).abs();
+            c >= cos_cone && c >= limit
+        });
+        let keep = in_cone.nth(most).is_none()
+            || (own.nth(most).is_none() && !between_kept(m.axis, &kept));
         if !keep {
             continue;
         }
@@ -886,7 +876,7 @@ fn concentrated_modes(
 /// kept axis is taken on `m`'s side).
 fn between_kept(m: [f64; 3], kept: &[Mode]) -> bool {
     let h = MODE_KERNEL_DEG.to_radians();
-    let toward = |a: [f64; 3]| if dot(a, m) < 0.0 { a.map(|x| -x) } else { a };
+    let toward = |a: [f64; 3]| if dot(a, m) < 0.0 { scale(-1.0, a) } else { a };
     let angle = |u: [f64; 3], v: [f64; 3]| dot(u, v).clamp(-1.0, 1.0).acos();
     kept.iter().enumerate().any(|(i, a)| {
         kept[i + 1..].iter().any(|b| {
@@ -898,11 +888,7 @@ fn between_kept(m: [f64; 3], kept: &[Mode]) -> bool {
             if off_circle.abs() > h.sin() {
                 return false;
             }
-            let Some(p) = normalize([
-                m[0] - off_circle * n[0],
-                m[1] - off_circle * n[1],
-                m[2] - off_circle * n[2],
-            ]) else {
+            let Some(p) = normalize(sub(m, scale(off_circle, n))) else {
                 return false;
             };
             let (ap, pb) = (angle(a, p), angle(p, b));

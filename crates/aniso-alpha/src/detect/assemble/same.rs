@@ -56,11 +56,22 @@ pub(super) fn same_primitive(a: Piece, b: Piece, angle_deg: f64, points: &[[f64;
     if a.fit.distance(&centroid(b.fit)) <= a.tau && b.fit.distance(&centroid(a.fit)) <= b.tau {
         return true;
     }
-    let (big, small) = if a.seeds.len() >= b.seeds.len() {
+    let (big, small) = big_and_small(a, b);
+    mostly_within(small, big, points)
+}
+
+/// The piece with more seeds (`a` on a tie), then the other.
+fn big_and_small<'a>(a: Piece<'a>, b: Piece<'a>) -> (Piece<'a>, Piece<'a>) {
+    if a.seeds.len() >= b.seeds.len() {
         (a, b)
     } else {
         (b, a)
-    };
+    }
+}
+
+/// Whether most of `small`'s seeds ([`SAME_SHARE`]) lie within `big`'s
+/// claim radius of `big`'s primitive.
+fn mostly_within(small: Piece, big: Piece, points: &[[f64; 3]]) -> bool {
     let near = small
         .seeds
         .iter()
@@ -76,17 +87,9 @@ pub(super) fn same_primitive(a: Piece, b: Piece, angle_deg: f64, points: &[[f64;
 /// whose own spacing and noise are inflated, as the blended normals along
 /// an edge) on points of a finer one. `Some(true)` when it is `a`.
 pub(super) fn absorbed(a: Piece, b: Piece, points: &[[f64; 3]]) -> Option<bool> {
+    let (big, small) = big_and_small(a, b);
     let a_is_small = a.seeds.len() < b.seeds.len();
-    let (big, small) = if a_is_small { (b, a) } else { (a, b) };
-    if small.tau <= big.tau {
-        return None;
-    }
-    let near = small
-        .seeds
-        .iter()
-        .filter(|&&v| big.fit.distance(&points[v as usize]) <= big.tau)
-        .count();
-    (near as f64 >= SAME_SHARE * small.seeds.len() as f64).then_some(a_is_small)
+    (small.tau > big.tau && mostly_within(small, big, points)).then_some(a_is_small)
 }
 
 /// Whether two pieces of a noisy line are one line: the line fitted to
