@@ -2,10 +2,11 @@
 //! doc §4, §7, §8).
 
 use std::path::PathBuf;
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use aniso_alpha::detect::StructureKind;
-use aniso_alpha::detect::{DetectError, Detection, Detector, OrientationSet, Primitive};
+use aniso_alpha::detect::{DetectError, Detection, Detector, OrientationSet, Primitive, Stage};
 use aniso_alpha::eval::{evaluate, Evaluation};
 use aniso_alpha::io::{self, write_scene, Mesh, PointCloud, ReadOptions};
 use aniso_alpha::options::{
@@ -107,6 +108,15 @@ pub struct DetectArgs {
     /// memory, the same result
     #[arg(long, allow_negative_numbers = true, value_name = "SIZE", value_parser = parse_positive)]
     pub tile: Option<f64>,
+    /// Detect region by region: square columns of this side in x-y
+    /// (input units), each with its own parameters from its points and a
+    /// margin for its ellipsoids' reach, parts joined across borders;
+    /// memory bounded by one region's run. 'auto' (the default unless an
+    /// output needs a whole run: --html, --png, --union, .obj): regions of
+    /// about 500,000 points, a whole run up to 1,000,000 points. 'off': one
+    /// whole run
+    #[arg(long, value_name = "SIDE|auto|off", value_parser = crate::cmd_regions::parse_regions, requires = "input")]
+    pub regions: Option<crate::cmd_regions::Regions>,
     /// Write one label per input point: its structure id (a polyhedral
     /// surface is one structure), or -1
     #[arg(long, allow_negative_numbers = true, value_name = "OUT.txt")]
@@ -243,6 +253,7 @@ impl OutputPaths {
             None => false,
         };
         check_classify(args, labelled_output)?;
+        crate::cmd_regions::check_outputs(args.regions, &paths.whole_outputs(args))?;
         if let Some(out) = &args.union {
             common::mesh_format(out)?;
         }
@@ -264,6 +275,18 @@ impl OutputPaths {
             labelled_output,
             ..paths
         })
+    }
+
+    /// The outputs asked for that need a whole run (the views, the union,
+    /// meshes alone), by flag; the built-in example writes a view.
+    fn whole_outputs(&self, args: &DetectArgs) -> Vec<&'static str> {
+        let mesh_output = self.output.is_some() && !self.labelled_output;
+        let mut w =
+            crate::cmd_regions::whole_outputs(&self.html, &args.png, &args.union, mesh_output);
+        if self.scene.is_some() {
+            w.push("the built-in example");
+        }
+        w
     }
 }
 
@@ -387,9 +410,29 @@ fn detect_points(
             true
         }
     };
+    let stages = Arc::new(Mutex::new(Vec::new()));
+    let observe = {
+        let stages = stages.clone();
+        move |stage: Stage, secs: f64| {
+            if let Ok(mut s) = stages.lock() {
+                s.push((stage, secs));
+            }
+        }
+    };
     let det = timings
-        .phase("detect", || detector.clone().progress(tick).run(points))
+        .phase("detect", || {
+            detector
+                .clone()
+                .progress(tick)
+                .on_stage(observe)
+                .run(points)
+        })
         .map_err(in_file)?;
+    if let Ok(stages) = stages.lock() {
+        for &(stage, secs) in stages.iter() {
+            timings.add_stage(stage.name(), secs);
+        }
+    }
     let seconds = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
     Ok((detector, det, seconds))
@@ -560,6 +603,28 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
         (n, _) => n,
     };
     let keep = keep.as_deref();
+    let whole = !paths.whole_outputs(args).is_empty();
+    if let Some(side) = crate::cmd_regions::side(args.regions, whole, points) {
+        let out = crate::cmd_regions::RegionOutputs {
+            labels: paths.labels.as_ref(),
+            parts: paths.parts.as_ref(),
+            output: paths.output.as_ref(),
+            classify: args.classify.map(|c| c.class),
+            report: paths.report.as_ref(),
+        };
+        let options = options(args, example);
+        return crate::cmd_regions::run(
+            &name,
+            &cloud,
+            points,
+            normals.as_deref(),
+            keep,
+            &options,
+            side,
+            &out,
+            timings,
+        );
+    }
     let n_input = cloud.points.len();
     let (detector, det, seconds) =
         detect_points(args, points, normals.as_deref(), example, timings)?;
@@ -597,7 +662,7 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
     common::print_summary(&out)
 }
 
-fn write_ints(w: &mut dyn std::io::Write, values: &[i64]) -> std::io::Result<()> {
+pub(crate) fn write_ints(w: &mut dyn std::io::Write, values: &[i64]) -> std::io::Result<()> {
     let mut s = String::with_capacity(values.len() * 3);
     for v in values {
         s.push_str(&v.to_string());

@@ -168,11 +168,14 @@ pub fn spinner(msg: &str) -> ProgressBar {
 // ---------------------------------------------------------------- timings
 
 /// Wall time per phase, for `--timings`: one JSON object on stderr,
-/// e.g. `{"read":0.012,"triangulate":1.5,"write":0.2,"total":1.72}`.
+/// e.g. `{"read":0.012,"triangulate":1.5,"write":0.2,"total":1.72}`;
+/// `detect` adds the stages of its detection phase as an object under
+/// `stages` (`{"scan":0.4,"union":0.05,...}`, parts of `detect`).
 #[derive(Debug)]
 pub struct Timings {
     start: Instant,
     phases: Vec<(&'static str, f64)>,
+    stages: Vec<(&'static str, f64)>,
 }
 
 impl Default for Timings {
@@ -187,6 +190,7 @@ impl Timings {
         Timings {
             start: Instant::now(),
             phases: Vec::new(),
+            stages: Vec::new(),
         }
     }
 
@@ -200,10 +204,13 @@ impl Timings {
 
     /// Adds `seconds` to phase `name`.
     pub fn add(&mut self, name: &'static str, seconds: f64) {
-        match self.phases.iter_mut().find(|(n, _)| *n == name) {
-            Some((_, s)) => *s += seconds,
-            None => self.phases.push((name, seconds)),
-        }
+        add_to(&mut self.phases, name, seconds);
+    }
+
+    /// Adds `seconds` to stage `name` of a phase (reported under
+    /// `stages`, not counted as a phase of its own).
+    pub fn add_stage(&mut self, name: &'static str, seconds: f64) {
+        add_to(&mut self.stages, name, seconds);
     }
 
     /// The JSON object: phases in the order first seen, then `total`.
@@ -217,11 +224,27 @@ impl Timings {
         for (name, s) in &self.phases {
             map.insert((*name).to_string(), round_json(*s));
         }
+        if !self.stages.is_empty() {
+            let stages: serde_json::Map<String, serde_json::Value> = self
+                .stages
+                .iter()
+                .map(|(n, s)| ((*n).to_string(), round_json(*s)))
+                .collect();
+            map.insert("stages".to_string(), serde_json::Value::Object(stages));
+        }
         map.insert(
             "total".to_string(),
             round_json(self.start.elapsed().as_secs_f64()),
         );
         serde_json::Value::Object(map)
+    }
+}
+
+/// Adds `seconds` to the entry `name` of `list`, or appends it.
+fn add_to(list: &mut Vec<(&'static str, f64)>, name: &'static str, seconds: f64) {
+    match list.iter_mut().find(|(n, _)| *n == name) {
+        Some((_, s)) => *s += seconds,
+        None => list.push((name, seconds)),
     }
 }
 

@@ -9,6 +9,7 @@ mod cmd_alpha;
 mod cmd_delaunay;
 mod cmd_detect;
 mod cmd_eval;
+mod cmd_regions;
 mod cmd_synth;
 mod cmd_view;
 mod common;

@@ -14,5 +14,7 @@ mod end_to_end;
 mod outputs;
 #[path = "readme.rs"]
 mod readme;
+#[path = "regions.rs"]
+mod regions;
 #[path = "viewer.rs"]
 mod viewer;

@@ -659,3 +659,45 @@ fn detect_ignores_normals_that_disagree_with_the_points() {
     assert!(n["agreement"].as_f64().unwrap() < 0.5);
     assert!(String::from_utf8_lossy(&o.stdout).contains("normals: the input's were ignored"));
 }
+
+#[test]
+fn detect_timings_name_every_stage_of_the_run_within_the_detect_phase() {
+    // CGAL's ball scan, automatic mode: the stages a run meets, each
+    // timed once (no ladder), add up to no more than the detect phase.
+    let ball =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../aniso-alpha/tests/fixtures/real/ball.ply");
+    let o = ok(&[
+        "detect",
+        ball.to_str().unwrap(),
+        "--structure",
+        "planes",
+        "--quiet",
+        "--timings",
+    ]);
+    let t: serde_json::Value =
+        serde_json::from_str(String::from_utf8_lossy(&o.stderr).trim()).unwrap();
+    let stages = t["stages"].as_object().expect("a stages object");
+    for key in [
+        "scan",
+        "union",
+        "candidates",
+        "widen",
+        "claims",
+        "significance",
+        "merge",
+        "proportions",
+        "structures",
+    ] {
+        let s = stages[key].as_f64().unwrap_or(-1.0);
+        assert!(s >= 0.0, "{key}: {t}");
+    }
+    // No scale ladder on this scan: no selection across levels.
+    assert!(stages.get("select").is_none(), "{t}");
+    let sum: f64 = stages.values().map(|v| v.as_f64().unwrap()).sum();
+    let detect = t["detect"].as_f64().unwrap();
+    assert!(sum <= detect + 1e-3, "stages {sum} > detect {detect}: {t}");
+    assert!(
+        sum >= 0.5 * detect,
+        "stages {sum} cover little of detect {detect}: {t}"
+    );
+}

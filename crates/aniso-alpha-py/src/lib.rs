@@ -13,6 +13,7 @@ mod convert;
 mod errors;
 mod options;
 mod progress;
+mod regions;
 mod report;
 mod run;
 mod split;
@@ -352,6 +353,8 @@ fn _panic(py: Python<'_>, on_worker: bool) -> PyResult<()> {
 /// The Rust side of `aniso_alpha` (private: use the package's functions).
 #[pymodule(name = "_native")]
 mod native {
+    #[pymodule_export]
+    use super::regions::detect_regions;
     #[pymodule_export]
     use super::split::{plan, tile_step, PyPlan};
     #[pymodule_export]

@@ -113,7 +113,9 @@ fn one_position_repeated() {
     for kind in [StructureKind::Planes, StructureKind::Lines] {
         // No spacing to estimate from: an error saying so, not NaN.
         match Detector::auto(kind, &pts, &Given::default()) {
-            Err(DetectError::BadParameter(m)) => assert!(m.contains("no spacing"), "{m}"),
+            Err(e @ DetectError::NoSpacing) => {
+                assert!(e.to_string().contains("no spacing"), "{e}")
+            }
             other => panic!("{:?}", other.map(|d| d.alpha())),
         }
     }

@@ -10,7 +10,8 @@ even on degenerate input. Points in and results out are numpy arrays.
 (48, 4)
 
 Functions: :func:`detect` (the CLI's ``detect``, the same options and
-labels), :func:`read` (a :class:`Cloud`: points, normals, attributes),
+labels), :func:`detect_regions` (region by region, for clouds of millions
+of points: the CLI's default above 1,000,000), :func:`read` (a :class:`Cloud`: points, normals, attributes),
 :func:`write` (the labelled cloud, as ``detect --output``),
 :func:`labelled_array` (PDAL's structured arrays), :func:`delaunay`,
 :func:`alpha_intervals`. :func:`detect` takes a :class:`Cloud`, PDAL's
@@ -26,10 +27,18 @@ the ``distributed`` extra) runs :func:`detect` tile by tile on a Dask
 cluster, with the same result.
 """
 
-from ._api import AlphaIntervals, Sampler, Structure, alpha_intervals, delaunay, detect
+from ._api import (
+    AlphaIntervals,
+    Sampler,
+    Structure,
+    alpha_intervals,
+    delaunay,
+    detect,
+    detect_regions,
+)
 from ._io import AnisoAlphaWarning, Cloud, labelled_array, read, write
 from ._native import __version__
-from ._results import Detection, Plane, Segment
+from ._results import Detection, Plane, RegionDetection, RegionPart, Segment
 
 __all__ = [
     "AlphaIntervals",
@@ -37,6 +46,8 @@ __all__ = [
     "Cloud",
     "Detection",
     "Plane",
+    "RegionDetection",
+    "RegionPart",
     "Sampler",
     "Segment",
     "Structure",
@@ -44,6 +55,7 @@ __all__ = [
     "alpha_intervals",
     "delaunay",
     "detect",
+    "detect_regions",
     "labelled_array",
     "read",
     "write",

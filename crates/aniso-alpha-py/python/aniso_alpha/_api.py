@@ -12,7 +12,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _native
 from ._io import _warn, source_points
-from ._results import Detection
+from ._results import Detection, RegionDetection, RegionPart
 
 __all__ = ["AlphaIntervals", "Sampler", "Structure", "alpha_intervals", "delaunay", "detect"]
 
@@ -330,3 +330,90 @@ def detect(
     _warn(messages)
     r = json.loads(report)
     return Detection(labels, part_labels, r["structures"], r["parameters"], list(messages), native)
+
+
+def detect_regions(
+    points: Any,
+    structure: Structure,
+    *,
+    side: Optional[float] = None,
+    alpha: Optional[float] = None,
+    lambda2: Optional[float] = None,
+    lambda3: Optional[float] = None,
+    min_size: Optional[int] = None,
+    sampler: Optional[Sampler] = None,
+    m1: float = 0.3,
+    m2: int = 12,
+    step: float = 10.0,
+    epsilon: Optional[float] = 1.0,
+    normals: Optional[ArrayLike] = None,
+    ignore_normals: bool = False,
+    threads: Optional[int] = None,
+    progress: Optional[Callable[[int, int], Optional[bool]]] = None,
+) -> RegionDetection:
+    """:func:`detect` region by region, for clouds of millions of points
+    (what ``aniso-alpha detect`` does by default above 1,000,000 points,
+    docs/method.md §8 "Regions"): the x-y extent is cut into square
+    regions, each detected on its points and a margin with its own
+    parameters from its data, and the parts that cross a border are joined
+    through the points both regions labelled. The peak memory is one
+    region's run, not the whole cloud's.
+
+    Args:
+        points: as for :func:`detect`.
+        structure: ``"lines"`` or ``"planes"``.
+        side: the region side (input units); default: regions of about
+            500,000 points, and one whole run for a cloud of up to
+            1,000,000 points (``--regions``).
+        alpha, lambda2, lambda3, min_size, sampler, m1, m2, step, epsilon,
+            normals, ignore_normals, threads: as for :func:`detect`, for
+            every region.
+        progress: called as ``progress(done, total)`` after each region;
+            ``False`` cancels (``RuntimeError``).
+
+    Returns:
+        a :class:`RegionDetection`: per-point ``labels`` and
+        ``part_labels``, the joined ``parts`` (plane equations or line
+        directions), the ``side`` used and the counts of regions,
+        widened margins and joins.
+
+    Two regions of 30 units across a plane of 60 x 30 points give one part:
+
+    >>> import numpy as np, aniso_alpha as aa
+    >>> x, y = (a.ravel() for a in np.meshgrid(np.arange(60.0), np.arange(30.0)))
+    >>> sheet = np.c_[x, y, np.random.default_rng(2).normal(0, 0.01, x.size)]
+    >>> r = aa.detect_regions(sheet, "planes", side=30.0)
+    >>> r.regions, len(r.parts), r.parts[0].pieces, r.parts[0].points > 1600
+    (2, 1, 2, True)
+    """
+    pts, nrm = detect_input(points, normals, ignore_normals)
+    options = detect_options(
+        alpha=alpha,
+        lambda2=lambda2,
+        lambda3=lambda3,
+        min_size=min_size,
+        sampler=sampler,
+        m1=m1,
+        m2=m2,
+        step=step,
+        epsilon=epsilon,
+    )
+    labels, part_labels, rows, used, regions, widened, joins, skipped = _native.detect_regions(
+        pts, structure, side, options, threads, nrm, progress
+    )
+    parts = []
+    for pid, st, n, pieces, a, b, rms in rows:
+        line = structure == "lines"
+        parts.append(
+            RegionPart(
+                id=pid,
+                structure=st,
+                points=n,
+                pieces=pieces,
+                equation=None if line or not a else np.asarray(a, dtype=np.float64),
+                direction=np.asarray(a, dtype=np.float64) if line and a else None,
+                point=np.asarray(b, dtype=np.float64) if line and b else None,
+                rms=rms,
+            )
+        )
+    return RegionDetection(labels, part_labels, parts, used, regions, widened, joins, skipped)

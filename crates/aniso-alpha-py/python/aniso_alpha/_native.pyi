@@ -41,6 +41,19 @@ def detect(
     """(labels, part_labels, JSON text of {"structures": [...], "parameters": {...}},
     warnings, the detection)."""
 
+_PartRow = Tuple[int, int, int, int, List[float], List[float], float]
+
+def detect_regions(
+    points: Any,
+    structure: str,
+    side: Optional[float] = None,
+    options: Optional[Dict[str, Any]] = None,
+    threads: Optional[int] = None,
+    normals: Optional[ArrayLike] = None,
+    progress: Optional[Callable[[int, int], Optional[bool]]] = None,
+) -> Tuple[NDArray[np.int64], NDArray[np.int64], List[_PartRow], Optional[float], int, int, int, int]:
+    """(labels, part_labels, parts, side used, regions, widened, joins, skipped)."""
+
 class Plan:
     """A split detection run (aniso_alpha.distributed); made by `plan`."""
 

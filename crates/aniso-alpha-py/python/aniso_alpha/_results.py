@@ -10,7 +10,7 @@ from typing import Any, Dict, List, Optional
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["Detection", "Plane", "Segment"]
+__all__ = ["Detection", "Plane", "RegionDetection", "RegionPart", "Segment"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -198,3 +198,58 @@ class Detection:
             f"{'plane' if self.kind == 'planes' else 'segment'}(s), "
             f"{len(self.labels)} points of which {background} background)"
         )
+
+
+@dataclass(frozen=True, eq=False)
+class RegionPart:
+    """One part of a region-by-region detection, joined across regions.
+
+    Attributes:
+        id: its id in ``RegionDetection.part_labels`` (0 = most points).
+        structure: the id of its structure in ``RegionDetection.labels``.
+        points: its number of points.
+        pieces: how many regions' parts it joins.
+        equation: a plane's float64 ``[a, b, c, d]`` (unit normal), least
+            squares on its points; ``None`` for a line.
+        direction: a line's float64 unit direction; ``None`` for a plane.
+        point: a line's float64 point (its points' centroid); ``None`` for
+            a plane.
+        rms: root mean square distance of its points to the primitive.
+    """
+
+    id: int
+    structure: int
+    points: int
+    pieces: int
+    equation: Optional[NDArray[np.float64]]
+    direction: Optional[NDArray[np.float64]]
+    point: Optional[NDArray[np.float64]]
+    rms: float
+
+
+@dataclass(frozen=True, eq=False)
+class RegionDetection:
+    """What :func:`aniso_alpha.detect_regions` returns.
+
+    Attributes:
+        labels: int64 (n,): each point's structure id, or -1.
+        part_labels: int64 (n,): each point's part id, or -1.
+        parts: the joined parts, by id (:class:`RegionPart`).
+        side: the region side used (input units); ``None`` when the cloud
+            is about one region and ran whole.
+        regions: the number of regions with points.
+        widened: region estimates run again with a wider margin (their
+            ellipsoids reached past the first one).
+        joins: region parts joined across borders.
+        skipped: regions whose points are all at one position (no spacing
+            to estimate from), left as background.
+    """
+
+    labels: NDArray[np.int64]
+    part_labels: NDArray[np.int64]
+    parts: List[RegionPart] = field(default_factory=list)
+    side: Optional[float] = None
+    regions: int = 1
+    widened: int = 0
+    joins: int = 0
+    skipped: int = 0

@@ -44,6 +44,7 @@ pub use estimate::{Estimate, Given, GivenNormals, Ladder, ModeScan, Param};
 pub use fit::{LineFit, PlaneFit};
 pub use orientations::{OrientationError, Sampler, MAX_ORIENTATIONS};
 pub use split::{Members, Plan, SplitJob, Step, Tile, TileOutput};
+pub use stages::Stage;
 
 mod assemble;
 mod cloud;
@@ -60,9 +61,11 @@ mod outline;
 pub mod parts;
 mod prune;
 mod regime;
+pub mod regions;
 mod scan;
 pub mod significance;
 mod split;
+mod stages;
 
 /// Which structures are sought: k = 1 (lines, edges) or k = 2 (planes,
 /// triangles).

@@ -245,6 +245,7 @@ mod tests {
                     cell: 3.0,
                 },
             ],
+            clock: Default::default(),
         };
         let regime = Regime::new(StructureKind::Lines, None, false, None);
         let cands = find(&pts, &edges, &group, &settings, &regime).unwrap();

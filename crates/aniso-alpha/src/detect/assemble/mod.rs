@@ -57,6 +57,7 @@ use super::cloud::Cloud;
 use super::detection::{Detection, Primitive, RunStats};
 use super::filter::FilterError;
 use super::regime::Regime;
+use super::stages::{Clock, Stage};
 use footprint::Footprint;
 
 /// The scale of the candidates found by one group (mode) of orientations.
@@ -77,6 +78,8 @@ pub(crate) struct Settings {
     pub min_vertices: usize,
     /// The scale of each group.
     pub scales: Vec<Scale>,
+    /// Times the stages for the detector's observer.
+    pub clock: Clock,
 }
 
 /// A candidate part while it is assembled.
@@ -190,23 +193,32 @@ pub(crate) fn level<S: Shape>(
 ) -> Result<Level<S>, FilterError> {
     let points = cloud.points();
     let angle = settings.part_angle_deg;
+    let clock = &settings.clock;
     // 1–2. Candidates and their footprints.
-    let mut cands = candidates::find(points, &kept, &group, settings, regime)?;
+    let mut cands = clock.time(Stage::Candidates, || {
+        candidates::find(points, &kept, &group, settings, regime)
+    })?;
     // 3. Members: claim radii from the noise, claims, merging of
     // duplicates, resolution, refit, claims again.
     if regime.widens_claims() {
-        widen::claim_radii::<S>(&mut cands, cloud);
+        clock.time(Stage::Widen, || widen::claim_radii::<S>(&mut cands, cloud));
     }
-    let (cands, claims) = claims::settle::<S>(cands, cloud, regime.claim_normals(), angle);
-    let mut parts = claims::parts::<S>(&claims, cands.len(), points, settings.min_vertices);
-    // 4. Significance.
-    if let Some(log10_epsilon) = regime.significance() {
-        stats.rejected_parts += significance::reject::<S>(&mut parts, &cands, cloud, log10_epsilon);
-    }
-    // 4b. Lines inside a surface.
-    if regime.drops_lines_inside_surfaces() {
-        stats.surface_lines += S::reject_in_surface(&mut parts, &cands, cloud);
-    }
+    let (cands, claims, mut parts) = clock.time(Stage::Claims, || {
+        let (cands, claims) = claims::settle::<S>(cands, cloud, regime.claim_normals(), angle);
+        let parts = claims::parts::<S>(&claims, cands.len(), points, settings.min_vertices);
+        (cands, claims, parts)
+    });
+    clock.time(Stage::Significance, || {
+        // 4. Significance.
+        if let Some(log10_epsilon) = regime.significance() {
+            stats.rejected_parts +=
+                significance::reject::<S>(&mut parts, &cands, cloud, log10_epsilon);
+        }
+        // 4b. Lines inside a surface.
+        if regime.drops_lines_inside_surfaces() {
+            stats.surface_lines += S::reject_in_surface(&mut parts, &cands, cloud);
+        }
+    });
     Ok(Level {
         cands,
         claims,
@@ -233,14 +245,23 @@ pub(crate) fn finish<S: Shape>(
     } = if levels.len() == 1 {
         levels.pop().expect("one level")
     } else {
-        select::across_levels::<S>(levels, cloud, regime, settings.min_vertices)
+        settings.clock.time(Stage::Select, || {
+            select::across_levels::<S>(levels, cloud, regime, settings.min_vertices)
+        })
     };
+    let clock = &settings.clock;
     // 5. One primitive, one part.
-    S::merge_apart(&mut parts, &cands, cloud.points(), settings.part_angle_deg);
+    clock.time(Stage::Merge, || {
+        S::merge_apart(&mut parts, &cands, cloud.points(), settings.part_angle_deg)
+    });
     // 5b. Proportions at the ellipsoid's scale.
     if regime.checks_proportions() {
-        stats.out_of_proportion += proportions::reject(&mut parts, &cands, cloud.points());
+        stats.out_of_proportion += clock.time(Stage::Proportions, || {
+            proportions::reject(&mut parts, &cands, cloud.points())
+        });
     }
     // 6. Structures, outlines, labels.
-    structures::detection::<S>(cloud, regime.kind(), &parts, &cands, &claims, &kept, stats)
+    clock.time(Stage::Structures, || {
+        structures::detection::<S>(cloud, regime.kind(), &parts, &cands, &claims, &kept, stats)
+    })
 }

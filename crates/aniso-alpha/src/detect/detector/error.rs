@@ -13,6 +13,9 @@ pub enum DetectError {
     BadParameter(String),
     /// The input holds no point.
     Empty,
+    /// Every point is at one position: no spacing to estimate α and λ
+    /// from (give them).
+    NoSpacing,
     /// A coordinate is NaN or infinite.
     NonFinite {
         /// Index of the point.
@@ -40,6 +43,11 @@ impl fmt::Display for DetectError {
         match self {
             DetectError::BadParameter(m) => write!(f, "bad parameter: {m}"),
             DetectError::Empty => write!(f, "no points"),
+            DetectError::NoSpacing => write!(
+                f,
+                "bad parameter: no spacing to estimate alpha and lambda from (every point is at \
+                 one position): give alpha, lambda3 and min-size"
+            ),
             DetectError::NonFinite { index } => {
                 write!(f, "point {index} has a non-finite coordinate")
             }

@@ -46,6 +46,7 @@ use super::estimate::{check_normals_agreement, estimate, estimate_oriented, mode
 use super::estimate::{Estimate, Given, GivenNormals, Ladder, ModeScan};
 use super::orientations::{orientations, Sampler};
 use super::regime::Regime;
+use super::stages::{Clock, Stage};
 pub use super::StructureKind;
 use std::fmt;
 use std::sync::Arc;
@@ -93,6 +94,7 @@ pub struct Detector {
     given_normals: Option<GivenNormals>,
     ladder: Option<Ladder>,
     progress: Option<Progress>,
+    stages: Clock,
 }
 
 /// Normals given with the points, unit length (zero where a point's
@@ -156,6 +158,7 @@ impl Detector {
             given_normals: None,
             ladder: None,
             progress: None,
+            stages: Clock::default(),
         }
     }
 
@@ -247,11 +250,7 @@ impl Detector {
             .iter()
             .all(|v| v.is_finite())
         {
-            return Err(DetectError::BadParameter(
-                "no spacing to estimate alpha and lambda from (every point is at one \
-                 position): give alpha, lambda3 and min-size"
-                    .into(),
-            ));
+            return Err(DetectError::NoSpacing);
         }
         let mut d = match kind {
             StructureKind::Lines => {
@@ -369,6 +368,11 @@ impl Detector {
         self
     }
 
+    /// The angle tolerance (degrees) of the straight/flat parts.
+    pub fn part_angle_degrees(&self) -> f64 {
+        self.part_angle_deg
+    }
+
     /// The significance test's ε (default 1: keep parts with at most one
     /// expected false alarm), or `None` to keep every part (the paper's
     /// behaviour, nb_c alone).
@@ -397,6 +401,15 @@ impl Detector {
     /// from worker threads, and shared by the detector's clones.
     pub fn progress(mut self, f: impl Fn(usize, usize) -> bool + Send + Sync + 'static) -> Self {
         self.progress = Some(Arc::new(f));
+        self
+    }
+
+    /// A callback called after each stage of the run ([`Stage`]) with its
+    /// wall seconds (a scale ladder runs the per-level stages once per
+    /// level). It is called from the thread that runs the detection, and
+    /// shared by the detector's clones; it does not change the result.
+    pub fn on_stage(mut self, f: impl Fn(Stage, f64) + Send + Sync + 'static) -> Self {
+        self.stages = Clock::new(Some(Arc::new(f)));
         self
     }
 

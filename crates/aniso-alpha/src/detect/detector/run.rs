@@ -16,6 +16,7 @@ use crate::detect::scan::{
     raw_faces, run_job, run_job_at, union, ChanceScale, Face, Job, JobResult, Pruning, ScanFilter,
     RADIUS_SLACK,
 };
+use crate::detect::stages::Stage;
 use crate::detect::StructureKind;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
@@ -154,13 +155,17 @@ impl Detector {
             }
             Ok(r)
         };
-        #[cfg(feature = "parallel")]
-        let per: Vec<PerJob<S>> = {
-            use rayon::prelude::*;
-            jobs.par_iter().map(one).collect()
-        };
-        #[cfg(not(feature = "parallel"))]
-        let per: Vec<PerJob<S>> = jobs.iter().map(one).collect();
+        let per: Vec<PerJob<S>> = self.stages.time(Stage::Scan, || {
+            #[cfg(feature = "parallel")]
+            {
+                use rayon::prelude::*;
+                jobs.par_iter().map(one).collect()
+            }
+            #[cfg(not(feature = "parallel"))]
+            {
+                jobs.iter().map(one).collect()
+            }
+        });
         if cancelled.load(Ordering::Relaxed) {
             return Err(DetectError::Cancelled);
         }
@@ -350,6 +355,11 @@ impl Detector {
             part_angle_deg: self.part_angle_deg,
             min_vertices: S::min_vertices(self.nb_c),
             scales,
+            clock: self.stages.clone(),
+        };
+        let cleaned_union = |found, sf, stats: &mut RunStats| {
+            self.stages
+                .time(Stage::Union, || cleaned_union(found, sf, stats))
         };
         let Some(ladder) = &self.ladder else {
             let (kept, groups) = cleaned_union(found, sf[0], &mut stats)?;

@@ -1,0 +1,228 @@
+//! `detect --regions`: the detection region by region
+//! (`aniso_alpha::detect::regions`), the default for clouds of more than
+//! 1,000,000 points (`auto`): each region estimates its own parameters
+//! from its points, the parts crossing region borders are joined, and the
+//! peak memory is one region's run. Writes the labels, the labelled cloud
+//! (without meshes) and a report of the joined parts; the views, the
+//! union and the meshes need a whole run (asking for them without
+//! `--regions` runs whole).
+
+use std::path::PathBuf;
+
+use aniso_alpha::detect::regions::{detect_by_regions_with_progress, side_for, RegionRun};
+use aniso_alpha::detect::{DetectError, Primitive};
+use aniso_alpha::io::{self, PointCloud};
+use aniso_alpha::options::{DetectOptions, Style};
+use serde_json::json;
+
+use crate::common::{self, CliError, Timings};
+
+/// `--regions`: a side, `auto` or `off`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Regions {
+    /// Square columns of this side (input units).
+    Side(f64),
+    /// Regions of about `REGION_POINTS` points; none for smaller clouds.
+    Auto,
+    /// One whole run.
+    Off,
+}
+
+/// clap parser for `--regions`: a side > 0, `auto` or `off`.
+pub fn parse_regions(s: &str) -> Result<Regions, String> {
+    match s.trim().to_ascii_lowercase().as_str() {
+        "auto" => Ok(Regions::Auto),
+        "off" => Ok(Regions::Off),
+        _ => common::parse_positive(s)
+            .map(Regions::Side)
+            .map_err(|e| format!("{e}, 'auto' or 'off'")),
+    }
+}
+
+/// The region side of a run on `points`, or `None` for one whole run:
+/// `--regions` as given; without it, `auto` unless an output needs a
+/// whole run (`whole_outputs`).
+pub fn side(regions: Option<Regions>, whole_outputs: bool, points: &[[f64; 3]]) -> Option<f64> {
+    match regions {
+        Some(Regions::Side(s)) => Some(s),
+        Some(Regions::Auto) => side_for(points),
+        Some(Regions::Off) => None,
+        None if whole_outputs => None,
+        None => side_for(points),
+    }
+}
+
+/// The outputs made from a whole run's simplices and meshes that were
+/// asked for, by flag.
+pub fn whole_outputs(
+    html: &Option<PathBuf>,
+    png: &Option<PathBuf>,
+    union: &Option<PathBuf>,
+    mesh_output: bool,
+) -> Vec<&'static str> {
+    [
+        ("--html", html.is_some()),
+        ("--png", png.is_some()),
+        ("--union", union.is_some()),
+        ("an .obj --output", mesh_output),
+    ]
+    .into_iter()
+    .filter_map(|(flag, given)| given.then_some(flag))
+    .collect()
+}
+
+/// `--regions` (a side or `auto`) with an output that needs a whole run is
+/// refused before any work.
+pub fn check_outputs(regions: Option<Regions>, whole: &[&str]) -> Result<(), CliError> {
+    if matches!(regions, Some(Regions::Side(_) | Regions::Auto)) {
+        if let Some(flag) = whole.first() {
+            return Err(CliError::msg(format!(
+                "{flag} needs a whole run: not with --regions (labels, a labelled .las/.laz/.ply \
+                 --output and --report are written region by region; --regions off runs whole)"
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Where a region run writes.
+pub struct RegionOutputs<'a> {
+    /// `--labels`.
+    pub labels: Option<&'a PathBuf>,
+    /// `--part-labels`.
+    pub parts: Option<&'a PathBuf>,
+    /// A labelled `--output` (.las, .laz, .ply).
+    pub output: Option<&'a PathBuf>,
+    /// `--classify`'s class.
+    pub classify: Option<u8>,
+    /// `--report`.
+    pub report: Option<&'a PathBuf>,
+}
+
+/// The region run on `points` (the input's points at `keep`, or all of
+/// them) with `options`, then its outputs and summary.
+#[allow(clippy::too_many_arguments)]
+pub fn run(
+    name: &str,
+    cloud: &PointCloud,
+    points: &[[f64; 3]],
+    normals: Option<&[[f64; 3]]>,
+    keep: Option<&[u32]>,
+    options: &DetectOptions,
+    side: f64,
+    out: &RegionOutputs<'_>,
+    timings: &mut Timings,
+) -> Result<(), CliError> {
+    let bar = common::progress(0, "regions");
+    let start = std::time::Instant::now();
+    let run = timings
+        .phase("regions", || {
+            detect_by_regions_with_progress(
+                points,
+                side,
+                |ids| {
+                    let sub: Vec<[f64; 3]> = ids.iter().map(|&i| points[i as usize]).collect();
+                    let nsub: Option<Vec<[f64; 3]>> =
+                        normals.map(|n| ids.iter().map(|&i| n[i as usize]).collect());
+                    options.build(&sub, nsub.as_deref(), Style::Cli)
+                },
+                &mut |done, total| {
+                    bar.set_length(total as u64);
+                    bar.set_position(done as u64);
+                    true
+                },
+            )
+        })
+        .map_err(|e: DetectError| CliError::msg(e.to_string()))?;
+    let seconds = start.elapsed().as_secs_f64();
+    bar.finish_and_clear();
+    let n = cloud.points.len();
+    let labels = common::spread(&run.labels, keep, n);
+    let part_labels = common::spread(&run.part_labels, keep, n);
+    if let Some(p) = out.labels {
+        common::write_output(p, timings, |w| crate::cmd_detect::write_ints(w, &labels))?;
+    }
+    if let Some(p) = out.parts {
+        common::write_output(p, timings, |w| {
+            crate::cmd_detect::write_ints(w, &part_labels)
+        })?;
+    }
+    if let Some(p) = out.output {
+        let labelled = io::Labelled {
+            classify: out.classify,
+            ..io::Labelled::new(&labels, &part_labels)
+        };
+        common::write_labelled(p, cloud, &labelled, timings)?;
+    }
+    if let Some(p) = out.report {
+        common::write_json(p, &report(name, side, &run, seconds), timings)?;
+    }
+    common::print_summary(&summary(name, points.len(), side, &run, seconds))
+}
+
+/// A joined part's primitive as JSON: a plane's `[a, b, c, d]` or a line's
+/// direction and a point on it.
+fn primitive_json(p: &Primitive) -> serde_json::Value {
+    match p {
+        Primitive::Plane(f) => json!({"plane": p.plane_equation(), "rms": f.rms_residual}),
+        Primitive::Line(f) => {
+            json!({"direction": f.direction, "point": f.centroid, "rms": f.rms_residual})
+        }
+        Primitive::None => json!(null),
+    }
+}
+
+/// The report of a region run.
+fn report(name: &str, side: f64, run: &RegionRun, seconds: f64) -> serde_json::Value {
+    json!({
+        "input": name,
+        "regions": {
+            "side": side, "count": run.regions, "widened": run.widened, "joins": run.joins,
+            "skipped": run.skipped,
+        },
+        "seconds": seconds,
+        "parts": run.parts.iter().map(|p| json!({
+            "id": p.id,
+            "structure": p.structure,
+            "points": p.points,
+            "pieces": p.pieces,
+            "primitive": primitive_json(&p.primitive),
+        })).collect::<Vec<_>>(),
+    })
+}
+
+/// The terminal summary: the regions, then one row per part (at most 40).
+fn summary(name: &str, n: usize, side: f64, run: &RegionRun, seconds: f64) -> String {
+    let mut s = format!(
+        "aniso-alpha detect: {name}\n  {n} points in {} region(s) of side {side} ({} widened for their \
+         ellipsoids' reach{}), each with its own parameters; {} part(s) after {} join(s) across \
+         borders, in {seconds:.2} s\n\n  part  structure    points  pieces  normal / direction\n",
+        run.regions,
+        run.widened,
+        if run.skipped > 0 {
+            format!(
+                "; {} of one position, left as background",
+                run.skipped
+            )
+        } else {
+            String::new()
+        },
+        run.parts.len(),
+        run.joins,
+    );
+    for p in run.parts.iter().take(40) {
+        let dir = match &p.primitive {
+            Primitive::Plane(f) => f.normal,
+            Primitive::Line(f) => f.direction,
+            Primitive::None => [f64::NAN; 3],
+        };
+        s.push_str(&format!(
+            "  {:>4}  {:>9}  {:>8}  {:>6}  [{:.6} {:.6} {:.6}]\n",
+            p.id, p.structure, p.points, p.pieces, dir[0], dir[1], dir[2]
+        ));
+    }
+    if run.parts.len() > 40 {
+        s.push_str(&format!("  ... {} more (--report)\n", run.parts.len() - 40));
+    }
+    s
+}

@@ -1,0 +1,163 @@
+//! `detect --regions`: the detection region by region, its outputs, the
+//! outputs it refuses, and `off`.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+use crate::common;
+use aniso_alpha::rng::SplitMix64;
+use common::TempDir;
+
+const BIN: &str = env!("CARGO_BIN_EXE_aniso-alpha");
+
+fn run(args: &[&str]) -> Output {
+    let o = Command::new(BIN).args(args).output().unwrap();
+    assert!(
+        !String::from_utf8_lossy(&o.stderr).contains("panicked"),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    o
+}
+
+/// A ground of 100 × 100 points, spacing 1, jittered, with a pitched roof
+/// face over 25..55 × 20..35 (across the region border x = 40 of
+/// 40-unit regions), written as x y z.
+fn scene(path: &Path) -> usize {
+    let mut rng = SplitMix64::new(3);
+    let mut s = String::new();
+    let mut n = 0;
+    for iy in 0..100 {
+        for ix in 0..100 {
+            let (x, y) = (
+                ix as f64 + 0.2 * (rng.uniform() - 0.5),
+                iy as f64 + 0.2 * (rng.uniform() - 0.5),
+            );
+            let roof = (25.0..55.0).contains(&x) && (20.0..35.0).contains(&y);
+            let z = if roof { 6.0 + 0.4 * (y - 20.0) } else { 0.0 };
+            s.push_str(&format!("{x} {y} {}\n", z + 0.02 * (rng.uniform() - 0.5)));
+            n += 1;
+        }
+    }
+    std::fs::write(path, s).unwrap();
+    n
+}
+
+fn ints(path: &Path) -> Vec<i64> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .map(|l| l.parse().unwrap())
+        .collect()
+}
+
+#[test]
+fn regions_label_every_point_and_join_the_ground_across_borders() {
+    let d = TempDir::new("regions", "run");
+    let input = d.path("scene.xyz");
+    let n = scene(&input);
+    let (labels, parts, report) = (d.path("l.txt"), d.path("p.txt"), d.path("r.json"));
+    let o = run(&[
+        "detect",
+        input.to_str().unwrap(),
+        "--structure",
+        "planes",
+        "--regions",
+        "40",
+        "--labels",
+        labels.to_str().unwrap(),
+        "--part-labels",
+        parts.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+        "--threads",
+        "1",
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("9 region(s) of side 40"), "{out}");
+    let (l, p) = (ints(&labels), ints(&parts));
+    assert_eq!((l.len(), p.len()), (n, n));
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(r["regions"]["count"], 9);
+    let first = &r["parts"][0];
+    // The ground: one part of nine pieces, nearly every ground point.
+    assert!(first["pieces"].as_u64().unwrap() >= 9, "{first}");
+    let ground = p.iter().filter(|&&x| x == 0).count();
+    assert!(ground as f64 > 0.9 * (n - 450) as f64, "{ground}");
+    assert_eq!(first["points"].as_u64().unwrap() as usize, ground);
+    let plane = first["primitive"]["plane"].as_array().unwrap();
+    assert!(plane[2].as_f64().unwrap().abs() > 0.999, "{first}");
+    // The roof crossing x = 40 is one part too.
+    let roof: Vec<i64> = (0..n)
+        .filter(|&i| {
+            let (x, y) = ((i % 100) as f64, (i / 100) as f64);
+            (27.0..53.0).contains(&x) && (22.0..33.0).contains(&y)
+        })
+        .map(|i| p[i])
+        .collect();
+    let r0 = roof[0];
+    assert!(r0 > 0, "{r0}");
+    let same = roof.iter().filter(|&&x| x == r0).count();
+    assert!(
+        same as f64 > 0.95 * roof.len() as f64,
+        "{same} of {}",
+        roof.len()
+    );
+}
+
+#[test]
+fn regions_refuse_the_outputs_of_a_whole_run_and_off_runs_whole() {
+    let d = TempDir::new("regions", "refuse");
+    let input = d.path("scene.xyz");
+    scene(&input);
+    let html = d.path("v.html");
+    let o = run(&[
+        "detect",
+        input.to_str().unwrap(),
+        "--structure",
+        "planes",
+        "--regions",
+        "40",
+        "--html",
+        html.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("--html needs a whole run"), "{err}");
+    assert!(!html.exists());
+    for bad in ["0", "-3", "nan", "sometimes"] {
+        let o = run(&[
+            "detect",
+            input.to_str().unwrap(),
+            "--structure",
+            "planes",
+            "--regions",
+            bad,
+        ]);
+        assert_eq!(o.status.code(), Some(2), "{bad}");
+    }
+    // `off` and a small cloud under `auto`: the whole run's summary.
+    for mode in ["off", "auto"] {
+        let o = run(&[
+            "detect",
+            input.to_str().unwrap(),
+            "--structure",
+            "planes",
+            "--regions",
+            mode,
+            "--threads",
+            "1",
+        ]);
+        assert_eq!(o.status.code(), Some(0));
+        let out = String::from_utf8_lossy(&o.stdout);
+        assert!(out.contains("structure  part  kind"), "{mode}: {out}");
+        assert!(!out.contains("region(s)"), "{mode}: {out}");
+    }
+}

@@ -1,0 +1,64 @@
+"""detect_regions: the detection region by region (docs/method.md §8
+"Regions"): a plane across regions is one part, a small cloud runs whole
+with detect's labels, progress per region, errors."""
+
+import numpy as np
+import pytest
+
+import aniso_alpha as aa
+
+
+@pytest.fixture(scope="module")
+def ground_and_roof():
+    """A 90 x 60 ground at z = 0, spacing 1, with a pitched roof face over
+    25..55 x 20..35 (across the border x = 30 of 30-unit regions)."""
+    rng = np.random.default_rng(5)
+    x, y = (a.ravel() for a in np.meshgrid(np.arange(90.0), np.arange(60.0)))
+    x = x + rng.uniform(-0.1, 0.1, x.size)
+    y = y + rng.uniform(-0.1, 0.1, y.size)
+    roof = (x >= 25) & (x < 55) & (y >= 20) & (y < 35)
+    z = np.where(roof, 6.0 + 0.4 * (y - 20.0), 0.0) + rng.uniform(-0.01, 0.01, x.size)
+    return np.c_[x, y, z], roof
+
+
+def test_a_plane_across_regions_is_one_part(ground_and_roof):
+    pts, roof = ground_and_roof
+    r = aa.detect_regions(pts, "planes", side=30.0, threads=1)
+    assert isinstance(r, aa.RegionDetection)
+    assert (r.side, r.regions) == (30.0, 6)
+    assert r.labels.shape == r.part_labels.shape == (len(pts),)
+    assert r.joins > 0
+    ground = r.parts[0]
+    assert ground.pieces == 6 and ground.equation is not None and ground.direction is None
+    assert abs(ground.equation[2]) > 0.999
+    assert ground.points == int(np.sum(r.part_labels == 0))
+    assert np.mean(r.part_labels[~roof] == 0) > 0.9
+    inner = roof & (pts[:, 0] > 27) & (pts[:, 0] < 53) & (pts[:, 1] > 22) & (pts[:, 1] < 33)
+    ids, counts = np.unique(r.part_labels[inner], return_counts=True)
+    assert ids[np.argmax(counts)] > 0 and counts.max() > 0.95 * inner.sum()
+    assert [p.id for p in r.parts] == list(range(len(r.parts)))
+
+
+def test_a_small_cloud_runs_whole_with_detects_labels(ground_and_roof):
+    pts, _ = ground_and_roof
+    r = aa.detect_regions(pts, "planes", threads=1)
+    assert (r.side, r.regions, r.joins) == (None, 1, 0)
+    d = aa.detect(pts, "planes", threads=1)
+    np.testing.assert_array_equal(r.part_labels, d.part_labels)
+    np.testing.assert_array_equal(r.labels, d.labels)
+
+
+def test_progress_per_region_and_false_cancels(ground_and_roof):
+    pts, _ = ground_and_roof
+    calls = []
+    aa.detect_regions(pts, "planes", side=45.0, threads=1, progress=lambda d, t: calls.append((d, t)))
+    assert calls == [(1, 4), (2, 4), (3, 4), (4, 4)]
+    with pytest.raises(RuntimeError, match="cancelled"):
+        aa.detect_regions(pts, "planes", side=45.0, threads=1, progress=lambda d, t: False)
+
+
+@pytest.mark.parametrize("side", [0.0, -2.0, float("nan"), float("inf")])
+def test_a_bad_side_is_a_value_error(ground_and_roof, side):
+    pts, _ = ground_and_roof
+    with pytest.raises(ValueError, match="region side"):
+        aa.detect_regions(pts, "planes", side=side)

@@ -1,0 +1,741 @@
+//! A detection region by region, for clouds whose whole run would not fit
+//! in memory (docs/method.md §8, "Regions"): the cloud's x–y extent is cut
+//! into square columns of side `side` (regions); each region is detected
+//! on its own points and a margin around them, with its own parameters
+//! from the data, and the parts that cross a region's border are joined
+//! through the points both regions saw.
+//!
+//! 1. **Regions.** Point i belongs to the column ⌊(x − x₀)/side⌋,
+//!    ⌊(y − y₀)/side⌋ (its *core* region). A region's run takes its core
+//!    points and every point within `margin` of the column (in x and y).
+//! 2. **Margin.** A region's result near its border depends on the points
+//!    within the reach of its ellipsoids: 2α·λ_max, the halo of the tiled
+//!    scan (`detect::split`). The margin starts at side / 16; a region whose
+//!    detector (estimated on its points and margin) reaches farther is
+//!    estimated again with the margin its reach asks for, and the margin
+//!    carries over to the next regions (widenings are counted in
+//!    [`RegionRun::widened`]), so a core point's result always had the
+//!    whole reach around it.
+//! 3. **Labels.** A point's part and structure are those its core region
+//!    gave it. A region whose points are all at one position (a stray
+//!    point far from the rest) has no spacing to estimate from: its points
+//!    are background ([`RegionRun::skipped`]).
+//! 4. **Joining.** A point in region B's margin that lies in region A's
+//!    core was labelled by both: it pairs its part in A with its part in
+//!    B. Two parts are one when most of the labelled points one of them
+//!    has over the other's region lie in the other (the same majority as
+//!    the assembly's same-primitive test, [`SAME_SHARE`]) and their
+//!    planes (directions, for lines) agree within the part angle. Their
+//!    structures join with them.
+//! 5. **Numbering.** Joined parts and structures are numbered by their
+//!    number of points, largest first (ties by first region).
+//!
+//! Memory: the cloud, two labels per point and one region's run at a time
+//! (its triangulations and assembly, which dominate a whole run's peak).
+//! Deterministic: regions run in a fixed order, each on its points in
+//! input order.
+
+use super::detection::{Detection, Primitive};
+use super::scan::halo_width;
+use super::{DetectError, Detector};
+use crate::unionfind::UnionFind;
+use std::collections::{BTreeMap, HashMap};
+
+/// The share of a part's doubly labelled points that must lie in another
+/// part for the two to be joined: a majority, as in the assembly's
+/// same-primitive test.
+pub const SAME_SHARE: f64 = 0.5;
+
+/// The first margin, as a fraction of the side (a region's run is widened
+/// when its reach asks for more).
+pub const FIRST_MARGIN: f64 = 1.0 / 16.0;
+
+/// A margin widened for a detector's reach r becomes r times this (the
+/// next region's estimate may reach a little farther).
+pub const MARGIN_SLACK: f64 = 1.25;
+
+/// Points a region holds with [`side_for`]: a run of this size keeps its
+/// per-point time within 1.2× that of a 40k-point tile and its peak at a
+/// few hundred MiB (BENCHMARKS.md, growth over AHN tiles: 24.5 µs a point
+/// and 284 MiB at 697k points against 21.0 µs at 43k).
+pub const REGION_POINTS: usize = 500_000;
+
+/// One joined part of a region run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RegionPart {
+    /// Its id in [`RegionRun::part_labels`] (0 = most points).
+    pub id: u32,
+    /// The id of its structure in [`RegionRun::labels`].
+    pub structure: u32,
+    /// Its points (those whose core region gave them this part).
+    pub points: usize,
+    /// Its line or plane, fitted on those points.
+    pub primitive: Primitive,
+    /// How many regions' parts it joins.
+    pub pieces: usize,
+}
+
+/// The result of [`detect_by_regions`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct RegionRun {
+    /// Per input point: its structure id, or −1.
+    pub labels: Vec<i64>,
+    /// Per input point: its part id, or −1.
+    pub part_labels: Vec<i64>,
+    /// The joined parts, by id.
+    pub parts: Vec<RegionPart>,
+    /// Number of regions with points.
+    pub regions: usize,
+    /// Regions run again with a wider margin (their reach exceeded the
+    /// first margin).
+    pub widened: usize,
+    /// Region parts joined across borders (pairs that became one).
+    pub joins: usize,
+    /// Regions whose points are all at one position (no spacing to
+    /// estimate from): their points are background.
+    pub skipped: usize,
+}
+
+/// The side of square regions holding about [`REGION_POINTS`] points each
+/// at the cloud's mean density over its x–y extent; `None` when the whole
+/// cloud is about one region (or flat in x or y).
+pub fn side_for(points: &[[f64; 3]]) -> Option<f64> {
+    if points.len() <= 2 * REGION_POINTS {
+        return None;
+    }
+    let (lo, hi) = crate::geometry::bounding_box(points);
+    let (w, h) = (hi[0] - lo[0], hi[1] - lo[1]);
+    if !(w > 0.0 && h > 0.0) {
+        return None;
+    }
+    Some((w * h * REGION_POINTS as f64 / points.len() as f64).sqrt())
+}
+
+/// How far a detector's ellipsoids reach: the largest 2α·λ_max of its
+/// orientations (the halo of the tiled scan).
+pub fn reach(detector: &Detector) -> Result<f64, DetectError> {
+    let (jobs, _) = detector.scan_jobs(detector.modes())?;
+    Ok(jobs.iter().map(halo_width).fold(0.0, f64::max))
+}
+
+/// The region grid of a cloud: origin and side in x–y.
+#[derive(Debug, Clone, Copy)]
+struct Grid {
+    origin: [f64; 2],
+    side: f64,
+}
+
+impl Grid {
+    fn cell(&self, p: &[f64; 3]) -> (i64, i64) {
+        (
+            ((p[0] - self.origin[0]) / self.side).floor() as i64,
+            ((p[1] - self.origin[1]) / self.side).floor() as i64,
+        )
+    }
+}
+
+/// What one region's run leaves for the joining: per region part, its
+/// structure and primitive; the (point, part) labels of its margin.
+struct RegionResult {
+    parts: Vec<(u32, Primitive)>,
+    margin: Vec<(u32, u32)>,
+}
+
+/// Detects region by region (module doc). `build(ids)` builds the
+/// detector of the points `ids` (input indices, ascending) from their data
+/// (with [`Detector::auto`] or the options' builder, and the normals of
+/// those points if the cloud has them); `side` is the region side in input
+/// units. Two parts' primitives agree within the detectors' part angle
+/// ([`Detector::part_angle`]).
+///
+/// # Errors
+/// A region's error; a side that is not positive and finite.
+pub fn detect_by_regions(
+    points: &[[f64; 3]],
+    side: f64,
+    build: impl FnMut(&[u32]) -> Result<Detector, DetectError>,
+) -> Result<RegionRun, DetectError> {
+    regions_run(points, side, true, build, &mut |_, _| true)
+}
+
+/// [`detect_by_regions`], calling `progress(done, total)` after each
+/// region; `false` returned cancels the run.
+///
+/// # Errors
+/// As [`detect_by_regions`]; [`DetectError::Cancelled`] when `progress`
+/// returned `false`.
+pub fn detect_by_regions_with_progress(
+    points: &[[f64; 3]],
+    side: f64,
+    build: impl FnMut(&[u32]) -> Result<Detector, DetectError>,
+    progress: &mut dyn FnMut(usize, usize) -> bool,
+) -> Result<RegionRun, DetectError> {
+    regions_run(points, side, true, build, progress)
+}
+
+/// [`detect_by_regions`], with or without the joining of step 4 (without:
+/// each region's parts stay apart).
+fn regions_run(
+    points: &[[f64; 3]],
+    side: f64,
+    joining: bool,
+    mut build: impl FnMut(&[u32]) -> Result<Detector, DetectError>,
+    progress: &mut dyn FnMut(usize, usize) -> bool,
+) -> Result<RegionRun, DetectError> {
+    if !(side.is_finite() && side > 0.0) {
+        return Err(DetectError::BadParameter(format!(
+            "region side {side}: must be positive and finite"
+        )));
+    }
+    if points.is_empty() {
+        return Err(DetectError::Empty);
+    }
+    let (lo, _) = crate::geometry::bounding_box(points);
+    let grid = Grid {
+        origin: [lo[0], lo[1]],
+        side,
+    };
+    let cells = cells_of(points, &grid);
+    let n = points.len();
+    let mut part_of = vec![u32::MAX; n];
+    let mut structure_of = vec![u32::MAX; n];
+    let mut results: Vec<RegionResult> = Vec::with_capacity(cells.len());
+    let (mut n_parts, mut n_structures, mut widened) = (0u32, 0u32, 0usize);
+    let mut margin = FIRST_MARGIN * side;
+    let mut angle = 0.0f64;
+    let mut skipped = 0usize;
+    for (&cell, core) in &cells {
+        let found = loop {
+            let ids = region_points(points, &cells, &grid, cell, margin);
+            let detector = match build(&ids) {
+                Ok(d) => d,
+                // A region of one position (a stray point, a stack of
+                // copies) has no spacing to estimate: its points are
+                // background, as a whole run leaves an isolated point.
+                Err(DetectError::NoSpacing) => break None,
+                Err(e) => return Err(e),
+            };
+            let r = reach(&detector)?;
+            if r <= margin {
+                break Some((ids, detector));
+            }
+            widened += 1;
+            margin = r * MARGIN_SLACK;
+        };
+        let Some((ids, detector)) = found else {
+            skipped += 1;
+            results.push(RegionResult {
+                parts: Vec::new(),
+                margin: Vec::new(),
+            });
+            if !progress(results.len(), cells.len()) {
+                return Err(DetectError::Cancelled);
+            }
+            continue;
+        };
+        angle = angle.max(detector.part_angle_degrees());
+        let sub: Vec<[f64; 3]> = ids.iter().map(|&i| points[i as usize]).collect();
+        let det = detector.run(&sub)?;
+        drop(sub);
+        let res = record(
+            &ids,
+            core,
+            &det,
+            (n_parts, n_structures),
+            &mut part_of,
+            &mut structure_of,
+        );
+        n_parts += res.parts.len() as u32;
+        n_structures += det.structures.len() as u32;
+        results.push(res);
+        if !progress(results.len(), cells.len()) {
+            return Err(DetectError::Cancelled);
+        }
+    }
+    if skipped == results.len() {
+        // Every region is one position: the whole cloud's answer.
+        return Err(DetectError::NoSpacing);
+    }
+    let (mut parts_uf, mut structures_uf, joins) = match joining {
+        true => join(
+            &results,
+            &part_of,
+            n_parts as usize,
+            n_structures as usize,
+            angle,
+        ),
+        false => (
+            UnionFind::new(n_parts as usize),
+            UnionFind::new(n_structures as usize),
+            0,
+        ),
+    };
+    let (part_labels, labels, parts) = number(
+        points,
+        &results,
+        n_structures as usize,
+        &part_of,
+        &structure_of,
+        &mut parts_uf,
+        &mut structures_uf,
+    );
+    Ok(RegionRun {
+        labels,
+        part_labels,
+        parts,
+        regions: results.len(),
+        widened,
+        joins,
+        skipped,
+    })
+}
+
+/// Each non-empty region and its core points (ascending), regions in
+/// (x, y) cell order.
+fn cells_of(points: &[[f64; 3]], grid: &Grid) -> BTreeMap<(i64, i64), Vec<u32>> {
+    let mut cells: BTreeMap<(i64, i64), Vec<u32>> = BTreeMap::new();
+    for (i, p) in points.iter().enumerate() {
+        cells.entry(grid.cell(p)).or_default().push(i as u32);
+    }
+    cells
+}
+
+/// The points of region `cell` grown by `margin` in x and y, ascending.
+fn region_points(
+    points: &[[f64; 3]],
+    cells: &BTreeMap<(i64, i64), Vec<u32>>,
+    grid: &Grid,
+    cell: (i64, i64),
+    margin: f64,
+) -> Vec<u32> {
+    let reach = (margin / grid.side).ceil() as i64;
+    let lo = [
+        grid.origin[0] + cell.0 as f64 * grid.side - margin,
+        grid.origin[1] + cell.1 as f64 * grid.side - margin,
+    ];
+    let hi = [
+        lo[0] + grid.side + 2.0 * margin,
+        lo[1] + grid.side + 2.0 * margin,
+    ];
+    let mut ids = Vec::new();
+    for cx in cell.0 - reach..=cell.0 + reach {
+        for (_, list) in cells.range((cx, cell.1 - reach)..=(cx, cell.1 + reach)) {
+            ids.extend(list.iter().copied().filter(|&i| {
+                let p = &points[i as usize];
+                p[0] >= lo[0] && p[0] <= hi[0] && p[1] >= lo[1] && p[1] <= hi[1]
+            }));
+        }
+    }
+    ids.sort_unstable();
+    ids
+}
+
+/// Records a region's detection `det` over the points `ids`: its core
+/// points' parts and structures (ids offset by `first`), and the labels
+/// of its margin points for the joining.
+fn record(
+    ids: &[u32],
+    core: &[u32],
+    det: &Detection,
+    first: (u32, u32),
+    part_of: &mut [u32],
+    structure_of: &mut [u32],
+) -> RegionResult {
+    let (first_part, first_structure) = first;
+    let mut parts = Vec::with_capacity(det.num_parts());
+    for st in &det.structures {
+        for p in &st.parts {
+            parts.push((first_structure + st.id, p.primitive.clone()));
+        }
+    }
+    let local_parts = det.part_labels();
+    let mut margin = Vec::new();
+    let mut c = 0usize;
+    for (k, &i) in ids.iter().enumerate() {
+        let is_core = c < core.len() && core[c] == i;
+        if is_core {
+            c += 1;
+        }
+        let (lp, ls) = (local_parts[k], det.labels[k]);
+        if is_core {
+            if lp >= 0 {
+                part_of[i as usize] = first_part + lp as u32;
+                structure_of[i as usize] = first_structure + ls as u32;
+            }
+        } else if lp >= 0 {
+            margin.push((i, first_part + lp as u32));
+        }
+    }
+    RegionResult { parts, margin }
+}
+
+/// Whether two primitives agree within `angle_deg` (planes: normals;
+/// lines: directions; either way).
+fn agree(a: &Primitive, b: &Primitive, angle_deg: f64) -> bool {
+    let dir = |p: &Primitive| match p {
+        Primitive::Plane(f) => Some(f.normal),
+        Primitive::Line(f) => Some(f.direction),
+        Primitive::None => None,
+    };
+    match (dir(a), dir(b)) {
+        (Some(u), Some(v)) => {
+            let c = (u[0] * v[0] + u[1] * v[1] + u[2] * v[2]).abs();
+            c >= angle_deg.to_radians().cos()
+        }
+        _ => false,
+    }
+}
+
+/// The joining (module doc, step 4): union-finds over the global part and
+/// structure ids, and the number of joins.
+fn join(
+    results: &[RegionResult],
+    part_of: &[u32],
+    n_parts: usize,
+    n_structures: usize,
+    angle_deg: f64,
+) -> (UnionFind, UnionFind, usize) {
+    // Per global part: its region, structure and primitive.
+    let mut info: Vec<(usize, u32, &Primitive)> = Vec::with_capacity(n_parts);
+    for (r, res) in results.iter().enumerate() {
+        for (s, prim) in &res.parts {
+            info.push((r, *s, prim));
+        }
+    }
+    // Pairs (part in the margin, part of the core owner), counted; and
+    // per (margin part, owner region) the doubly labelled points.
+    let mut pairs: HashMap<(u32, u32), u32> = HashMap::new();
+    let mut over: HashMap<(u32, usize), u32> = HashMap::new();
+    for res in results {
+        for &(i, pm) in &res.margin {
+            let owner = part_of[i as usize];
+            if owner == u32::MAX {
+                continue;
+            }
+            let owner_region = info[owner as usize].0;
+            *pairs.entry((pm, owner)).or_insert(0) += 1;
+            *over.entry((pm, owner_region)).or_insert(0) += 1;
+        }
+    }
+    // Counts the other way: for a core part `owner` seen from region r,
+    // how many of its points r's margin labelled.
+    let mut seen: HashMap<(u32, usize), u32> = HashMap::new();
+    for (&(pm, owner), &c) in &pairs {
+        *seen.entry((owner, info[pm as usize].0)).or_insert(0) += c;
+    }
+    let mut keys: Vec<(u32, u32)> = pairs.keys().copied().collect();
+    keys.sort_unstable();
+    let mut parts_uf = UnionFind::new(n_parts);
+    let mut structures_uf = UnionFind::new(n_structures);
+    let mut joins = 0usize;
+    for (pm, owner) in keys {
+        let c = f64::from(pairs[&(pm, owner)]);
+        let (rm, sm, prim_m) = info[pm as usize];
+        let (ro, so, prim_o) = info[owner as usize];
+        let of_margin = f64::from(over[&(pm, ro)]);
+        let of_owner = f64::from(seen[&(owner, rm)]);
+        let majority = c >= SAME_SHARE * of_margin || c >= SAME_SHARE * of_owner;
+        if majority && agree(prim_m, prim_o, angle_deg) && parts_uf.union_min_root(pm, owner) {
+            joins += 1;
+            structures_uf.union_min_root(sm, so);
+        }
+    }
+    (parts_uf, structures_uf, joins)
+}
+
+/// Final ids (module doc, step 5) and the joined parts' summaries.
+fn number(
+    points: &[[f64; 3]],
+    results: &[RegionResult],
+    n_structures: usize,
+    part_of: &[u32],
+    structure_of: &[u32],
+    parts_uf: &mut UnionFind,
+    structures_uf: &mut UnionFind,
+) -> (Vec<i64>, Vec<i64>, Vec<RegionPart>) {
+    let n_parts: usize = results.iter().map(|r| r.parts.len()).sum();
+    // Points per root, in one pass.
+    let mut part_count = vec![0usize; n_parts];
+    let mut structure_count = vec![0usize; n_structures];
+    for (&p, &s) in part_of.iter().zip(structure_of) {
+        if p != u32::MAX {
+            part_count[parts_uf.find(p) as usize] += 1;
+            structure_count[structures_uf.find(s) as usize] += 1;
+        }
+    }
+    let rank = |count: &[usize]| -> Vec<u32> {
+        let mut roots: Vec<u32> = (0..count.len() as u32)
+            .filter(|&r| count[r as usize] > 0)
+            .collect();
+        roots.sort_by(|&a, &b| count[b as usize].cmp(&count[a as usize]).then(a.cmp(&b)));
+        let mut id = vec![u32::MAX; count.len()];
+        for (k, &r) in roots.iter().enumerate() {
+            id[r as usize] = k as u32;
+        }
+        id
+    };
+    let part_id = rank(&part_count);
+    let structure_id = rank(&structure_count);
+    let mut part_labels = vec![-1i64; part_of.len()];
+    let mut labels = vec![-1i64; part_of.len()];
+    let n_final = part_count.iter().filter(|&&c| c > 0).count();
+    let mut members: Vec<Vec<u32>> = vec![Vec::new(); n_final];
+    let mut pieces = vec![0usize; n_final];
+    let mut structure_of_part = vec![0u32; n_final];
+    for (i, (&p, &s)) in part_of.iter().zip(structure_of).enumerate() {
+        if p != u32::MAX {
+            let pid = part_id[parts_uf.find(p) as usize];
+            let sid = structure_id[structures_uf.find(s) as usize];
+            part_labels[i] = i64::from(pid);
+            labels[i] = i64::from(sid);
+            members[pid as usize].push(i as u32);
+            structure_of_part[pid as usize] = sid;
+        }
+    }
+    for p in 0..n_parts as u32 {
+        let id = part_id[parts_uf.find(p) as usize];
+        if id != u32::MAX {
+            pieces[id as usize] += 1;
+        }
+    }
+    let is_line = results
+        .iter()
+        .flat_map(|r| r.parts.iter())
+        .any(|p| matches!(p.1, Primitive::Line(_)));
+    let parts = members
+        .iter()
+        .enumerate()
+        .map(|(k, m)| RegionPart {
+            id: k as u32,
+            structure: structure_of_part[k],
+            points: m.len(),
+            primitive: if is_line {
+                super::fit::fit_line_indices(points, m).map_or(Primitive::None, Primitive::Line)
+            } else {
+                super::fit::fit_plane_indices(points, m).map_or(Primitive::None, Primitive::Plane)
+            },
+            pieces: pieces[k],
+        })
+        .collect();
+    (part_labels, labels, parts)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::detect::{Given, StructureKind};
+    use crate::rng::SplitMix64;
+
+    /// A jittered grid of spacing 1 over `[x0, x1) × [y0, y1)` at height
+    /// `z(x, y)`.
+    fn sheet(
+        rng: &mut SplitMix64,
+        (x0, x1): (f64, f64),
+        (y0, y1): (f64, f64),
+        z: impl Fn(f64, f64) -> f64,
+        out: &mut Vec<[f64; 3]>,
+    ) {
+        let mut y = y0;
+        while y < y1 {
+            let mut x = x0;
+            while x < x1 {
+                let (jx, jy) = (0.2 * (rng.uniform() - 0.5), 0.2 * (rng.uniform() - 0.5));
+                let jz = 0.02 * (rng.uniform() - 0.5);
+                out.push([x + jx, y + jy, z(x + jx, y + jy) + jz]);
+                x += 1.0;
+            }
+            y += 1.0;
+        }
+    }
+
+    /// Ground 0..120 × 0..120 at z = 0; one pitched roof face crossing the
+    /// region border near x = 40 (z = 6 + 0.4·(y − 20) over 25..55 ×
+    /// 20..35); two flat roofs at z = 8, 60 apart (10..25 × 80..95 and
+    /// 85..100 × 80..95).
+    fn scene() -> Vec<[f64; 3]> {
+        let mut rng = SplitMix64::new(7);
+        let mut pts = Vec::new();
+        let on_a_roof = |x: f64, y: f64| {
+            (25.0..55.0).contains(&x) && (20.0..35.0).contains(&y)
+                || (10.0..25.0).contains(&x) && (80.0..95.0).contains(&y)
+                || (85.0..100.0).contains(&x) && (80.0..95.0).contains(&y)
+        };
+        let mut ground = Vec::new();
+        sheet(
+            &mut rng,
+            (0.0, 120.0),
+            (0.0, 120.0),
+            |_, _| 0.0,
+            &mut ground,
+        );
+        pts.extend(ground.into_iter().filter(|p| !on_a_roof(p[0], p[1])));
+        sheet(
+            &mut rng,
+            (25.0, 55.0),
+            (20.0, 35.0),
+            |_, y| 6.0 + 0.4 * (y - 20.0),
+            &mut pts,
+        );
+        sheet(&mut rng, (10.0, 25.0), (80.0, 95.0), |_, _| 8.0, &mut pts);
+        sheet(&mut rng, (85.0, 100.0), (80.0, 95.0), |_, _| 8.0, &mut pts);
+        pts
+    }
+
+    /// The automatic detector of the points `ids` of `pts`, on one thread.
+    fn build(pts: &[[f64; 3]], ids: &[u32]) -> Result<Detector, DetectError> {
+        let sub: Vec<[f64; 3]> = ids.iter().map(|&i| pts[i as usize]).collect();
+        Ok(Detector::auto(StructureKind::Planes, &sub, &Given::default())?.threads(1))
+    }
+
+    fn by_regions(pts: &[[f64; 3]], side: f64) -> RegionRun {
+        detect_by_regions(pts, side, |ids| build(pts, ids)).unwrap()
+    }
+
+    /// The part most of `ids`' points carry, and its share of them.
+    fn main_part(labels: &[i64], ids: impl Iterator<Item = usize>) -> (i64, f64) {
+        let mut count: HashMap<i64, usize> = HashMap::new();
+        let mut n = 0usize;
+        for i in ids {
+            *count.entry(labels[i]).or_insert(0) += 1;
+            n += 1;
+        }
+        let (&p, &c) = count.iter().max_by_key(|(p, c)| (**c, -**p)).unwrap();
+        (p, c as f64 / n as f64)
+    }
+
+    #[test]
+    fn a_plane_across_regions_is_one_part_and_planes_apart_stay_apart() {
+        let pts = scene();
+        let run = by_regions(&pts, 40.0);
+        assert_eq!(run.regions, 9);
+        assert!(run.joins > 0);
+        let where_ = |f: &dyn Fn(&[f64; 3]) -> bool| -> Vec<usize> {
+            (0..pts.len()).filter(|&i| f(&pts[i])).collect()
+        };
+        let ground = where_(&|p| p[2].abs() < 0.1);
+        let roof = where_(&|p| p[2] > 5.0 && p[1] < 40.0);
+        let west = where_(&|p| p[2] > 7.5 && p[0] < 50.0 && p[1] > 70.0);
+        let east = where_(&|p| p[2] > 7.5 && p[0] > 50.0 && p[1] > 70.0);
+        // The ground spans the nine regions: one part holds nearly all.
+        let (g, share) = main_part(&run.part_labels, ground.iter().copied());
+        assert!(g >= 0 && share > 0.95, "ground: part {g}, share {share}");
+        assert!(
+            run.parts[g as usize].pieces >= 9,
+            "{:?}",
+            run.parts[g as usize]
+        );
+        // The roof face crosses x = 40 and is one part.
+        let (r, share) = main_part(&run.part_labels, roof.iter().copied());
+        assert!(
+            r >= 0 && r != g && share > 0.9,
+            "roof: part {r}, share {share}"
+        );
+        assert!(run.parts[r as usize].pieces >= 2);
+        // Two coplanar roofs 60 apart: two parts.
+        let (w, sw) = main_part(&run.part_labels, west.iter().copied());
+        let (e, se) = main_part(&run.part_labels, east.iter().copied());
+        assert!(
+            w >= 0 && e >= 0 && w != e,
+            "west {w} ({sw}), east {e} ({se})"
+        );
+        // Ids are numbered by size; the labels and parts agree.
+        for (k, p) in run.parts.iter().enumerate() {
+            assert_eq!(p.id as usize, k);
+            let n = run.part_labels.iter().filter(|&&l| l == k as i64).count();
+            assert_eq!(n, p.points);
+            if k > 0 {
+                assert!(run.parts[k - 1].points >= p.points);
+            }
+        }
+        // The first region widened its margin for its reach; the others
+        // started from it.
+        assert!(run.widened <= 2, "{}", run.widened);
+    }
+
+    #[test]
+    fn one_region_gives_the_whole_runs_labels() {
+        let pts = scene();
+        let run = by_regions(&pts, 1000.0);
+        assert_eq!((run.regions, run.joins), (1, 0));
+        let d = Detector::auto(StructureKind::Planes, &pts, &Given::default())
+            .unwrap()
+            .threads(1);
+        let det = d.run(&pts).unwrap();
+        assert_eq!(run.part_labels, det.part_labels());
+        assert_eq!(run.labels, det.labels);
+    }
+
+    #[test]
+    fn without_the_joining_a_plane_across_regions_is_in_pieces() {
+        // The oracle can fail: without the joining, the ground is one
+        // part per region.
+        let pts = scene();
+        let run = regions_run(&pts, 40.0, false, |ids| build(&pts, ids), &mut |_, _| true).unwrap();
+        assert_eq!(run.joins, 0);
+        let ground: Vec<usize> = (0..pts.len()).filter(|&i| pts[i][2].abs() < 0.1).collect();
+        let (_, share) = main_part(&run.part_labels, ground.into_iter());
+        assert!(share < 0.3, "{share}");
+    }
+
+    #[test]
+    fn a_progress_callback_sees_every_region_and_can_cancel() {
+        let pts = scene();
+        let mut seen = Vec::new();
+        let run = detect_by_regions_with_progress(
+            &pts,
+            60.0,
+            |ids| build(&pts, ids),
+            &mut |done, total| {
+                seen.push((done, total));
+                true
+            },
+        )
+        .unwrap();
+        assert_eq!(run.regions, 4);
+        assert_eq!(seen, [(1, 4), (2, 4), (3, 4), (4, 4)]);
+        let r =
+            detect_by_regions_with_progress(&pts, 60.0, |ids| build(&pts, ids), &mut |done, _| {
+                done < 2
+            });
+        assert!(matches!(r, Err(DetectError::Cancelled)));
+    }
+
+    #[test]
+    fn a_region_of_one_position_is_background_not_an_error() {
+        let mut pts = scene();
+        let n = pts.len();
+        pts.extend([[500.0, 500.0, 1.0]; 3]);
+        let run = by_regions(&pts, 40.0);
+        assert_eq!((run.regions, run.skipped), (10, 1));
+        assert!(run.part_labels[n..].iter().all(|&l| l == -1));
+        assert!(run.part_labels[..n].iter().filter(|&&l| l >= 0).count() > n / 2);
+    }
+
+    #[test]
+    fn a_cloud_of_one_position_per_region_is_the_whole_runs_error() {
+        let pts = vec![[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [100.0, 0.0, 0.0]];
+        let r = detect_by_regions(&pts, 10.0, |ids| build(&pts, ids));
+        assert!(matches!(r, Err(DetectError::NoSpacing)), "{r:?}");
+    }
+
+    #[test]
+    fn a_bad_side_is_an_error() {
+        let pts = scene();
+        for side in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            let r = detect_by_regions(&pts, side, |_| unreachable!());
+            assert!(matches!(r, Err(DetectError::BadParameter(_))), "{side}");
+        }
+    }
+
+    #[test]
+    fn the_side_for_a_cloud_holds_about_the_region_points() {
+        let pts: Vec<[f64; 3]> = (0..3_000_000u32)
+            .map(|i| [f64::from(i % 2000), f64::from(i / 2000), 0.0])
+            .collect();
+        let side = side_for(&pts).unwrap();
+        // 2000 x 1500 at one point per unit: 500k points in a square of
+        // side about 707.
+        assert!((side - 707.1).abs() < 1.0, "{side}");
+        assert!(side_for(&pts[..1_000_000]).is_none());
+    }
+}
