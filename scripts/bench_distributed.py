@@ -17,6 +17,11 @@ Needs the package with its [distributed] extra:
 Each distributed run has its own LocalCluster (worker processes of one
 thread each), started before the timer; the in-process run uses `--threads`
 threads (default: all cores). Prints one Markdown table row per run.
+
+`--regions` runs `distributed.detect_regions` (one task per region, the
+driver joins) against the in-process `aa.detect_regions` instead, and
+gives the peak RSS of the driver (this process: run with
+`--no-reference` for the driver's own figure) and of the workers.
 """
 
 from __future__ import annotations
@@ -70,7 +75,10 @@ def main() -> None:
     ap.add_argument("--threads", type=int, default=None, help="in-process run and driver threads")
     ap.add_argument("--tile", type=float, default=None, help="tile side (default: distributed's)")
     ap.add_argument("--no-reference", action="store_true", help="skip the in-process run")
+    ap.add_argument("--regions", action="store_true", help="detect_regions instead of the tiled detect")
     args = ap.parse_args()
+    if args.regions:
+        return regions(args)
 
     import aniso_alpha as aa
     from aniso_alpha import distributed
@@ -111,6 +119,51 @@ def main() -> None:
                 f"| {tiles} | {ratio} | {same} |",
                 flush=True,
             )
+    print(f"load average after: {os.getloadavg()[0]:.2f}")
+
+
+def peak_rss_mib() -> float:
+    """This process's peak RSS (MiB)."""
+    import resource
+
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
+def regions(args: argparse.Namespace) -> None:
+    """The `--regions` table: distributed.detect_regions against
+    aa.detect_regions."""
+    import aniso_alpha as aa
+    from aniso_alpha import distributed
+    from dask.distributed import Client, LocalCluster
+
+    print(f"load average before: {os.getloadavg()[0]:.2f}, cores: {os.cpu_count()}")
+    print("| points | run | wall s | regions | parts | driver peak RSS MiB | worker peak RSS MiB | same labels |")
+    print("|---:|---|---:|---:|---:|---:|---:|---|")
+    for size in args.sizes:
+        pts = town(int(size))
+        n = len(pts)
+        ref = None
+        if not args.no_reference:
+            t0 = time.perf_counter()
+            ref = aa.detect_regions(pts, "planes", threads=args.threads)
+            t = time.perf_counter() - t0
+            print(f"| {n:,} | in-process ({args.threads or os.cpu_count()} threads) | {t:.1f} | {ref.regions} "
+                  f"| {len(ref.parts)} | {peak_rss_mib():.0f} | | |", flush=True)
+        for w in args.workers:
+            cluster = LocalCluster(n_workers=w, threads_per_worker=1, processes=True, dashboard_address=None)
+            client = Client(cluster)
+            try:
+                t0 = time.perf_counter()
+                r = distributed.detect_regions(pts, "planes", client=client)
+                t = time.perf_counter() - t0
+                workers = client.run(peak_rss_mib)
+            finally:
+                client.close()
+                cluster.close()
+            same = "" if ref is None else (
+                "yes" if np.array_equal(r.part_labels, ref.part_labels) else "**NO**")
+            print(f"| {n:,} | {w} worker(s) | {t:.1f} | {r.regions} | {len(r.parts)} | {peak_rss_mib():.0f} "
+                  f"| {max(workers.values()):.0f} | {same} |", flush=True)
     print(f"load average after: {os.getloadavg()[0]:.2f}")
 
 

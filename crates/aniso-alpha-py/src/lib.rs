@@ -354,7 +354,7 @@ fn _panic(py: Python<'_>, on_worker: bool) -> PyResult<()> {
 #[pymodule(name = "_native")]
 mod native {
     #[pymodule_export]
-    use super::regions::detect_regions;
+    use super::regions::{detect_regions, region_plan, region_task, PyRegionJoin, PyRegionPlan};
     #[pymodule_export]
     use super::split::{plan, tile_step, PyPlan};
     #[pymodule_export]

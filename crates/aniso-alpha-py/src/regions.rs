@@ -2,9 +2,13 @@
 //! (`aniso_alpha::detect::regions`), for clouds whose whole run would not
 //! fit in memory.
 
-use aniso_alpha::detect::regions::{detect_by_regions_with_progress, side_for};
+use aniso_alpha::detect::regions::{
+    detect_by_regions_with_progress, region_step, side_for, wider_margin, RegionJoin, RegionPlan,
+    RegionRun, RegionStep,
+};
+use aniso_alpha::detect::DetectError;
 use aniso_alpha::detect::Primitive;
-use numpy::{IntoPyArray, PyArray1};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -83,8 +87,7 @@ pub fn detect_regions<'py>(
         let side = if region_side.is_finite() {
             region_side
         } else {
-            let (lo, hi) = aniso_alpha::geometry::bounding_box(pts);
-            2.0 * (hi[0] - lo[0]).max(hi[1] - lo[1]).max(1.0)
+            whole_side(pts)
         };
         detect_by_regions_with_progress(pts, side, build, &mut on_region).map_err(|e| {
             callback
@@ -93,8 +96,22 @@ pub fn detect_regions<'py>(
                 .unwrap_or_else(|| value_error(e))
         })
     })?;
-    let parts: Vec<PartRow> = run
-        .parts
+    let parts = part_rows(&run);
+    Ok((
+        run.labels.into_pyarray(py),
+        run.part_labels.into_pyarray(py),
+        parts,
+        side,
+        run.regions,
+        run.widened,
+        run.joins,
+        run.skipped,
+    ))
+}
+
+/// The joined parts of a region run as rows ([`PartRow`]).
+fn part_rows(run: &RegionRun) -> Vec<PartRow> {
+    run.parts
         .iter()
         .map(|p| {
             let (a, b, rms) = match &p.primitive {
@@ -110,15 +127,291 @@ pub fn detect_regions<'py>(
             };
             (p.id, p.structure, p.points, p.pieces, a, b, rms)
         })
-        .collect();
+        .collect()
+}
+
+/// The regions of a cloud, kept by a driver (`aniso_alpha.distributed.
+/// detect_regions`): the grid and each region's core points.
+#[pyclass(frozen, name = "RegionPlan", module = "aniso_alpha._native")]
+pub struct PyRegionPlan {
+    plan: RegionPlan,
+    /// One region made to hold the whole cloud (no side given, and the
+    /// cloud about one region).
+    whole: bool,
+}
+
+/// The regions of `points` of side `side` (`None`: about 500,000 points a
+/// region; a cloud of about one region is one region).
+#[pyfunction]
+#[pyo3(signature = (points, side = None))]
+pub fn region_plan(points: &Bound<'_, PyAny>, side: Option<f64>) -> PyResult<PyRegionPlan> {
+    let points = Points::extract(points)?;
+    let pts = points.as_slice();
+    let (side, whole) = match side.map(Some).unwrap_or_else(|| side_for(pts)) {
+        Some(s) => (s, false),
+        None => (whole_side(pts), true),
+    };
+    Ok(PyRegionPlan {
+        plan: RegionPlan::new(pts, side).map_err(value_error)?,
+        whole,
+    })
+}
+
+/// A side that makes `pts` one region.
+fn whole_side(pts: &[[f64; 3]]) -> f64 {
+    if pts.is_empty() {
+        return 1.0;
+    }
+    let (lo, hi) = aniso_alpha::geometry::bounding_box(pts);
+    2.0 * (hi[0] - lo[0]).max(hi[1] - lo[1]).max(1.0)
+}
+
+#[pymethods]
+impl PyRegionPlan {
+    fn __len__(&self) -> usize {
+        self.plan.len()
+    }
+
+    /// The region side, or `None` when the plan is one region made to
+    /// hold the whole cloud.
+    #[getter]
+    fn side(&self) -> Option<f64> {
+        (!self.whole).then(|| self.plan.side())
+    }
+
+    /// The first margin of every region.
+    #[getter]
+    fn first_margin(&self) -> f64 {
+        self.plan.first_margin()
+    }
+
+    /// Region `r`'s core points (uint32, ascending).
+    fn core<'py>(&self, py: Python<'py>, r: usize) -> PyResult<Bound<'py, PyArray1<u32>>> {
+        self.check(r)?;
+        Ok(self.plan.core(r).to_vec().into_pyarray(py))
+    }
+
+    /// Region `r`'s points grown by `margin` (uint32, ascending).
+    fn points_within<'py>(
+        &self,
+        py: Python<'py>,
+        points: &Bound<'py, PyAny>,
+        r: usize,
+        margin: f64,
+    ) -> PyResult<Bound<'py, PyArray1<u32>>> {
+        self.check(r)?;
+        let points = Points::extract(points)?;
+        Ok(self
+            .plan
+            .points_within(points.as_slice(), r, margin)
+            .into_pyarray(py))
+    }
+}
+
+impl PyRegionPlan {
+    fn check(&self, r: usize) -> PyResult<()> {
+        if r < self.plan.len() {
+            Ok(())
+        } else {
+            Err(PyValueError::new_err(format!(
+                "region {r} of {}",
+                self.plan.len()
+            )))
+        }
+    }
+}
+
+/// What a region task returns: `("skip", 0.0, None)` for a region of one
+/// position, `("wider", margin, None)` when its estimate
+/// reaches past its margin, or `("step", margin, (part int64, structure
+/// int64, part structures uint32, part axes float64 (p, 3) NaN when not
+/// fitted, structures, part angle, lines))`.
+type StepArrays<'py> = (
+    Bound<'py, PyArray1<i64>>,
+    Bound<'py, PyArray1<i64>>,
+    Bound<'py, PyArray1<u32>>,
+    Bound<'py, PyArray2<f64>>,
+    u32,
+    f64,
+    bool,
+);
+
+/// One region's task (a worker's half of `distributed.detect_regions`):
+/// the detector of the region's `points` (its core and `margin`, in input
+/// order) from their data and `options`, then its step, unless the
+/// estimate reaches past `margin`.
+#[pyfunction]
+#[pyo3(signature = (points, structure, margin, options = None, normals = None, threads = None))]
+pub fn region_task<'py>(
+    py: Python<'py>,
+    points: &Bound<'py, PyAny>,
+    structure: &str,
+    margin: f64,
+    options: Option<&Bound<'py, PyDict>>,
+    normals: Option<&Bound<'py, PyAny>>,
+    threads: Option<i64>,
+) -> PyResult<(&'static str, f64, Option<StepArrays<'py>>)> {
+    let options = options::detect_options(structure, options)?;
+    let points = Points::extract(points)?;
+    let normals = normals.map(extract_normals).transpose()?;
+    let threads = thread_count(threads)?;
+    let pts = points.as_slice();
+    let normals = normals.as_ref().map(|n| n.as_slice());
+    let out = detached(py, threads, |_| {
+        let detector = match options.build(pts, normals, aniso_alpha::options::Style::Python) {
+            Ok(d) => d,
+            Err(DetectError::NoSpacing) => return Ok(("skip", 0.0, None)),
+            Err(e) => return Err(value_error(e)),
+        };
+        if let Some(m) = wider_margin(&detector, margin).map_err(value_error)? {
+            return Ok(("wider", m, None));
+        }
+        let step = region_step(&detector, pts).map_err(value_error)?;
+        Ok(("step", margin, Some(step)))
+    })?;
+    let (kind, m, step) = out;
     Ok((
-        run.labels.into_pyarray(py),
-        run.part_labels.into_pyarray(py),
-        parts,
-        side,
-        run.regions,
-        run.widened,
-        run.joins,
-        run.skipped,
+        kind,
+        m,
+        step.map(|st| {
+            let axes: Vec<[f64; 3]> = st
+                .parts
+                .iter()
+                .map(|(_, a)| a.unwrap_or([f64::NAN; 3]))
+                .collect();
+            let ps: Vec<u32> = st.parts.iter().map(|(s, _)| *s).collect();
+            (
+                st.part.into_pyarray(py),
+                st.structure.into_pyarray(py),
+                ps.into_pyarray(py),
+                crate::convert::rows_to_numpy(py, axes),
+                st.structures,
+                st.part_angle,
+                st.lines,
+            )
+        }),
     ))
+}
+
+/// A region step from Python (`region_task`'s arrays), as the joining
+/// takes it.
+type StepIn<'py> = (
+    PyReadonlyArray1<'py, i64>,
+    PyReadonlyArray1<'py, i64>,
+    PyReadonlyArray1<'py, u32>,
+    PyReadonlyArray2<'py, f64>,
+    u32,
+    f64,
+    bool,
+);
+
+/// The joining of region steps on a driver (`distributed.detect_regions`):
+/// `add` each region's step in the plan's order, then `finish`.
+#[pyclass(name = "RegionJoin", module = "aniso_alpha._native")]
+pub struct PyRegionJoin {
+    join: Option<RegionJoin>,
+}
+
+#[pymethods]
+impl PyRegionJoin {
+    #[new]
+    fn new(n: usize) -> Self {
+        PyRegionJoin {
+            join: Some(RegionJoin::new(n)),
+        }
+    }
+
+    /// Counts a region whose margin was widened.
+    fn widened(&mut self) -> PyResult<()> {
+        self.get()?.widened();
+        Ok(())
+    }
+
+    /// Adds a region: its points `ids` and `core` (uint32, ascending) and
+    /// its step (`region_task`'s arrays), or `None` for a region of one
+    /// position.
+    #[pyo3(signature = (ids, core, step = None))]
+    fn add(
+        &mut self,
+        ids: PyReadonlyArray1<'_, u32>,
+        core: PyReadonlyArray1<'_, u32>,
+        step: Option<StepIn<'_>>,
+    ) -> PyResult<()> {
+        let step = match step {
+            None => None,
+            Some((part, structure, ps, axes, structures, part_angle, lines)) => {
+                let axes = axes.as_array();
+                let ps = ps.as_slice()?;
+                if axes.shape() != [ps.len(), 3] {
+                    return Err(PyValueError::new_err(
+                        "a region step's axes must be (parts, 3)",
+                    ));
+                }
+                let parts = ps
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &s)| {
+                        let a = [axes[[k, 0]], axes[[k, 1]], axes[[k, 2]]];
+                        (s, a.iter().all(|v| v.is_finite()).then_some(a))
+                    })
+                    .collect();
+                Some(RegionStep {
+                    part: part.as_slice()?.to_vec(),
+                    structure: structure.as_slice()?.to_vec(),
+                    parts,
+                    structures,
+                    part_angle,
+                    lines,
+                })
+            }
+        };
+        let ids = ids.as_slice()?;
+        let core = core.as_slice()?;
+        self.get()?
+            .add(ids, core, step.as_ref())
+            .map_err(value_error)
+    }
+
+    /// The joined run over `points`: (labels, part_labels, parts, regions,
+    /// widened, joins, skipped), as `detect_regions` gives them.
+    #[allow(clippy::type_complexity)]
+    fn finish<'py>(
+        &mut self,
+        py: Python<'py>,
+        points: &Bound<'py, PyAny>,
+    ) -> PyResult<(
+        Bound<'py, PyArray1<i64>>,
+        Bound<'py, PyArray1<i64>>,
+        Vec<PartRow>,
+        usize,
+        usize,
+        usize,
+        usize,
+    )> {
+        let join = self
+            .join
+            .take()
+            .ok_or_else(|| PyValueError::new_err("this joining is finished"))?;
+        let points = Points::extract(points)?;
+        let pts = points.as_slice();
+        let run = detached(py, 1, |_| join.finish(pts).map_err(value_error))?;
+        let parts = part_rows(&run);
+        Ok((
+            run.labels.into_pyarray(py),
+            run.part_labels.into_pyarray(py),
+            parts,
+            run.regions,
+            run.widened,
+            run.joins,
+            run.skipped,
+        ))
+    }
+}
+
+impl PyRegionJoin {
+    fn get(&mut self) -> PyResult<&mut RegionJoin> {
+        self.join
+            .as_mut()
+            .ok_or_else(|| PyValueError::new_err("this joining is finished"))
+    }
 }

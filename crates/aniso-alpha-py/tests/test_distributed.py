@@ -192,18 +192,18 @@ def test_normals_equal_in_process(client):
         distributed.detect(pts, "planes", tile=2.0, client=client, normals=normals[:5])
 
 
-def killing_cluster(marker, always=False):
+def killing_cluster(marker, always=False, task="_run_tile"):
     """A 2-process LocalCluster whose workers kill their own process when a
-    tile task starts: once (the first task of the run, the marker file
-    records it) or every time (``always``). The nannies start a new worker
-    in its place, as a cluster's would."""
+    task (a tile's, or ``task``) starts: once (the first task of the run,
+    the marker file records it) or every time (``always``). The nannies
+    start a new worker in its place, as a cluster's would."""
     from dask.distributed import Client, LocalCluster, WorkerPlugin
 
     class KillOnTile(WorkerPlugin):  # defined here: pickled by value
         name = "kill-on-tile"
 
         def transition(self, key, start, finish, **kwargs):
-            if finish != "executing" or "_run_tile" not in str(key):
+            if finish != "executing" or task not in str(key):
                 return
             if not always:
                 try:
@@ -242,6 +242,70 @@ def test_a_tile_that_always_kills_its_worker_is_a_clear_error(tmp_path):
     try:
         with pytest.raises(distributed.TileLost, match=r"was lost 3 times"):
             distributed.detect(pts, "planes", tile=100.0, client=c)
+    finally:
+        c.close()
+        cluster.close()
+
+
+def ground_and_roof():
+    """A 90 x 60 ground (spacing 1) with a pitched roof face across the
+    border x = 30 of 30-unit regions."""
+    rng = np.random.default_rng(5)
+    x, y = (a.ravel() for a in np.meshgrid(np.arange(90.0), np.arange(60.0)))
+    x = x + rng.uniform(-0.1, 0.1, x.size)
+    y = y + rng.uniform(-0.1, 0.1, y.size)
+    roof = (x >= 25) & (x < 55) & (y >= 20) & (y < 35)
+    z = np.where(roof, 6.0 + 0.4 * (y - 20.0), 0.0) + rng.uniform(-0.01, 0.01, x.size)
+    return np.c_[x, y, z]
+
+
+def assert_same_regions(r, ref):
+    assert isinstance(r, aa.RegionDetection)
+    np.testing.assert_array_equal(r.labels, ref.labels)
+    np.testing.assert_array_equal(r.part_labels, ref.part_labels)
+    assert (r.side, r.regions, r.widened, r.joins, r.skipped) == (
+        ref.side, ref.regions, ref.widened, ref.joins, ref.skipped)
+    assert [(p.id, p.structure, p.points, p.pieces) for p in r.parts] == [
+        (p.id, p.structure, p.points, p.pieces) for p in ref.parts]
+    for a, b in zip(r.parts, ref.parts):
+        np.testing.assert_allclose(a.equation, b.equation)
+
+
+def test_regions_equal_in_process(client):
+    pts = ground_and_roof()
+    ref = aa.detect_regions(pts, "planes", side=30.0)
+    # Each region's estimate reaches past side/16: every task is sent
+    # again with a wider margin, and the ground crosses every border.
+    assert ref.regions == 6 and ref.widened == 6 and ref.parts[0].pieces == 6
+    assert_same_regions(distributed.detect_regions(pts, "planes", side=30.0, client=client), ref)
+    # No side: about one region here, as aa.detect_regions.
+    whole = distributed.detect_regions(pts, "planes", client=client)
+    assert whole.side is None and whole.regions == 1
+    np.testing.assert_array_equal(whole.part_labels, aa.detect(pts, "planes").part_labels)
+    with pytest.raises(ValueError, match="region side"):
+        distributed.detect_regions(pts, "planes", side=0.0, client=client)
+
+
+def test_a_region_whose_worker_is_killed_gives_the_same_labels(tmp_path):
+    pts = ground_and_roof()
+    ref = aa.detect_regions(pts, "planes", side=30.0)
+    marker = tmp_path / "killed"
+    c, cluster = killing_cluster(str(marker), task="_run_region")
+    try:
+        r = distributed.detect_regions(pts, "planes", side=30.0, client=c)
+    finally:
+        c.close()
+        cluster.close()
+    assert marker.exists(), "no worker was killed: the test tested nothing"
+    assert_same_regions(r, ref)
+
+
+def test_a_region_that_always_kills_its_worker_is_a_clear_error(tmp_path):
+    pts = ground_and_roof()
+    c, cluster = killing_cluster(str(tmp_path / "unused"), always=True, task="_run_region")
+    try:
+        with pytest.raises(distributed.RegionLost, match=r"region 0 .* lost its worker"):
+            distributed.detect_regions(pts, "planes", side=45.0, client=c)
     finally:
         c.close()
         cluster.close()

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass
-from typing import Any, Callable, Dict, Literal, Optional, Sequence, Tuple
+from typing import Any, Callable, Dict, List, Literal, Optional, Sequence, Tuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -401,9 +401,16 @@ def detect_regions(
     labels, part_labels, rows, used, regions, widened, joins, skipped = _native.detect_regions(
         pts, structure, side, options, threads, nrm, progress
     )
+    return RegionDetection(
+        labels, part_labels, _region_parts(rows, structure), used, regions, widened, joins, skipped
+    )
+
+
+def _region_parts(rows: Sequence[Tuple[Any, ...]], structure: str) -> List[RegionPart]:
+    """The joined parts of a region run from the extension's rows."""
     parts = []
+    line = structure == "lines"
     for pid, st, n, pieces, a, b, rms in rows:
-        line = structure == "lines"
         parts.append(
             RegionPart(
                 id=pid,
@@ -416,4 +423,4 @@ def detect_regions(
                 rms=rms,
             )
         )
-    return RegionDetection(labels, part_labels, parts, used, regions, widened, joins, skipped)
+    return parts

@@ -54,6 +54,45 @@ def detect_regions(
 ) -> Tuple[NDArray[np.int64], NDArray[np.int64], List[_PartRow], Optional[float], int, int, int, int]:
     """(labels, part_labels, parts, side used, regions, widened, joins, skipped)."""
 
+class RegionPlan:
+    """The regions of a cloud (aniso_alpha.distributed.detect_regions)."""
+
+    def __len__(self) -> int: ...
+    @property
+    def side(self) -> Optional[float]: ...
+    @property
+    def first_margin(self) -> float: ...
+    def core(self, r: int) -> NDArray[np.uint32]: ...
+    def points_within(self, points: ArrayLike, r: int, margin: float) -> NDArray[np.uint32]: ...
+
+def region_plan(points: ArrayLike, side: Optional[float] = None) -> RegionPlan: ...
+
+_StepArrays = Tuple[
+    NDArray[np.int64], NDArray[np.int64], NDArray[np.uint32], NDArray[np.float64], int, float, bool
+]
+
+def region_task(
+    points: ArrayLike,
+    structure: str,
+    margin: float,
+    options: Optional[Dict[str, Any]] = None,
+    normals: Optional[ArrayLike] = None,
+    threads: Optional[int] = None,
+) -> Tuple[str, float, Optional[_StepArrays]]:
+    """("skip" | "wider" | "step", margin, the step's arrays or None)."""
+
+class RegionJoin:
+    """The joining of region steps on the driver."""
+
+    def __init__(self, n: int) -> None: ...
+    def widened(self) -> None: ...
+    def add(
+        self, ids: NDArray[np.uint32], core: NDArray[np.uint32], step: Optional[_StepArrays] = None
+    ) -> None: ...
+    def finish(
+        self, points: ArrayLike
+    ) -> Tuple[NDArray[np.int64], NDArray[np.int64], List[_PartRow], int, int, int, int]: ...
+
 class Plan:
     """A split detection run (aniso_alpha.distributed); made by `plan`."""
 

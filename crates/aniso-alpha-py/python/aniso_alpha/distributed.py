@@ -22,6 +22,13 @@ How a run goes (docs/method.md §8; ARCHITECTURE.md, "Distributed detection"):
    filter, the union, the component filter and the structures. The
    simplices owned by the cores are exactly the whole cloud's, so the
    labels are those of :func:`aniso_alpha.detect`.
+
+:func:`detect_regions` spreads :func:`aniso_alpha.detect_regions` instead
+(docs/method.md §8, "Regions"): each region (its core and margin) is one
+task that estimates its own parameters and runs the whole detection on
+its points; the driver keeps the points, two labels a point and the
+regions' part axes, and joins the parts across borders. It gives the
+labels of :func:`aniso_alpha.detect_regions`.
 """
 
 from __future__ import annotations
@@ -38,9 +45,9 @@ from numpy.typing import ArrayLike, NDArray
 from . import _native
 from ._api import Structure, detect_input, detect_options
 from ._io import Cloud, PathLike, _warn, read
-from ._results import Detection
+from ._results import Detection, RegionDetection, RegionPart
 
-__all__ = ["TileLost", "detect", "load", "plan"]
+__all__ = ["RegionLost", "TileLost", "detect", "detect_regions", "load", "plan"]
 
 Source = Union[PathLike, Sequence[PathLike], ArrayLike, Any]
 
@@ -301,6 +308,12 @@ class TileLost(RuntimeError):
     tile's cell and the last error."""
 
 
+class RegionLost(TileLost):
+    """A region's task of :func:`detect_regions` was lost with its worker
+    as many times as the cluster allows (Dask's ``allowed-failures``): the
+    run stops, naming the region."""
+
+
 def _lost_worker_errors() -> Tuple[Type[BaseException], ...]:
     """The exceptions a task's result raises when its worker (or the data
     scattered to it) was lost, rather than when the task itself failed."""
@@ -390,3 +403,155 @@ def _run(
         if nxt is not None:
             pending.add(submit(nxt))  # type: ignore[no-untyped-call]
     return outputs
+
+
+def _run_region(
+    points: NDArray[np.float64],
+    normals: Optional[NDArray[np.float64]],
+    structure: str,
+    margin: float,
+    options: Dict[str, Any],
+    task_threads: int,
+) -> Tuple[Any, ...]:
+    """A region's task on a worker (see :func:`detect_regions`)."""
+    # Unpickled from one frame, the arrays may be unaligned (see _run_tile).
+    pts = np.require(points, requirements=("C", "A"))
+    nrm = None if normals is None else np.require(normals, requirements=("C", "A"))
+    return _native.region_task(pts, structure, margin, options, nrm, task_threads)
+
+
+def detect_regions(
+    source: Source,
+    structure: Structure,
+    *,
+    side: Optional[float] = None,
+    client: Any = None,
+    n_workers: Optional[int] = None,
+    task_threads: int = 1,
+    normals: Optional[ArrayLike] = None,
+    ignore_normals: bool = False,
+    **options: Any,
+) -> RegionDetection:
+    """:func:`aniso_alpha.detect_regions` with each region run as a Dask
+    task: the same labels and parts.
+
+    Args:
+        source: as for :func:`detect`.
+        structure: ``"lines"`` or ``"planes"``.
+        side: the region side (input units); default: regions of about
+            500,000 points (one region for a cloud of up to 1,000,000).
+        client: a ``dask.distributed.Client``; ``None`` starts a
+            ``LocalCluster`` of ``n_workers`` processes, one thread each.
+        n_workers: the workers of that LocalCluster (default: one per core).
+        task_threads: threads of each region task.
+        normals, ignore_normals, options: as for
+            :func:`aniso_alpha.detect_regions`; the parameters are
+            estimated in each task, from its region's points.
+
+    Returns:
+        the :class:`~aniso_alpha.RegionDetection` of
+        :func:`aniso_alpha.detect_regions` on the same points.
+
+    The driver holds the points, two labels a point and, per region, its
+    part axes; each task holds one region. A region's result depends on
+    its own points only, so a task whose worker dies is run again (by
+    Dask: its points travel with the task) with the same result. A region
+    whose estimate reaches past its margin is sent again with the margin
+    it asks for.
+
+    >>> import numpy as np, aniso_alpha as aa
+    >>> from aniso_alpha import distributed
+    >>> x, y = (a.ravel() for a in np.meshgrid(np.arange(60.0), np.arange(30.0)))
+    >>> sheet = np.c_[x, y, np.random.default_rng(2).normal(0, 0.01, x.size)]
+    >>> r = distributed.detect_regions(sheet, "planes", side=30.0, n_workers=2)
+    >>> bool((r.part_labels == aa.detect_regions(sheet, "planes", side=30.0).part_labels).all())
+    True
+    """
+    from dask.distributed import Client, LocalCluster, as_completed
+
+    if isinstance(source, (str, os.PathLike)):
+        source = read(source)
+    if isinstance(source, Cloud):
+        _, normals = detect_input(source, normals, ignore_normals)
+        source = source.points
+    else:
+        _, normals = detect_input(None, normals, ignore_normals)
+    points = load(source)
+    nrm = None if normals is None else load(normals)
+    if side is not None and not (math.isfinite(side) and side > 0):
+        raise ValueError(f"region side {side}: must be positive and finite")
+    opts = detect_options(**options)
+    plan = _native.region_plan(points, side)
+    own = None
+    if client is None:
+        n = int(n_workers) if n_workers else (os.cpu_count() or 1)
+        cluster = LocalCluster(  # type: ignore[no-untyped-call]
+            n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None
+        )
+        own = (Client(cluster), cluster)  # type: ignore[no-untyped-call]
+        client = own[0]
+    try:
+        steps: Dict[int, Tuple[NDArray[np.uint32], Optional[Tuple[Any, ...]], bool]] = {}
+        meta: Dict[str, Tuple[int, NDArray[np.uint32], bool]] = {}
+        limit = 2 * _workers(client) + 2
+        regions = iter(range(len(plan)))
+
+        def submit(r: int, margin: float, widened: bool) -> Any:
+            ids = plan.points_within(points, r, margin)
+            sub_n = None if nrm is None else np.ascontiguousarray(nrm[ids])
+            future = client.submit(
+                _run_region,
+                np.ascontiguousarray(points[ids]),
+                sub_n,
+                structure,
+                margin,
+                opts,
+                task_threads,
+                pure=False,
+            )
+            meta[future.key] = (r, ids, widened)
+            return future
+
+        first = plan.first_margin
+        pending = as_completed([submit(r, first, False) for _, r in zip(range(limit), regions)])  # type: ignore[no-untyped-call]
+        lost_errors = _lost_worker_errors()
+        for done in pending:
+            r, ids, widened = meta.pop(done.key)
+            try:
+                kind, margin, step = done.result()
+            except lost_errors as e:
+                # Dask ran the task again on other workers (its points travel
+                # with it) until its allowed failures were spent.
+                raise RegionLost(
+                    f"region {r} ({len(ids)} points) lost its worker on every try (its worker died "
+                    f"or left the cluster); last error: {type(e).__name__}: {e}"
+                ) from e
+            done.release()
+            if kind == "wider":
+                pending.add(submit(r, margin, True))  # type: ignore[no-untyped-call]
+                continue
+            if step is not None:
+                # Unpickled from one frame, the arrays may be unaligned.
+                step = tuple(
+                    np.require(a, requirements=("C", "A")) if isinstance(a, np.ndarray) else a for a in step
+                )
+            steps[r] = (ids, step if kind == "step" else None, widened)
+            nxt = next(regions, None)
+            if nxt is not None:
+                pending.add(submit(nxt, first, False))  # type: ignore[no-untyped-call]
+        join = _native.RegionJoin(len(points))
+        for r in range(len(plan)):
+            ids, step, widened = steps.pop(r)
+            if widened:
+                join.widened()
+            join.add(ids, plan.core(r), step)
+        labels, part_labels, rows, regions_n, widened_n, joins, skipped = join.finish(points)
+    finally:
+        if own is not None:
+            own[0].close()  # type: ignore[no-untyped-call]
+            own[1].close()
+    from ._api import _region_parts
+
+    return RegionDetection(
+        labels, part_labels, _region_parts(rows, structure), plan.side, regions_n, widened_n, joins, skipped
+    )
