@@ -491,7 +491,21 @@ def detect_regions(
         own = (Client(cluster), cluster)  # type: ignore[no-untyped-call]
         client = own[0]
     try:
+        # Steps wait here until every earlier region is joined (the joining
+        # takes the plan's order); joined ones are dropped.
         steps: Dict[int, Tuple[NDArray[np.uint32], Optional[Tuple[Any, ...]], bool]] = {}
+        join = _native.RegionJoin(len(points))
+        joined = 0
+
+        def join_ready() -> None:
+            nonlocal joined
+            while joined in steps:
+                ids, step, widened = steps.pop(joined)
+                if widened:
+                    join.widened()
+                join.add(ids, plan.core(joined), step)
+                joined += 1
+
         meta: Dict[str, Tuple[int, NDArray[np.uint32], bool]] = {}
         limit = 2 * _workers(client) + 2
         regions = iter(range(len(plan)))
@@ -536,15 +550,10 @@ def detect_regions(
                     np.require(a, requirements=("C", "A")) if isinstance(a, np.ndarray) else a for a in step
                 )
             steps[r] = (ids, step if kind == "step" else None, widened)
+            join_ready()
             nxt = next(regions, None)
             if nxt is not None:
                 pending.add(submit(nxt, first, False))  # type: ignore[no-untyped-call]
-        join = _native.RegionJoin(len(points))
-        for r in range(len(plan)):
-            ids, step, widened = steps.pop(r)
-            if widened:
-                join.widened()
-            join.add(ids, plan.core(r), step)
         labels, part_labels, rows, regions_n, widened_n, joins, skipped = join.finish(points)
     finally:
         if own is not None:

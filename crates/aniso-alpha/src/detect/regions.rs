@@ -34,8 +34,8 @@
 //!
 //! Memory: the cloud, two labels per point and one region's run at a time
 //! (its triangulations and assembly, which dominate a whole run's peak).
-//! Deterministic: regions run in a fixed order, each on its points in
-//! input order.
+//! Deterministic: a region's result depends on its own points (in input
+//! order) only, and the joining takes the regions in the plan's order.
 
 use super::detection::{Detection, Primitive};
 use super::scan::halo_width;
@@ -428,8 +428,7 @@ impl RegionJoin {
         } else {
             (UnionFind::new(n_parts), UnionFind::new(n_structures), 0)
         };
-        let (part_labels, labels, parts) =
-            number(points, &self, &mut parts_uf, &mut structures_uf);
+        let (part_labels, labels, parts) = number(points, &self, &mut parts_uf, &mut structures_uf);
         Ok(RegionRun {
             labels,
             part_labels,
