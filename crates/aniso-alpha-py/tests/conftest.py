@@ -122,3 +122,16 @@ def need(module: str, why: str):
         if os.environ.get("ANISO_ALPHA_CI", "") not in ("", "0"):
             pytest.fail(msg + " (ANISO_ALPHA_CI is set: a test whose tool is missing fails)")
         pytest.skip(msg)
+
+
+def ground_and_roof_scene():
+    """A 90 x 60 ground at z = 0 (spacing 1, jittered) with a pitched roof
+    face over 25..55 x 20..35, across the border x = 30 of 30-unit
+    regions; the points and the roof's mask."""
+    rng = np.random.default_rng(5)
+    x, y = (a.ravel() for a in np.meshgrid(np.arange(90.0), np.arange(60.0)))
+    x = x + rng.uniform(-0.1, 0.1, x.size)
+    y = y + rng.uniform(-0.1, 0.1, y.size)
+    roof = (x >= 25) & (x < 55) & (y >= 20) & (y < 35)
+    z = np.where(roof, 6.0 + 0.4 * (y - 20.0), 0.0) + rng.uniform(-0.01, 0.01, x.size)
+    return np.c_[x, y, z], roof

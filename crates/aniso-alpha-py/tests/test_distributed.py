@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import aniso_alpha as aa
-from conftest import PAPER
+from conftest import PAPER, ground_and_roof_scene
 
 if os.environ.get("CI"):
     import dask.distributed  # noqa: F401  (CI installs the [distributed] extra: never skip there)
@@ -248,15 +248,7 @@ def test_a_tile_that_always_kills_its_worker_is_a_clear_error(tmp_path):
 
 
 def ground_and_roof():
-    """A 90 x 60 ground (spacing 1) with a pitched roof face across the
-    border x = 30 of 30-unit regions."""
-    rng = np.random.default_rng(5)
-    x, y = (a.ravel() for a in np.meshgrid(np.arange(90.0), np.arange(60.0)))
-    x = x + rng.uniform(-0.1, 0.1, x.size)
-    y = y + rng.uniform(-0.1, 0.1, y.size)
-    roof = (x >= 25) & (x < 55) & (y >= 20) & (y < 35)
-    z = np.where(roof, 6.0 + 0.4 * (y - 20.0), 0.0) + rng.uniform(-0.01, 0.01, x.size)
-    return np.c_[x, y, z]
+    return ground_and_roof_scene()[0]
 
 
 def assert_same_regions(r, ref):

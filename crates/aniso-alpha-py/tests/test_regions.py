@@ -6,19 +6,12 @@ import numpy as np
 import pytest
 
 import aniso_alpha as aa
+from conftest import ground_and_roof_scene
 
 
 @pytest.fixture(scope="module")
 def ground_and_roof():
-    """A 90 x 60 ground at z = 0, spacing 1, with a pitched roof face over
-    25..55 x 20..35 (across the border x = 30 of 30-unit regions)."""
-    rng = np.random.default_rng(5)
-    x, y = (a.ravel() for a in np.meshgrid(np.arange(90.0), np.arange(60.0)))
-    x = x + rng.uniform(-0.1, 0.1, x.size)
-    y = y + rng.uniform(-0.1, 0.1, y.size)
-    roof = (x >= 25) & (x < 55) & (y >= 20) & (y < 35)
-    z = np.where(roof, 6.0 + 0.4 * (y - 20.0), 0.0) + rng.uniform(-0.01, 0.01, x.size)
-    return np.c_[x, y, z], roof
+    return ground_and_roof_scene()
 
 
 def test_a_plane_across_regions_is_one_part(ground_and_roof):

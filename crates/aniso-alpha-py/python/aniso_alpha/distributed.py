@@ -258,24 +258,8 @@ def detect(
 
     On a cluster, pass its client (``Client("scheduler-address:8786")``).
     """
-    from dask.distributed import Client, LocalCluster
-
-    if isinstance(source, (str, os.PathLike)):
-        source = read(source)
-    if isinstance(source, Cloud):
-        _, normals = detect_input(source, normals, ignore_normals)
-        source = source.points
-    else:
-        _, normals = detect_input(None, normals, ignore_normals)
-    points = load(source)
-    own = None
-    if client is None:
-        n = int(n_workers) if n_workers else (os.cpu_count() or 1)
-        cluster = LocalCluster(  # type: ignore[no-untyped-call]
-            n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None
-        )
-        own = (Client(cluster), cluster)  # type: ignore[no-untyped-call]
-        client = own[0]
+    points, normals = _source(source, normals, ignore_normals)
+    client, own = _client(client, n_workers)
     try:
         p = plan(
             points,
@@ -290,11 +274,47 @@ def detect(
         outputs = _run(client, p, points, task_threads)
         labels, part_labels, report, messages, native = p.finish(points, outputs, threads)
     finally:
-        if own is not None:
-            own[0].close()  # type: ignore[no-untyped-call]
-            own[1].close()
+        _close(own)
     r = json.loads(report)
     return Detection(labels, part_labels, r["structures"], r["parameters"], list(messages), native)
+
+
+def _source(
+    source: Source, normals: Optional[ArrayLike], ignore_normals: bool
+) -> Tuple[NDArray[np.float64], Optional[ArrayLike]]:
+    """The points of ``source`` (a path read, a Cloud's points, or an
+    array, as :func:`load` takes them) and the normals to use."""
+    if isinstance(source, (str, os.PathLike)):
+        source = read(source)
+    if isinstance(source, Cloud):
+        _, normals = detect_input(source, normals, ignore_normals)
+        source = source.points
+    else:
+        _, normals = detect_input(None, normals, ignore_normals)
+    return load(source), normals
+
+
+def _client(client: Any, n_workers: Optional[int]) -> Tuple[Any, Optional[Tuple[Any, Any]]]:
+    """``client``, or a new one on a ``LocalCluster`` of ``n_workers``
+    processes (default: one per core), one thread each, with that client
+    and cluster to close (:func:`_close`)."""
+    if client is not None:
+        return client, None
+    from dask.distributed import Client, LocalCluster
+
+    n = int(n_workers) if n_workers else (os.cpu_count() or 1)
+    cluster = LocalCluster(  # type: ignore[no-untyped-call]
+        n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None
+    )
+    own = (Client(cluster), cluster)  # type: ignore[no-untyped-call]
+    return own[0], own
+
+
+def _close(own: Optional[Tuple[Any, Any]]) -> None:
+    """Closes the client and cluster :func:`_client` started, if any."""
+    if own is not None:
+        own[0].close()
+        own[1].close()
 
 
 # A tile whose task is lost this many times (its worker died, its scattered
@@ -467,29 +487,15 @@ def detect_regions(
     >>> bool((r.part_labels == aa.detect_regions(sheet, "planes", side=30.0).part_labels).all())
     True
     """
-    from dask.distributed import Client, LocalCluster, as_completed
+    from dask.distributed import as_completed
 
-    if isinstance(source, (str, os.PathLike)):
-        source = read(source)
-    if isinstance(source, Cloud):
-        _, normals = detect_input(source, normals, ignore_normals)
-        source = source.points
-    else:
-        _, normals = detect_input(None, normals, ignore_normals)
-    points = load(source)
+    points, normals = _source(source, normals, ignore_normals)
     nrm = None if normals is None else load(normals)
     if side is not None and not (math.isfinite(side) and side > 0):
         raise ValueError(f"region side {side}: must be positive and finite")
     opts = detect_options(**options)
     plan = _native.region_plan(points, side)
-    own = None
-    if client is None:
-        n = int(n_workers) if n_workers else (os.cpu_count() or 1)
-        cluster = LocalCluster(  # type: ignore[no-untyped-call]
-            n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None
-        )
-        own = (Client(cluster), cluster)  # type: ignore[no-untyped-call]
-        client = own[0]
+    client, own = _client(client, n_workers)
     try:
         # Steps wait here until every earlier region is joined (the joining
         # takes the plan's order); joined ones are dropped.
@@ -556,9 +562,7 @@ def detect_regions(
                 pending.add(submit(nxt, first, False))  # type: ignore[no-untyped-call]
         labels, part_labels, rows, regions_n, widened_n, joins, skipped = join.finish(points)
     finally:
-        if own is not None:
-            own[0].close()  # type: ignore[no-untyped-call]
-            own[1].close()
+        _close(own)
     from ._api import _region_parts
 
     return RegionDetection(
