@@ -123,7 +123,16 @@ def main() -> None:
 
 
 def peak_rss_mib() -> float:
-    """This process's peak RSS (MiB)."""
+    """This process's peak RSS (MiB): Linux's VmHWM, which starts again at
+    exec (getrusage's ru_maxrss does not: a worker process spawned by the
+    driver would report the driver's peak at the time of the spawn)."""
+    try:
+        with open("/proc/self/status") as f:
+            for line in f:
+                if line.startswith("VmHWM:"):
+                    return int(line.split()[1]) / 1024
+    except OSError:
+        pass
     import resource
 
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
