@@ -120,11 +120,10 @@ pub fn run(
             detect_by_regions_with_progress(
                 points,
                 side,
-                |ids| {
-                    let sub: Vec<[f64; 3]> = ids.iter().map(|&i| points[i as usize]).collect();
+                |ids, sub| {
                     let nsub: Option<Vec<[f64; 3]>> =
                         normals.map(|n| ids.iter().map(|&i| n[i as usize]).collect());
-                    options.build(&sub, nsub.as_deref(), Style::Cli)
+                    options.build(sub, nsub.as_deref(), Style::Cli)
                 },
                 &mut |done, total| {
                     bar.set_length(total as u64);

@@ -63,33 +63,17 @@ pub fn detect_regions<'py>(
     let pts = points.as_slice();
     let normals = normals.as_ref().map(|n| n.as_slice());
     let callback = progress.map(progress::Callback::new);
-    let side = match side {
-        Some(s) if !(s.is_finite() && s > 0.0) => {
-            return Err(PyValueError::new_err(format!(
-                "region side {s}: must be positive and finite"
-            )))
-        }
-        Some(s) => Some(s),
-        None => side_for(pts),
-    };
+    let (run_side, side) = region_side(pts, side);
     let run = detached(py, threads, |_| {
-        let region_side = side.unwrap_or(f64::INFINITY);
-        let build = |ids: &[u32]| {
-            let sub: Vec<[f64; 3]> = ids.iter().map(|&i| pts[i as usize]).collect();
+        let build = |ids: &[u32], sub: &[[f64; 3]]| {
             let nsub: Option<Vec<[f64; 3]>> =
                 normals.map(|n| ids.iter().map(|&i| n[i as usize]).collect());
-            options.build(&sub, nsub.as_deref(), aniso_alpha::options::Style::Python)
+            options.build(sub, nsub.as_deref(), aniso_alpha::options::Style::Python)
         };
         let tick = callback.as_ref().map(|cb| cb.tick());
         let mut on_region =
             |done: usize, total: usize| tick.as_ref().is_none_or(|t| t(done, total));
-        // An infinite side is one region: the whole cloud, as `detect`.
-        let side = if region_side.is_finite() {
-            region_side
-        } else {
-            whole_side(pts)
-        };
-        detect_by_regions_with_progress(pts, side, build, &mut on_region).map_err(|e| {
+        detect_by_regions_with_progress(pts, run_side, build, &mut on_region).map_err(|e| {
             callback
                 .as_ref()
                 .and_then(|cb| cb.error(&e))
@@ -147,23 +131,26 @@ pub struct PyRegionPlan {
 pub fn region_plan(points: &Bound<'_, PyAny>, side: Option<f64>) -> PyResult<PyRegionPlan> {
     let points = Points::extract(points)?;
     let pts = points.as_slice();
-    let (side, whole) = match side.map(Some).unwrap_or_else(|| side_for(pts)) {
-        Some(s) => (s, false),
-        None => (whole_side(pts), true),
-    };
+    let (run_side, side) = region_side(pts, side);
     Ok(PyRegionPlan {
-        plan: RegionPlan::new(pts, side).map_err(value_error)?,
-        whole,
+        plan: RegionPlan::new(pts, run_side).map_err(value_error)?,
+        whole: side.is_none(),
     })
 }
 
-/// A side that makes `pts` one region.
-fn whole_side(pts: &[[f64; 3]]) -> f64 {
-    if pts.is_empty() {
-        return 1.0;
+/// The side to run `pts` with and the side to report: `side` when given
+/// (checked by the run), else about 500,000 points a region; a cloud of
+/// about one region runs as one region holding it all, reported as
+/// `None`.
+fn region_side(pts: &[[f64; 3]], side: Option<f64>) -> (f64, Option<f64>) {
+    match side.or_else(|| side_for(pts)) {
+        Some(s) => (s, Some(s)),
+        None if pts.is_empty() => (1.0, None),
+        None => {
+            let (lo, hi) = aniso_alpha::geometry::bounding_box(pts);
+            (2.0 * (hi[0] - lo[0]).max(hi[1] - lo[1]).max(1.0), None)
+        }
     }
-    let (lo, hi) = aniso_alpha::geometry::bounding_box(pts);
-    2.0 * (hi[0] - lo[0]).max(hi[1] - lo[1]).max(1.0)
 }
 
 #[pymethods]

@@ -441,8 +441,9 @@ impl RegionJoin {
     }
 }
 
-/// Detects region by region (module doc). `build(ids)` builds the
-/// detector of the points `ids` (input indices, ascending) from their data
+/// Detects region by region (module doc). `build(ids, sub)` builds the
+/// detector of the points `ids` (input indices, ascending; `sub` their
+/// coordinates, which the region then runs on) from their data
 /// (with [`Detector::auto`] or the options' builder, and the normals of
 /// those points if the cloud has them); `side` is the region side in input
 /// units. Two parts' primitives agree within the detectors' part angle
@@ -453,7 +454,7 @@ impl RegionJoin {
 pub fn detect_by_regions(
     points: &[[f64; 3]],
     side: f64,
-    build: impl FnMut(&[u32]) -> Result<Detector, DetectError>,
+    build: impl FnMut(&[u32], &[[f64; 3]]) -> Result<Detector, DetectError>,
 ) -> Result<RegionRun, DetectError> {
     regions_run(points, side, true, build, &mut |_, _| true)
 }
@@ -467,7 +468,7 @@ pub fn detect_by_regions(
 pub fn detect_by_regions_with_progress(
     points: &[[f64; 3]],
     side: f64,
-    build: impl FnMut(&[u32]) -> Result<Detector, DetectError>,
+    build: impl FnMut(&[u32], &[[f64; 3]]) -> Result<Detector, DetectError>,
     progress: &mut dyn FnMut(usize, usize) -> bool,
 ) -> Result<RegionRun, DetectError> {
     regions_run(points, side, true, build, progress)
@@ -479,7 +480,7 @@ fn regions_run(
     points: &[[f64; 3]],
     side: f64,
     joining: bool,
-    mut build: impl FnMut(&[u32]) -> Result<Detector, DetectError>,
+    mut build: impl FnMut(&[u32], &[[f64; 3]]) -> Result<Detector, DetectError>,
     progress: &mut dyn FnMut(usize, usize) -> bool,
 ) -> Result<RegionRun, DetectError> {
     let plan = RegionPlan::new(points, side)?;
@@ -488,7 +489,8 @@ fn regions_run(
         let mut margin = plan.first_margin();
         let found = loop {
             let ids = plan.points_within(points, r, margin);
-            let detector = match build(&ids) {
+            let sub: Vec<[f64; 3]> = ids.iter().map(|&i| points[i as usize]).collect();
+            let detector = match build(&ids, &sub) {
                 Ok(d) => d,
                 // A region of one position (a stray point, a stack of
                 // copies) has no spacing to estimate: its points are
@@ -497,7 +499,7 @@ fn regions_run(
                 Err(e) => return Err(e),
             };
             match wider_margin(&detector, margin)? {
-                None => break Some((ids, detector)),
+                None => break Some((ids, sub, detector)),
                 Some(m) => {
                     joined.widened();
                     margin = m;
@@ -506,8 +508,7 @@ fn regions_run(
         };
         match found {
             None => joined.add(&[], &[], None)?,
-            Some((ids, detector)) => {
-                let sub: Vec<[f64; 3]> = ids.iter().map(|&i| points[i as usize]).collect();
+            Some((ids, sub, detector)) => {
                 let step = region_step(&detector, &sub)?;
                 drop(sub);
                 joined.add(&ids, plan.core(r), Some(&step))?;
@@ -730,13 +731,12 @@ mod tests {
     }
 
     /// The automatic detector of the points `ids` of `pts`, on one thread.
-    fn build(pts: &[[f64; 3]], ids: &[u32]) -> Result<Detector, DetectError> {
-        let sub: Vec<[f64; 3]> = ids.iter().map(|&i| pts[i as usize]).collect();
-        Ok(Detector::auto(StructureKind::Planes, &sub, &Given::default())?.threads(1))
+    fn build(sub: &[[f64; 3]]) -> Result<Detector, DetectError> {
+        Ok(Detector::auto(StructureKind::Planes, sub, &Given::default())?.threads(1))
     }
 
     fn by_regions(pts: &[[f64; 3]], side: f64) -> RegionRun {
-        detect_by_regions(pts, side, |ids| build(pts, ids)).unwrap()
+        detect_by_regions(pts, side, |_, sub| build(sub)).unwrap()
     }
 
     /// The part most of `ids`' points carry, and its share of them.
@@ -812,18 +812,18 @@ mod tests {
         for r in (0..plan.len()).rev() {
             let mut margin = plan.first_margin();
             let mut widened = false;
-            let (ids, d) = loop {
+            let (ids, sub, d) = loop {
                 let ids = plan.points_within(&pts, r, margin);
-                let d = build(&pts, &ids).unwrap();
+                let sub: Vec<[f64; 3]> = ids.iter().map(|&i| pts[i as usize]).collect();
+                let d = build(&sub).unwrap();
                 match wider_margin(&d, margin).unwrap() {
-                    None => break (ids, d),
+                    None => break (ids, sub, d),
                     Some(m) => {
                         margin = m;
                         widened = true;
                     }
                 }
             };
-            let sub: Vec<[f64; 3]> = ids.iter().map(|&i| pts[i as usize]).collect();
             steps.push((r, ids, region_step(&d, &sub).unwrap(), widened));
         }
         // The joining takes the regions in the plan's order (the numbering
@@ -861,7 +861,7 @@ mod tests {
         // The oracle can fail: without the joining, the ground is one
         // part per region.
         let pts = scene();
-        let run = regions_run(&pts, 40.0, false, |ids| build(&pts, ids), &mut |_, _| true).unwrap();
+        let run = regions_run(&pts, 40.0, false, |_, sub| build(sub), &mut |_, _| true).unwrap();
         assert_eq!(run.joins, 0);
         let ground: Vec<usize> = (0..pts.len()).filter(|&i| pts[i][2].abs() < 0.1).collect();
         let (_, share) = main_part(&run.part_labels, ground.into_iter());
@@ -872,22 +872,17 @@ mod tests {
     fn a_progress_callback_sees_every_region_and_can_cancel() {
         let pts = scene();
         let mut seen = Vec::new();
-        let run = detect_by_regions_with_progress(
-            &pts,
-            60.0,
-            |ids| build(&pts, ids),
-            &mut |done, total| {
+        let run =
+            detect_by_regions_with_progress(&pts, 60.0, |_, sub| build(sub), &mut |done, total| {
                 seen.push((done, total));
                 true
-            },
-        )
-        .unwrap();
+            })
+            .unwrap();
         assert_eq!(run.regions, 4);
         assert_eq!(seen, [(1, 4), (2, 4), (3, 4), (4, 4)]);
-        let r =
-            detect_by_regions_with_progress(&pts, 60.0, |ids| build(&pts, ids), &mut |done, _| {
-                done < 2
-            });
+        let r = detect_by_regions_with_progress(&pts, 60.0, |_, sub| build(sub), &mut |done, _| {
+            done < 2
+        });
         assert!(matches!(r, Err(DetectError::Cancelled)));
     }
 
@@ -905,7 +900,7 @@ mod tests {
     #[test]
     fn a_cloud_of_one_position_per_region_is_the_whole_runs_error() {
         let pts = vec![[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [100.0, 0.0, 0.0]];
-        let r = detect_by_regions(&pts, 10.0, |ids| build(&pts, ids));
+        let r = detect_by_regions(&pts, 10.0, |_, sub| build(sub));
         assert!(matches!(r, Err(DetectError::NoSpacing)), "{r:?}");
     }
 
@@ -913,7 +908,7 @@ mod tests {
     fn a_bad_side_is_an_error() {
         let pts = scene();
         for side in [0.0, -1.0, f64::NAN, f64::INFINITY] {
-            let r = detect_by_regions(&pts, side, |_| unreachable!());
+            let r = detect_by_regions(&pts, side, |_, _| unreachable!());
             assert!(matches!(r, Err(DetectError::BadParameter(_))), "{side}");
         }
     }
