@@ -1,6 +1,7 @@
 //! `aniso-alpha detect`: structures by anisotropic alpha-shapes (method
 //! doc §4, §7, §8).
 
+use std::num::NonZeroUsize;
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
@@ -117,6 +118,10 @@ pub struct DetectArgs {
     /// whole run
     #[arg(long, value_name = "SIDE|auto|off", value_parser = crate::cmd_regions::parse_regions, requires = "input")]
     pub regions: Option<crate::cmd_regions::Regions>,
+    /// Regions detected at once (default: the thread count); each holds
+    /// one region's run in memory, and each runs on all threads
+    #[arg(long, value_name = "N", requires = "input")]
+    pub region_jobs: Option<NonZeroUsize>,
     /// Write one label per input point: its structure id (a polyhedral
     /// surface is one structure), or -1
     #[arg(long, allow_negative_numbers = true, value_name = "OUT.txt")]
@@ -612,18 +617,16 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
             classify: args.classify.map(|c| c.class),
             report: paths.report.as_ref(),
         };
-        let options = options(args, example);
-        return crate::cmd_regions::run(
-            &name,
-            &cloud,
+        let input = crate::cmd_regions::RegionInput {
+            name: &name,
+            cloud: &cloud,
             points,
-            normals.as_deref(),
+            normals: normals.as_deref(),
             keep,
-            &options,
             side,
-            &out,
-            timings,
-        );
+            jobs: args.region_jobs.map_or(0, NonZeroUsize::get),
+        };
+        return crate::cmd_regions::run(&input, &options(args, example), &out, timings);
     }
     let n_input = cloud.points.len();
     let (detector, det, seconds) =

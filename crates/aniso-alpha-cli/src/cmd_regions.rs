@@ -12,7 +12,7 @@ use std::path::PathBuf;
 use aniso_alpha::detect::regions::{detect_by_regions_with_progress, side_for, RegionRun};
 use aniso_alpha::detect::{DetectError, Primitive};
 use aniso_alpha::io::{self, PointCloud};
-use aniso_alpha::options::{DetectOptions, Style};
+use aniso_alpha::options::{region_warnings, DetectOptions, Style};
 use serde_json::json;
 
 use crate::common::{self, CliError, Timings};
@@ -99,20 +99,42 @@ pub struct RegionOutputs<'a> {
     pub report: Option<&'a PathBuf>,
 }
 
-/// The region run on `points` (the input's points at `keep`, or all of
-/// them) with `options`, then its outputs and summary.
-#[allow(clippy::too_many_arguments)]
+/// What a region run detects on: the input, the points it runs on (the
+/// input's points at `keep`, or all of them) and their normals, the
+/// region side and how many regions run at once (0: as many as threads).
+pub struct RegionInput<'a> {
+    /// The input's name, for the summary and the report.
+    pub name: &'a str,
+    /// The input cloud (its attributes go to a labelled `--output`).
+    pub cloud: &'a PointCloud,
+    /// The points detected on.
+    pub points: &'a [[f64; 3]],
+    /// Their normals, if the run uses the file's.
+    pub normals: Option<&'a [[f64; 3]]>,
+    /// The input indices of `points` (`None`: all of them).
+    pub keep: Option<&'a [u32]>,
+    /// The region side (input units).
+    pub side: f64,
+    /// Regions run at once (`--region-jobs`; 0: the thread count).
+    pub jobs: usize,
+}
+
+/// The region run of `input` with `options`, then its outputs and summary.
 pub fn run(
-    name: &str,
-    cloud: &PointCloud,
-    points: &[[f64; 3]],
-    normals: Option<&[[f64; 3]]>,
-    keep: Option<&[u32]>,
+    input: &RegionInput<'_>,
     options: &DetectOptions,
-    side: f64,
     out: &RegionOutputs<'_>,
     timings: &mut Timings,
 ) -> Result<(), CliError> {
+    let RegionInput {
+        name,
+        cloud,
+        points,
+        normals,
+        keep,
+        side,
+        jobs,
+    } = *input;
     let bar = common::progress(0, "regions");
     let start = std::time::Instant::now();
     let run = timings
@@ -120,6 +142,7 @@ pub fn run(
             detect_by_regions_with_progress(
                 points,
                 side,
+                jobs,
                 |ids, sub| {
                     let nsub: Option<Vec<[f64; 3]>> =
                         normals.map(|n| ids.iter().map(|&i| n[i as usize]).collect());
@@ -135,6 +158,9 @@ pub fn run(
         .map_err(|e: DetectError| CliError::msg(e.to_string()))?;
     let seconds = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
+    for w in region_warnings(&run) {
+        common::warn(format_args!("{w}"));
+    }
     let n = cloud.points.len();
     let labels = common::spread(&run.labels, keep, n);
     let part_labels = common::spread(&run.part_labels, keep, n);

@@ -24,9 +24,15 @@ fn run(args: &[&str]) -> Output {
 /// face over 25..55 × 20..35 (across the region border x = 40 of
 /// 40-unit regions), written as x y z.
 fn scene(path: &Path) -> usize {
+    let rows = scene_rows();
+    std::fs::write(path, rows.join("\n") + "\n").unwrap();
+    rows.len()
+}
+
+/// [`scene`]'s rows, x y z.
+fn scene_rows() -> Vec<String> {
     let mut rng = SplitMix64::new(3);
-    let mut s = String::new();
-    let mut n = 0;
+    let mut rows = Vec::new();
     for iy in 0..100 {
         for ix in 0..100 {
             let (x, y) = (
@@ -35,12 +41,17 @@ fn scene(path: &Path) -> usize {
             );
             let roof = (25.0..55.0).contains(&x) && (20.0..35.0).contains(&y);
             let z = if roof { 6.0 + 0.4 * (y - 20.0) } else { 0.0 };
-            s.push_str(&format!("{x} {y} {}\n", z + 0.02 * (rng.uniform() - 0.5)));
-            n += 1;
+            rows.push(format!("{x} {y} {}", z + 0.02 * (rng.uniform() - 0.5)));
         }
     }
-    std::fs::write(path, s).unwrap();
-    n
+    rows
+}
+
+/// `detect INPUT --structure planes ARGS…`.
+fn detect_planes(input: &Path, args: &[&str]) -> Output {
+    let mut all = vec!["detect", input.to_str().unwrap(), "--structure", "planes"];
+    all.extend_from_slice(args);
+    run(&all)
 }
 
 fn ints(path: &Path) -> Vec<i64> {
@@ -57,22 +68,21 @@ fn regions_label_every_point_and_join_the_ground_across_borders() {
     let input = d.path("scene.xyz");
     let n = scene(&input);
     let (labels, parts, report) = (d.path("l.txt"), d.path("p.txt"), d.path("r.json"));
-    let o = run(&[
-        "detect",
-        input.to_str().unwrap(),
-        "--structure",
-        "planes",
-        "--regions",
-        "40",
-        "--labels",
-        labels.to_str().unwrap(),
-        "--part-labels",
-        parts.to_str().unwrap(),
-        "--report",
-        report.to_str().unwrap(),
-        "--threads",
-        "1",
-    ]);
+    let o = detect_planes(
+        &input,
+        &[
+            "--regions",
+            "40",
+            "--labels",
+            labels.to_str().unwrap(),
+            "--part-labels",
+            parts.to_str().unwrap(),
+            "--report",
+            report.to_str().unwrap(),
+            "--threads",
+            "1",
+        ],
+    );
     assert_eq!(
         o.status.code(),
         Some(0),
@@ -110,6 +120,25 @@ fn regions_label_every_point_and_join_the_ground_across_borders() {
         "{same} of {}",
         roof.len()
     );
+    // Nine regions at once on two threads: the same labels.
+    let (l2, p2) = (d.path("l2.txt"), d.path("p2.txt"));
+    let o = detect_planes(
+        &input,
+        &[
+            "--regions",
+            "40",
+            "--region-jobs",
+            "9",
+            "--threads",
+            "2",
+            "--labels",
+            l2.to_str().unwrap(),
+            "--part-labels",
+            p2.to_str().unwrap(),
+        ],
+    );
+    assert_eq!(o.status.code(), Some(0));
+    assert_eq!((ints(&l2), ints(&p2)), (l, p));
 }
 
 #[test]
@@ -118,46 +147,60 @@ fn regions_refuse_the_outputs_of_a_whole_run_and_off_runs_whole() {
     let input = d.path("scene.xyz");
     scene(&input);
     let html = d.path("v.html");
-    let o = run(&[
-        "detect",
-        input.to_str().unwrap(),
-        "--structure",
-        "planes",
-        "--regions",
-        "40",
-        "--html",
-        html.to_str().unwrap(),
-    ]);
+    let o = detect_planes(
+        &input,
+        &["--regions", "40", "--html", html.to_str().unwrap()],
+    );
     assert_eq!(o.status.code(), Some(1));
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("--html needs a whole run"), "{err}");
     assert!(!html.exists());
     for bad in ["0", "-3", "nan", "sometimes"] {
-        let o = run(&[
-            "detect",
-            input.to_str().unwrap(),
-            "--structure",
-            "planes",
-            "--regions",
-            bad,
-        ]);
+        let o = detect_planes(&input, &["--regions", bad]);
         assert_eq!(o.status.code(), Some(2), "{bad}");
     }
+    let o = detect_planes(&input, &["--regions", "40", "--region-jobs", "0"]);
+    assert_eq!(o.status.code(), Some(2));
     // `off` and a small cloud under `auto`: the whole run's summary.
     for mode in ["off", "auto"] {
-        let o = run(&[
-            "detect",
-            input.to_str().unwrap(),
-            "--structure",
-            "planes",
-            "--regions",
-            mode,
-            "--threads",
-            "1",
-        ]);
+        let o = detect_planes(&input, &["--regions", mode, "--threads", "1"]);
         assert_eq!(o.status.code(), Some(0));
         let out = String::from_utf8_lossy(&o.stdout);
         assert!(out.contains("structure  part  kind"), "{mode}: {out}");
         assert!(!out.contains("region(s)"), "{mode}: {out}");
     }
+}
+
+#[test]
+fn regions_warn_once_for_normals_that_disagree() {
+    // Every point given the normal 1 0 0 (a ground and a roof): no region
+    // uses them, and one warning says so for all nine.
+    let d = TempDir::new("regions", "normals");
+    let rows = scene_rows();
+    let body: Vec<String> = rows.iter().map(|r| format!("{r} 1 0 0")).collect();
+    let ply = format!(
+        "ply\nformat ascii 1.0\nelement vertex {}\nproperty double x\nproperty double y\n\
+         property double z\nproperty float nx\nproperty float ny\nproperty float nz\nend_header\n{}\n",
+        body.len(),
+        body.join("\n")
+    );
+    let input = d.path("scene.ply");
+    std::fs::write(&input, ply).unwrap();
+    let o = detect_planes(&input, &["--regions", "40", "--threads", "1"]);
+    assert_eq!(o.status.code(), Some(0));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(err.matches("normals disagree").count(), 1, "{err}");
+    assert!(err.contains("in 9 of 9 region(s)"), "{err}");
+    // Normals that agree (0 0 1 on the ground, most of the points): no warning.
+    let body: Vec<String> = rows.iter().map(|r| format!("{r} 0 0 1")).collect();
+    let ply = format!(
+        "ply\nformat ascii 1.0\nelement vertex {}\nproperty double x\nproperty double y\n\
+         property double z\nproperty float nx\nproperty float ny\nproperty float nz\nend_header\n{}\n",
+        body.len(),
+        body.join("\n")
+    );
+    std::fs::write(&input, ply).unwrap();
+    let o = detect_planes(&input, &["--regions", "40", "--threads", "1"]);
+    assert_eq!(o.status.code(), Some(0));
+    assert!(!String::from_utf8_lossy(&o.stderr).contains("normals disagree"));
 }

@@ -8,6 +8,7 @@ use aniso_alpha::detect::regions::{
 };
 use aniso_alpha::detect::DetectError;
 use aniso_alpha::detect::Primitive;
+use aniso_alpha::options::region_warnings;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -36,6 +37,7 @@ type RegionsOut<'py> = (
     usize,
     usize,
     usize,
+    Vec<String>,
 );
 
 /// The detection region by region (docs/method.md §8 "Regions"): regions of
@@ -44,7 +46,7 @@ type RegionsOut<'py> = (
 /// `threads` and `progress` (called after each region; `False` cancels)
 /// as for `detect`.
 #[pyfunction]
-#[pyo3(signature = (points, structure, side = None, options = None, threads = None, normals = None, progress = None))]
+#[pyo3(signature = (points, structure, side = None, options = None, threads = None, normals = None, progress = None, jobs = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn detect_regions<'py>(
     py: Python<'py>,
@@ -55,8 +57,14 @@ pub fn detect_regions<'py>(
     threads: Option<i64>,
     normals: Option<&Bound<'py, PyAny>>,
     progress: Option<Py<PyAny>>,
+    jobs: Option<i64>,
 ) -> PyResult<RegionsOut<'py>> {
     let options = options::detect_options(structure, options)?;
+    let jobs = match jobs {
+        None => 0,
+        Some(j) if j >= 1 => j as usize,
+        Some(j) => return Err(value_error(format!("jobs {j}: must be at least 1"))),
+    };
     let points = Points::extract(points)?;
     let normals = normals.map(extract_normals).transpose()?;
     let threads = thread_count(threads)?;
@@ -73,7 +81,7 @@ pub fn detect_regions<'py>(
         let tick = callback.as_ref().map(|cb| cb.tick());
         let mut on_region =
             |done: usize, total: usize| tick.as_ref().is_none_or(|t| t(done, total));
-        detect_by_regions_with_progress(pts, run_side, build, &mut on_region).map_err(|e| {
+        detect_by_regions_with_progress(pts, run_side, jobs, build, &mut on_region).map_err(|e| {
             callback
                 .as_ref()
                 .and_then(|cb| cb.error(&e))
@@ -81,6 +89,7 @@ pub fn detect_regions<'py>(
         })
     })?;
     let parts = part_rows(&run);
+    let warnings = region_warnings(&run);
     Ok((
         run.labels.into_pyarray(py),
         run.part_labels.into_pyarray(py),
@@ -90,6 +99,7 @@ pub fn detect_regions<'py>(
         run.widened,
         run.joins,
         run.skipped,
+        warnings,
     ))
 }
 
@@ -212,7 +222,7 @@ impl PyRegionPlan {
 /// position, `("wider", margin, None)` when its estimate
 /// reaches past its margin, or `("step", margin, (part int64, structure
 /// int64, part structures uint32, part axes float64 (p, 3) NaN when not
-/// fitted, structures, part angle, lines))`.
+/// fitted, structures, part angle, lines, normals ignored))`.
 type StepArrays<'py> = (
     Bound<'py, PyArray1<i64>>,
     Bound<'py, PyArray1<i64>>,
@@ -220,6 +230,7 @@ type StepArrays<'py> = (
     Bound<'py, PyArray2<f64>>,
     u32,
     f64,
+    bool,
     bool,
 );
 
@@ -275,6 +286,7 @@ pub fn region_task<'py>(
                 st.structures,
                 st.part_angle,
                 st.lines,
+                st.normals_ignored,
             )
         }),
     ))
@@ -289,6 +301,7 @@ type StepIn<'py> = (
     PyReadonlyArray2<'py, f64>,
     u32,
     f64,
+    bool,
     bool,
 );
 
@@ -326,7 +339,7 @@ impl PyRegionJoin {
     ) -> PyResult<()> {
         let step = match step {
             None => None,
-            Some((part, structure, ps, axes, structures, part_angle, lines)) => {
+            Some((part, structure, ps, axes, structures, part_angle, lines, normals_ignored)) => {
                 let axes = axes.as_array();
                 let ps = ps.as_slice()?;
                 if axes.shape() != [ps.len(), 3] {
@@ -349,6 +362,7 @@ impl PyRegionJoin {
                     structures,
                     part_angle,
                     lines,
+                    normals_ignored,
                 })
             }
         };
@@ -360,7 +374,7 @@ impl PyRegionJoin {
     }
 
     /// The joined run over `points`: (labels, part_labels, parts, regions,
-    /// widened, joins, skipped), as `detect_regions` gives them.
+    /// widened, joins, skipped, warnings), as `detect_regions` gives them.
     #[allow(clippy::type_complexity)]
     fn finish<'py>(
         &mut self,
@@ -374,6 +388,7 @@ impl PyRegionJoin {
         usize,
         usize,
         usize,
+        Vec<String>,
     )> {
         let join = self
             .join
@@ -383,6 +398,7 @@ impl PyRegionJoin {
         let pts = points.as_slice();
         let run = detached(py, 1, |_| join.finish(pts).map_err(value_error))?;
         let parts = part_rows(&run);
+        let warnings = region_warnings(&run);
         Ok((
             run.labels.into_pyarray(py),
             run.part_labels.into_pyarray(py),
@@ -391,6 +407,7 @@ impl PyRegionJoin {
             run.widened,
             run.joins,
             run.skipped,
+            warnings,
         ))
     }
 }

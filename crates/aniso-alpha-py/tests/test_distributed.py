@@ -276,6 +276,12 @@ def test_regions_equal_in_process(client):
     np.testing.assert_array_equal(whole.part_labels, aa.detect(pts, "planes").part_labels)
     with pytest.raises(ValueError, match="region side"):
         distributed.detect_regions(pts, "planes", side=0.0, client=client)
+    # Normals that no region uses: the tasks say so, and the driver warns
+    # once, as in process.
+    wrong = np.tile([1.0, 0.0, 0.0], (len(pts), 1))
+    with pytest.warns(aa.AnisoAlphaWarning, match="in 6 of 6 region"):
+        r = distributed.detect_regions(pts, "planes", side=30.0, normals=wrong, client=client)
+    assert len(r.warnings) == 1
 
 
 def test_a_region_whose_worker_is_killed_gives_the_same_labels(tmp_path):

@@ -2,6 +2,8 @@
 "Regions"): a plane across regions is one part, a small cloud runs whole
 with detect's labels, progress per region, errors."""
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -48,6 +50,35 @@ def test_progress_per_region_and_false_cancels(ground_and_roof):
     assert calls == [(1, 4), (2, 4), (3, 4), (4, 4)]
     with pytest.raises(RuntimeError, match="cancelled"):
         aa.detect_regions(pts, "planes", side=45.0, threads=1, progress=lambda d, t: False)
+
+
+def test_regions_at_once_give_the_same_run(ground_and_roof):
+    # Six regions one at a time, and all at once on two threads (each
+    # progress call still in the plan's order): the same labels and parts.
+    pts, _ = ground_and_roof
+    one = aa.detect_regions(pts, "planes", side=30.0, threads=1, jobs=1)
+    calls = []
+    many = aa.detect_regions(
+        pts, "planes", side=30.0, threads=2, jobs=6, progress=lambda d, t: calls.append((d, t))
+    )
+    np.testing.assert_array_equal(many.labels, one.labels)
+    np.testing.assert_array_equal(many.part_labels, one.part_labels)
+    assert [(p.points, p.pieces) for p in many.parts] == [(p.points, p.pieces) for p in one.parts]
+    assert calls == [(d, 6) for d in range(1, 7)]
+    with pytest.raises(ValueError, match="jobs 0"):
+        aa.detect_regions(pts, "planes", side=30.0, jobs=0)
+
+
+def test_normals_that_disagree_warn_once_for_the_regions(ground_and_roof):
+    pts, _ = ground_and_roof
+    wrong = np.tile([1.0, 0.0, 0.0], (len(pts), 1))
+    with pytest.warns(aa.AnisoAlphaWarning, match="normals disagree with its points in 6 of 6 region") as w:
+        r = aa.detect_regions(pts, "planes", side=30.0, threads=1, normals=wrong)
+    assert len(w) == 1 and r.warnings == [str(w[0].message)]
+    up = np.tile([0.0, 0.0, 1.0], (len(pts), 1))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert aa.detect_regions(pts, "planes", side=30.0, threads=1, normals=up).warnings == []
 
 
 @pytest.mark.parametrize("side", [0.0, -2.0, float("nan"), float("inf")])

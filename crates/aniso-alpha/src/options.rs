@@ -335,6 +335,21 @@ pub fn run_warnings(
     out
 }
 
+/// The warnings of a region run: regions whose detector did not use the
+/// normals given with the points.
+pub fn region_warnings(run: &crate::detect::regions::RegionRun) -> Vec<String> {
+    let mut out = Vec::new();
+    if run.normals_ignored > 0 {
+        out.push(format!(
+            "the input's normals disagree with its points in {} of {} region(s): fewer than half of \
+             a region's locally planar points have their given normal within 25 degrees of their \
+             neighbourhood's; normals estimated there instead",
+            run.normals_ignored, run.regions
+        ));
+    }
+    out
+}
+
 /// Point insertions (points × orientations) above which a run is
 /// announced as long: at roughly a microsecond each, about half an hour
 /// of one core.

@@ -33,6 +33,39 @@ pub(crate) fn map_ranges<T: Send, S>(
     }
 }
 
+/// The threads of the current pool (1 without the `parallel` feature).
+pub(crate) fn threads() -> usize {
+    #[cfg(feature = "parallel")]
+    {
+        rayon::current_num_threads().max(1)
+    }
+    #[cfg(not(feature = "parallel"))]
+    {
+        1
+    }
+}
+
+/// `worker()` as `copies` tasks on the current pool, returning when every
+/// one has returned (without the `parallel` feature, once on this thread:
+/// a worker that takes items from a shared queue until it is empty then
+/// does all the work).
+pub(crate) fn spawn_workers(copies: usize, worker: impl Fn() + Sync) {
+    #[cfg(feature = "parallel")]
+    {
+        let worker = &worker;
+        rayon::scope(|s| {
+            for _ in 0..copies.max(1) {
+                s.spawn(move |_| worker());
+            }
+        });
+    }
+    #[cfg(not(feature = "parallel"))]
+    {
+        let _ = copies;
+        worker();
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::map_ranges;

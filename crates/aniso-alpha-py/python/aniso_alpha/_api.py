@@ -350,14 +350,15 @@ def detect_regions(
     ignore_normals: bool = False,
     threads: Optional[int] = None,
     progress: Optional[Callable[[int, int], Optional[bool]]] = None,
+    jobs: Optional[int] = None,
 ) -> RegionDetection:
     """:func:`detect` region by region, for clouds of millions of points
     (what ``aniso-alpha detect`` does by default above 1,000,000 points,
     docs/method.md §8 "Regions"): the x-y extent is cut into square
     regions, each detected on its points and a margin with its own
     parameters from its data, and the parts that cross a border are joined
-    through the points both regions labelled. The peak memory is one
-    region's run, not the whole cloud's.
+    through the points both regions labelled. The peak memory is that of
+    ``jobs`` regions' runs, not the whole cloud's.
 
     Args:
         points: as for :func:`detect`.
@@ -370,6 +371,9 @@ def detect_regions(
             every region.
         progress: called as ``progress(done, total)`` after each region;
             ``False`` cancels (``RuntimeError``).
+        jobs: regions detected at once (default: ``threads``); each holds
+            one region's run in memory and runs on all the threads. The
+            result is the same for any value.
 
     Returns:
         a :class:`RegionDetection`: per-point ``labels`` and
@@ -398,11 +402,12 @@ def detect_regions(
         step=step,
         epsilon=epsilon,
     )
-    labels, part_labels, rows, used, regions, widened, joins, skipped = _native.detect_regions(
-        pts, structure, side, options, threads, nrm, progress
+    labels, part_labels, rows, used, regions, widened, joins, skipped, messages = _native.detect_regions(
+        pts, structure, side, options, threads, nrm, progress, jobs
     )
+    _warn(messages)
     return RegionDetection(
-        labels, part_labels, _region_parts(rows, structure), used, regions, widened, joins, skipped
+        labels, part_labels, _region_parts(rows, structure), used, regions, widened, joins, skipped, messages
     )
 
 

@@ -51,8 +51,9 @@ def detect_regions(
     threads: Optional[int] = None,
     normals: Optional[ArrayLike] = None,
     progress: Optional[Callable[[int, int], Optional[bool]]] = None,
-) -> Tuple[NDArray[np.int64], NDArray[np.int64], List[_PartRow], Optional[float], int, int, int, int]:
-    """(labels, part_labels, parts, side used, regions, widened, joins, skipped)."""
+    jobs: Optional[int] = None,
+) -> Tuple[NDArray[np.int64], NDArray[np.int64], List[_PartRow], Optional[float], int, int, int, int, List[str]]:
+    """(labels, part_labels, parts, side used, regions, widened, joins, skipped, warnings)."""
 
 class RegionPlan:
     """The regions of a cloud (aniso_alpha.distributed.detect_regions)."""
@@ -68,7 +69,7 @@ class RegionPlan:
 def region_plan(points: ArrayLike, side: Optional[float] = None) -> RegionPlan: ...
 
 _StepArrays = Tuple[
-    NDArray[np.int64], NDArray[np.int64], NDArray[np.uint32], NDArray[np.float64], int, float, bool
+    NDArray[np.int64], NDArray[np.int64], NDArray[np.uint32], NDArray[np.float64], int, float, bool, bool
 ]
 
 def region_task(
@@ -91,7 +92,7 @@ class RegionJoin:
     ) -> None: ...
     def finish(
         self, points: ArrayLike
-    ) -> Tuple[NDArray[np.int64], NDArray[np.int64], List[_PartRow], int, int, int, int]: ...
+    ) -> Tuple[NDArray[np.int64], NDArray[np.int64], List[_PartRow], int, int, int, int, List[str]]: ...
 
 class Plan:
     """A split detection run (aniso_alpha.distributed); made by `plan`."""

@@ -243,6 +243,9 @@ class RegionDetection:
         joins: region parts joined across borders.
         skipped: regions whose points are all at one position (no spacing
             to estimate from), left as background.
+        warnings: what the CLI prints as warnings (also raised as
+            :class:`AnisoAlphaWarning`): regions that did not use the
+            normals given with the points.
     """
 
     labels: NDArray[np.int64]
@@ -253,3 +256,4 @@ class RegionDetection:
     widened: int = 0
     joins: int = 0
     skipped: int = 0
+    warnings: List[str] = field(default_factory=list)

@@ -560,11 +560,20 @@ def detect_regions(
             nxt = next(regions, None)
             if nxt is not None:
                 pending.add(submit(nxt, first, False))  # type: ignore[no-untyped-call]
-        labels, part_labels, rows, regions_n, widened_n, joins, skipped = join.finish(points)
+        labels, part_labels, rows, regions_n, widened_n, joins, skipped, messages = join.finish(points)
     finally:
         _close(own)
     from ._api import _region_parts
 
+    _warn(messages)
     return RegionDetection(
-        labels, part_labels, _region_parts(rows, structure), plan.side, regions_n, widened_n, joins, skipped
+        labels,
+        part_labels,
+        _region_parts(rows, structure),
+        plan.side,
+        regions_n,
+        widened_n,
+        joins,
+        skipped,
+        messages,
     )

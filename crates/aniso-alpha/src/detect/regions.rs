@@ -32,8 +32,13 @@
 //! 5. **Numbering.** Joined parts and structures are numbered by their
 //!    number of points, largest first (ties by first region).
 //!
-//! Memory: the cloud, two labels per point and one region's run at a time
-//! (its triangulations and assembly, which dominate a whole run's peak).
+//! Regions run as tasks on the current thread pool, up to `jobs` at once
+//! (by default as many as there are threads), each parallel inside: a
+//! region's serial stages overlap another's.
+//!
+//! Memory: the cloud, two labels per point and up to `jobs` regions' runs
+//! at a time (their triangulations and assembly, which dominate a whole
+//! run's peak), with the steps of regions done ahead of their turn.
 //! Deterministic: a region's result depends on its own points (in input
 //! order) only, and the joining takes the regions in the plan's order.
 
@@ -42,6 +47,8 @@ use super::scan::halo_width;
 use super::{DetectError, Detector};
 use crate::unionfind::UnionFind;
 use std::collections::{BTreeMap, HashMap};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Mutex;
 
 /// The share of a part's doubly labelled points that must lie in another
 /// part for the two to be joined: a majority, as in the assembly's
@@ -96,6 +103,10 @@ pub struct RegionRun {
     /// Regions whose points are all at one position (no spacing to
     /// estimate from): their points are background.
     pub skipped: usize,
+    /// Regions whose detector did not use the normals given with the
+    /// points (they disagree with the region's geometry: normals estimated
+    /// there instead).
+    pub normals_ignored: usize,
 }
 
 /// The side of square regions holding about [`REGION_POINTS`] points each
@@ -261,6 +272,9 @@ pub struct RegionStep {
     pub part_angle: f64,
     /// Lines (k = 1) rather than planes.
     pub lines: bool,
+    /// The normals given with the points were not used (they disagree
+    /// with the region's geometry).
+    pub normals_ignored: bool,
 }
 
 /// Runs `detector` on a region's points `sub` (its core and margin, in
@@ -270,7 +284,9 @@ pub struct RegionStep {
 /// As [`Detector::run`].
 pub fn region_step(detector: &Detector, sub: &[[f64; 3]]) -> Result<RegionStep, DetectError> {
     let det = detector.run(sub)?;
-    Ok(step_of(&det, detector.part_angle_degrees()))
+    let mut step = step_of(&det, detector.part_angle_degrees());
+    step.normals_ignored = detector.given_normals().is_some_and(|g| !g.used);
+    Ok(step)
 }
 
 /// A plane's normal or a line's direction.
@@ -297,6 +313,7 @@ fn step_of(det: &Detection, part_angle: f64) -> RegionStep {
         structures: det.structures.len() as u32,
         part_angle,
         lines: det.kind == super::StructureKind::Lines,
+        normals_ignored: false,
     }
 }
 
@@ -313,6 +330,7 @@ pub struct RegionJoin {
     lines: bool,
     widened: usize,
     skipped: usize,
+    normals_ignored: usize,
 }
 
 /// What one region's run leaves for the joining: per region part, its
@@ -336,6 +354,7 @@ impl RegionJoin {
             lines: false,
             widened: 0,
             skipped: 0,
+            normals_ignored: 0,
         }
     }
 
@@ -399,6 +418,7 @@ impl RegionJoin {
         self.n_structures += step.structures;
         self.angle = self.angle.max(step.part_angle);
         self.lines |= step.lines;
+        self.normals_ignored += usize::from(step.normals_ignored);
         self.results.push(RegionResult { parts, margin });
         Ok(())
     }
@@ -437,6 +457,7 @@ impl RegionJoin {
             widened: self.widened,
             joins,
             skipped: self.skipped,
+            normals_ignored: self.normals_ignored,
         })
     }
 }
@@ -454,13 +475,15 @@ impl RegionJoin {
 pub fn detect_by_regions(
     points: &[[f64; 3]],
     side: f64,
-    build: impl FnMut(&[u32], &[[f64; 3]]) -> Result<Detector, DetectError>,
+    build: impl Fn(&[u32], &[[f64; 3]]) -> Result<Detector, DetectError> + Sync,
 ) -> Result<RegionRun, DetectError> {
-    regions_run(points, side, true, build, &mut |_, _| true)
+    regions_run(points, side, true, 0, build, &mut |_, _| true)
 }
 
-/// [`detect_by_regions`], calling `progress(done, total)` after each
-/// region; `false` returned cancels the run.
+/// [`detect_by_regions`] with up to `jobs` regions running at once (0:
+/// as many as the current pool has threads), calling `progress(done,
+/// total)` after each region joined (in the plan's order); `false`
+/// returned cancels the run.
 ///
 /// # Errors
 /// As [`detect_by_regions`]; [`DetectError::Cancelled`] when `progress`
@@ -468,57 +491,152 @@ pub fn detect_by_regions(
 pub fn detect_by_regions_with_progress(
     points: &[[f64; 3]],
     side: f64,
-    build: impl FnMut(&[u32], &[[f64; 3]]) -> Result<Detector, DetectError>,
-    progress: &mut dyn FnMut(usize, usize) -> bool,
+    jobs: usize,
+    build: impl Fn(&[u32], &[[f64; 3]]) -> Result<Detector, DetectError> + Sync,
+    progress: &mut (dyn FnMut(usize, usize) -> bool + Send),
 ) -> Result<RegionRun, DetectError> {
-    regions_run(points, side, true, build, progress)
+    regions_run(points, side, true, jobs, build, progress)
+}
+
+/// One region's run as the joining takes it: its points (core and margin,
+/// ascending), its step (`None`: a region of one position), and how many
+/// times its margin was widened.
+struct RegionDone {
+    ids: Vec<u32>,
+    step: Option<RegionStep>,
+    widened: usize,
+}
+
+/// Region `r`'s run (module doc, steps 1–2): its detector built on its
+/// core and first margin, estimated again on a wider margin while its
+/// reach asks for one, then run.
+fn run_region(
+    plan: &RegionPlan,
+    points: &[[f64; 3]],
+    r: usize,
+    build: &(impl Fn(&[u32], &[[f64; 3]]) -> Result<Detector, DetectError> + Sync),
+) -> Result<RegionDone, DetectError> {
+    let mut margin = plan.first_margin();
+    let mut widened = 0;
+    loop {
+        let ids = plan.points_within(points, r, margin);
+        let sub: Vec<[f64; 3]> = ids.iter().map(|&i| points[i as usize]).collect();
+        let detector = match build(&ids, &sub) {
+            Ok(d) => d,
+            // A region of one position (a stray point, a stack of copies)
+            // has no spacing to estimate: its points are background, as a
+            // whole run leaves an isolated point.
+            Err(DetectError::NoSpacing) => {
+                return Ok(RegionDone {
+                    ids: Vec::new(),
+                    step: None,
+                    widened,
+                })
+            }
+            Err(e) => return Err(e),
+        };
+        match wider_margin(&detector, margin)? {
+            None => {
+                let step = region_step(&detector, &sub)?;
+                return Ok(RegionDone {
+                    ids,
+                    step: Some(step),
+                    widened,
+                });
+            }
+            Some(m) => {
+                widened += 1;
+                margin = m;
+            }
+        }
+    }
+}
+
+/// The joining side of a run whose regions finish in any order: the
+/// regions done ahead of their turn wait in `pending`, and each is added
+/// to the join in the plan's order.
+struct InOrder<'a> {
+    joined: RegionJoin,
+    pending: BTreeMap<usize, RegionDone>,
+    next: usize,
+    progress: &'a mut (dyn FnMut(usize, usize) -> bool + Send),
+    /// The first failure met (region, error).
+    failed: Option<(usize, DetectError)>,
+}
+
+impl InOrder<'_> {
+    /// Takes region `r`'s run and adds every region whose turn has come.
+    fn take(&mut self, plan: &RegionPlan, r: usize, done: RegionDone) -> Result<(), DetectError> {
+        self.pending.insert(r, done);
+        while let Some(d) = self.pending.remove(&self.next) {
+            for _ in 0..d.widened {
+                self.joined.widened();
+            }
+            match &d.step {
+                None => self.joined.add(&[], &[], None)?,
+                Some(step) => self.joined.add(&d.ids, plan.core(self.next), Some(step))?,
+            }
+            self.next += 1;
+            if !(self.progress)(self.next, plan.len()) {
+                return Err(DetectError::Cancelled);
+            }
+        }
+        Ok(())
+    }
 }
 
 /// [`detect_by_regions`], with or without the joining of step 4 (without:
-/// each region's parts stay apart).
+/// each region's parts stay apart). The regions run as tasks on the
+/// current pool, up to `jobs` at once, each of them parallel inside; a
+/// region's result does not depend on which ran first, and the joining
+/// takes them in the plan's order, so the run is the same for any `jobs`
+/// and any number of threads.
 fn regions_run(
     points: &[[f64; 3]],
     side: f64,
     joining: bool,
-    mut build: impl FnMut(&[u32], &[[f64; 3]]) -> Result<Detector, DetectError>,
-    progress: &mut dyn FnMut(usize, usize) -> bool,
+    jobs: usize,
+    build: impl Fn(&[u32], &[[f64; 3]]) -> Result<Detector, DetectError> + Sync,
+    progress: &mut (dyn FnMut(usize, usize) -> bool + Send),
 ) -> Result<RegionRun, DetectError> {
     let plan = RegionPlan::new(points, side)?;
-    let mut joined = RegionJoin::new(points.len());
-    for r in 0..plan.len() {
-        let mut margin = plan.first_margin();
-        let found = loop {
-            let ids = plan.points_within(points, r, margin);
-            let sub: Vec<[f64; 3]> = ids.iter().map(|&i| points[i as usize]).collect();
-            let detector = match build(&ids, &sub) {
-                Ok(d) => d,
-                // A region of one position (a stray point, a stack of
-                // copies) has no spacing to estimate: its points are
-                // background, as a whole run leaves an isolated point.
-                Err(DetectError::NoSpacing) => break None,
-                Err(e) => return Err(e),
-            };
-            match wider_margin(&detector, margin)? {
-                None => break Some((ids, sub, detector)),
-                Some(m) => {
-                    joined.widened();
-                    margin = m;
+    let jobs = if jobs == 0 {
+        crate::par::threads()
+    } else {
+        jobs
+    }
+    .clamp(1, plan.len());
+    let state = Mutex::new(InOrder {
+        joined: RegionJoin::new(points.len()),
+        pending: BTreeMap::new(),
+        next: 0,
+        progress,
+        failed: None,
+    });
+    let next_region = AtomicUsize::new(0);
+    let stop = AtomicBool::new(false);
+    let worker = || {
+        while !stop.load(Ordering::Relaxed) {
+            let r = next_region.fetch_add(1, Ordering::Relaxed);
+            if r >= plan.len() {
+                return;
+            }
+            let done = run_region(&plan, points, r, &build);
+            let mut st = state.lock().unwrap_or_else(|p| p.into_inner());
+            if let Err(e) = done.and_then(|d| st.take(&plan, r, d)) {
+                stop.store(true, Ordering::Relaxed);
+                if st.failed.as_ref().is_none_or(|(f, _)| r < *f) {
+                    st.failed = Some((r, e));
                 }
             }
-        };
-        match found {
-            None => joined.add(&[], &[], None)?,
-            Some((ids, sub, detector)) => {
-                let step = region_step(&detector, &sub)?;
-                drop(sub);
-                joined.add(&ids, plan.core(r), Some(&step))?;
-            }
         }
-        if !progress(r + 1, plan.len()) {
-            return Err(DetectError::Cancelled);
-        }
+    };
+    crate::par::spawn_workers(jobs, worker);
+    let st = state.into_inner().unwrap_or_else(|p| p.into_inner());
+    if let Some((_, e)) = st.failed {
+        return Err(e);
     }
-    joined.finish_with(points, joining)
+    st.joined.finish_with(points, joining)
 }
 
 /// Whether two axes (planes: normals; lines: directions) agree within
@@ -861,7 +979,7 @@ mod tests {
         // The oracle can fail: without the joining, the ground is one
         // part per region.
         let pts = scene();
-        let run = regions_run(&pts, 40.0, false, |_, sub| build(sub), &mut |_, _| true).unwrap();
+        let run = regions_run(&pts, 40.0, false, 0, |_, sub| build(sub), &mut |_, _| true).unwrap();
         assert_eq!(run.joins, 0);
         let ground: Vec<usize> = (0..pts.len()).filter(|&i| pts[i][2].abs() < 0.1).collect();
         let (_, share) = main_part(&run.part_labels, ground.into_iter());
@@ -871,19 +989,88 @@ mod tests {
     #[test]
     fn a_progress_callback_sees_every_region_and_can_cancel() {
         let pts = scene();
-        let mut seen = Vec::new();
-        let run =
-            detect_by_regions_with_progress(&pts, 60.0, |_, sub| build(sub), &mut |done, total| {
-                seen.push((done, total));
-                true
-            })
+        for jobs in [1, 3] {
+            let mut seen = Vec::new();
+            let run = detect_by_regions_with_progress(
+                &pts,
+                60.0,
+                jobs,
+                |_, sub| build(sub),
+                &mut |done, total| {
+                    seen.push((done, total));
+                    true
+                },
+            )
             .unwrap();
-        assert_eq!(run.regions, 4);
-        assert_eq!(seen, [(1, 4), (2, 4), (3, 4), (4, 4)]);
-        let r = detect_by_regions_with_progress(&pts, 60.0, |_, sub| build(sub), &mut |done, _| {
-            done < 2
-        });
-        assert!(matches!(r, Err(DetectError::Cancelled)));
+            assert_eq!(run.regions, 4);
+            // In the plan's order, whichever region finished first.
+            assert_eq!(seen, [(1, 4), (2, 4), (3, 4), (4, 4)]);
+            let r = detect_by_regions_with_progress(
+                &pts,
+                60.0,
+                jobs,
+                |_, sub| build(sub),
+                &mut |done, _| done < 2,
+            );
+            assert!(matches!(r, Err(DetectError::Cancelled)));
+        }
+    }
+
+    #[test]
+    fn regions_run_at_once_give_the_run_of_one_at_a_time() {
+        // Every region finishing in any order, on pools of 1 and 2
+        // threads (one thread: the region tasks take turns): the same run.
+        let pts = scene();
+        let one =
+            detect_by_regions_with_progress(&pts, 40.0, 1, |_, sub| build(sub), &mut |_, _| true)
+                .unwrap();
+        assert_eq!(one.regions, 9);
+        for (threads, jobs) in [(1, 9), (2, 2), (2, 9)] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let run = pool
+                .install(|| {
+                    detect_by_regions_with_progress(
+                        &pts,
+                        40.0,
+                        jobs,
+                        |_, sub| build(sub),
+                        &mut |_, _| true,
+                    )
+                })
+                .unwrap();
+            assert_eq!(run.labels, one.labels, "{threads} threads, {jobs} jobs");
+            assert_eq!(run.part_labels, one.part_labels);
+            assert_eq!(run.parts, one.parts);
+            assert_eq!((run.widened, run.joins), (one.widened, one.joins));
+        }
+    }
+
+    #[test]
+    fn the_first_failing_region_is_the_error() {
+        // A build refuses any region holding a core point of region 3 or
+        // 5 (theirs and their neighbours', through the margins): with 4
+        // regions at once, the run stops with that error, whichever region
+        // met it first, and no labels come back.
+        let pts = scene();
+        let plan = RegionPlan::new(&pts, 40.0).unwrap();
+        let bad: Vec<u32> = [3usize, 5].iter().map(|&r| plan.core(r)[0]).collect();
+        let r = detect_by_regions_with_progress(
+            &pts,
+            40.0,
+            4,
+            |ids, sub| {
+                if bad.iter().any(|b| ids.binary_search(b).is_ok()) {
+                    Err(DetectError::BadParameter("region refused".into()))
+                } else {
+                    build(sub)
+                }
+            },
+            &mut |_, _| true,
+        );
+        assert!(matches!(r, Err(DetectError::BadParameter(m)) if m == "region refused"));
     }
 
     #[test]
