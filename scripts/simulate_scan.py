@@ -209,7 +209,32 @@ def _rotated_box_walls(s, c, R, lx, ly, h, lab):
     return lab
 
 
-def airborne(rng):
+def _strip(rng, rs, labs, size, along, across, shift, sense):
+    """The points of one strip over the block: scan lines `along` apart
+    (shifted by `shift`), `across` between points on a line, the sweep's
+    slant in the direction `sense`; with their labels."""
+    import open3d as o3d
+
+    H = 300.0
+    xs = np.arange(-5, size + 5, across)
+    rows = np.arange(-5, size + 5, along) + shift
+    X, Y = np.meshgrid(xs, rows)
+    # The sweep's slant: each line drifts one line spacing along y over the swath.
+    Y = Y + sense * along * (X - X.min()) / (X.max() - X.min()) * np.where(np.arange(len(rows)) % 2 == 0, 1, -1)[:, None]
+    X = X + rng.normal(0, across * 0.05, X.shape)
+    target = np.stack([X.ravel(), Y.ravel(), np.zeros(X.size)], -1)
+    origin = np.stack([np.full(X.size, size / 2), Y.ravel(), np.full(X.size, H)], -1)
+    d = target - origin
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    ans = rs.cast_rays(o3d.core.Tensor(np.hstack([origin, d]).astype(np.float32)))
+    th_ = ans["t_hit"].numpy().astype(float)
+    pid = ans["primitive_ids"].numpy()
+    ok = np.isfinite(th_)
+    r = th_[ok] + rng.normal(0, 0.03, ok.sum())
+    return origin[ok] + r[:, None] * d[ok], labs[pid[ok]]
+
+
+def airborne(rng, strips=1):
     s = Scene()
     lab = 0
     size = 120.0
@@ -238,32 +263,22 @@ def airborne(rng):
         for side in (-1, 1):
             eave = np.r_[c + R @ [-lx / 2, side * ly / 2], h]
             s.quad(eave, np.r_[R @ [lx, 0], 0], np.r_[R @ [0, -side * ly / 2], hr], lab); lab += 1
-    # One strip along y, 300 m up, sweeping across track (a zig-zag).
+    # Strips along y, 300 m up, sweeping across track (a zig-zag); a
+    # second strip flies the other way over the same block, its lines
+    # shifted by a random part of the line spacing (the overlap of two
+    # strips, where points of the two come in near pairs).
     along = rng.uniform(0.8, 1.4)
     across = rng.uniform(0.3, 0.5)
-    H = 300.0
-    xs = np.arange(-5, size + 5, across)
-    rows = np.arange(-5, size + 5, along)
-    X, Y = np.meshgrid(xs, rows)
-    # The sweep's slant: each line drifts one line spacing along y over the swath.
-    Y = Y + along * (X - X.min()) / (X.max() - X.min()) * np.where(np.arange(len(rows)) % 2 == 0, 1, -1)[:, None]
-    X = X + rng.normal(0, across * 0.05, X.shape)
-    target = np.stack([X.ravel(), Y.ravel(), np.zeros(X.size)], -1)
-    origin = np.stack([np.full(X.size, size / 2), Y.ravel(), np.full(X.size, H)], -1)
     import open3d as o3d
 
     v, t, labs = s.arrays()
     rs = o3d.t.geometry.RaycastingScene()
     rs.add_triangles(o3d.core.Tensor(v.astype(np.float32)), o3d.core.Tensor(t.astype(np.uint32)))
-    d = target - origin
-    d /= np.linalg.norm(d, axis=1)[:, None]
-    ans = rs.cast_rays(o3d.core.Tensor(np.hstack([origin, d]).astype(np.float32)))
-    th_ = ans["t_hit"].numpy().astype(float)
-    pid = ans["primitive_ids"].numpy()
-    ok = np.isfinite(th_)
-    r = th_[ok] + rng.normal(0, 0.03, ok.sum())
-    pts = origin[ok] + r[:, None] * d[ok]
-    labels = labs[pid[ok]]
+    parts = [_strip(rng, rs, labs, size, along, across, 0.0, 1.0)]
+    for _ in range(1, strips):
+        parts.append(_strip(rng, rs, labs, size, along, across, rng.uniform(0, along), -1.0))
+    pts = np.vstack([p for p, _ in parts])
+    labels = np.concatenate([l for _, l in parts])
     # Trees: blobs of foliage points above the ground.
     trees = []
     for cx, cy in rng.uniform(5, size - 5, (8, 2)):
@@ -307,9 +322,11 @@ def main():
     ap.add_argument("scene", choices=["room", "house", "airborne", "street"])
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--output", required=True)
+    ap.add_argument("--strips", type=int, default=1, help="airborne: overlapping flight strips (default 1)")
     a = ap.parse_args()
     rng = np.random.default_rng(a.seed)
-    pts, labels = {"room": room, "house": house, "airborne": airborne, "street": street}[a.scene](rng)
+    scenes = {"room": room, "house": house, "airborne": lambda r: airborne(r, a.strips), "street": street}
+    pts, labels = scenes[a.scene](rng)
     # Shuffle (scanner order would make every neighbour query trivial).
     perm = rng.permutation(len(pts))
     pts, labels = pts[perm], labels[perm]
