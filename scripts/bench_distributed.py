@@ -22,12 +22,23 @@ threads (default: all cores). Prints one Markdown table row per run.
 driver joins) against the in-process `aa.detect_regions` instead, and
 gives the peak RSS of the driver (this process: run with
 `--no-reference` for the driver's own figure) and of the workers.
+
+`--regions --tiling SCAN K --per-file G` runs it on a tiling of a real
+tile instead of the town: SCAN (a PLY, e.g. the corpus's AHN tile) copied
+K x K times edge to edge, written as LAS files of G x G copies each (in
+`--workdir`, kept for the next run), the source the list of files, as a
+user's survey would come; the driver reads them (no in-process
+reference). `--memory-limit` gives each worker Dask's memory limit.
+
+    .venv/bin/python scripts/bench_distributed.py --regions --workers 2 \
+        --tiling ahn_2386_9702.ply 48 --per-file 8 --memory-limit 3GiB
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import sys
 import time
 
 import numpy as np
@@ -76,6 +87,11 @@ def main() -> None:
     ap.add_argument("--tile", type=float, default=None, help="tile side (default: distributed's)")
     ap.add_argument("--no-reference", action="store_true", help="skip the in-process run")
     ap.add_argument("--regions", action="store_true", help="detect_regions instead of the tiled detect")
+    ap.add_argument("--tiling", nargs=2, metavar=("SCAN", "K"), default=None,
+                    help="with --regions: a K x K tiling of a real tile (PLY) as LAS files")
+    ap.add_argument("--per-file", type=int, default=8, help="copies per side in each LAS file of --tiling")
+    ap.add_argument("--workdir", default="/tmp/aa_tiling", help="where --tiling writes its files")
+    ap.add_argument("--memory-limit", default=None, help="each worker's Dask memory limit (e.g. 3GiB)")
     args = ap.parse_args()
     if args.regions:
         return regions(args)
@@ -138,6 +154,61 @@ def peak_rss_mib() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 
 
+def tiling(scan: str, k: int, per_file: int, workdir: str) -> list:
+    """SCAN copied k x k times edge to edge (each copy shifted by the
+    tile's x-y extent), as LAS files of per_file x per_file copies each
+    (written once: files already there are kept); their paths."""
+    import laspy
+
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "corpus"))
+    from common import read_ply
+
+    v = read_ply(scan)
+    xyz = np.stack([v["x"], v["y"], v["z"]], 1).astype(np.float64)
+    lo, hi = xyz.min(axis=0), xyz.max(axis=0)
+    step = (hi - lo)[:2] + 1.0
+    os.makedirs(workdir, exist_ok=True)
+    paths = []
+    for fi in range(0, k, per_file):
+        for fj in range(0, k, per_file):
+            path = os.path.join(workdir, f"{os.path.basename(scan)[:-4]}_{k}_{fi}_{fj}.las")
+            paths.append(path)
+            if os.path.exists(path):
+                continue
+            blocks = []
+            for i in range(fi, min(fi + per_file, k)):
+                for j in range(fj, min(fj + per_file, k)):
+                    blocks.append(xyz + [i * step[0], j * step[1], 0.0])
+            pts = np.vstack(blocks)
+            header = laspy.LasHeader(point_format=1, version="1.2")
+            header.offsets = lo
+            header.scales = [0.001, 0.001, 0.001]
+            las = laspy.LasData(header)
+            las.x, las.y, las.z = pts[:, 0], pts[:, 1], pts[:, 2]
+            las.write(path + ".part")
+            os.replace(path + ".part", path)
+    return paths
+
+
+def tiling_f1(scan: str, pred: np.ndarray) -> float:
+    """Per-point plane F1 of a tiling's part labels against the tile's
+    plane labels (every copy is the tile's points in its order), one copy
+    at a time."""
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "corpus"))
+    from common import read_ply
+
+    truth = read_ply(scan)["plane"].astype(np.int64) >= 0
+    m = len(truth)
+    tp = fp = fn = 0
+    for c in range(len(pred) // m):
+        got = pred[c * m : (c + 1) * m] >= 0
+        tp += int(np.sum(truth & got))
+        fp += int(np.sum(~truth & got))
+        fn += int(np.sum(truth & ~got))
+    p, r = tp / max(tp + fp, 1), tp / max(tp + fn, 1)
+    return 2 * p * r / max(p + r, 1e-12)
+
+
 def regions(args: argparse.Namespace) -> None:
     """The `--regions` table: distributed.detect_regions against
     aa.detect_regions."""
@@ -148,18 +219,28 @@ def regions(args: argparse.Namespace) -> None:
     print(f"load average before: {os.getloadavg()[0]:.2f}, cores: {os.cpu_count()}")
     print("| points | run | wall s | regions | parts | driver peak RSS MiB | worker peak RSS MiB | same labels |")
     print("|---:|---|---:|---:|---:|---:|---:|---|")
-    for size in args.sizes:
-        pts = town(int(size))
-        n = len(pts)
+    sources = [None] if args.tiling else args.sizes
+    for size in sources:
+        if args.tiling:
+            # Written by a child process, so that the driver's peak RSS is
+            # the run's.
+            from concurrent.futures import ProcessPoolExecutor
+
+            with ProcessPoolExecutor(1) as ex:
+                pts = ex.submit(tiling, args.tiling[0], int(args.tiling[1]), args.per_file, args.workdir).result()
+            print(f"tiling: {len(pts)} LAS files in {args.workdir}", flush=True)
+        else:
+            pts = town(int(size))
         ref = None
-        if not args.no_reference:
+        if not args.no_reference and not args.tiling:
             t0 = time.perf_counter()
             ref = aa.detect_regions(pts, "planes", threads=args.threads)
             t = time.perf_counter() - t0
             print(f"| {n:,} | in-process ({args.threads or os.cpu_count()} threads) | {t:.1f} | {ref.regions} "
                   f"| {len(ref.parts)} | {peak_rss_mib():.0f} | | |", flush=True)
         for w in args.workers:
-            cluster = LocalCluster(n_workers=w, threads_per_worker=1, processes=True, dashboard_address=None)
+            cluster = LocalCluster(n_workers=w, threads_per_worker=1, processes=True, dashboard_address=None,
+                                   memory_limit=args.memory_limit or "auto")
             client = Client(cluster)
             try:
                 t0 = time.perf_counter()
@@ -171,8 +252,11 @@ def regions(args: argparse.Namespace) -> None:
                 cluster.close()
             same = "" if ref is None else (
                 "yes" if np.array_equal(r.part_labels, ref.part_labels) else "**NO**")
+            n = len(r.labels)
             print(f"| {n:,} | {w} worker(s) | {t:.1f} | {r.regions} | {len(r.parts)} | {peak_rss_mib():.0f} "
                   f"| {max(workers.values()):.0f} | {same} |", flush=True)
+            if args.tiling:
+                print(f"plane F1 of the copies: {tiling_f1(args.tiling[0], r.part_labels):.3f}", flush=True)
     print(f"load average after: {os.getloadavg()[0]:.2f}")
 
 

@@ -162,8 +162,43 @@ impl PyDetection {
 
 /// The normals of a call (an array-like of shape (n, 3)); a `ValueError`
 /// naming them otherwise.
-pub(crate) fn extract_normals<'py>(n: &Bound<'py, PyAny>) -> PyResult<Points<'py>> {
+fn extract_normals<'py>(n: &Bound<'py, PyAny>) -> PyResult<Points<'py>> {
     Points::extract(n).map_err(|e| PyValueError::new_err(format!("normals: {e}")))
+}
+
+/// A detection's input from Python: its points, their normals if given,
+/// and the thread count, each checked.
+pub(crate) struct DetectInput<'py> {
+    points: Points<'py>,
+    normals: Option<Points<'py>>,
+    /// The threads of the call's pool.
+    pub threads: usize,
+}
+
+impl<'py> DetectInput<'py> {
+    /// Extracts the points, the normals (`ValueError` naming them) and
+    /// the thread count.
+    pub(crate) fn extract(
+        points: &Bound<'py, PyAny>,
+        normals: Option<&Bound<'py, PyAny>>,
+        threads: Option<i64>,
+    ) -> PyResult<Self> {
+        Ok(DetectInput {
+            points: Points::extract(points)?,
+            normals: normals.map(extract_normals).transpose()?,
+            threads: thread_count(threads)?,
+        })
+    }
+
+    /// The points.
+    pub(crate) fn points(&self) -> &[[f64; 3]] {
+        self.points.as_slice()
+    }
+
+    /// The normals, if given.
+    pub(crate) fn normals(&self) -> Option<&[[f64; 3]]> {
+        self.normals.as_ref().map(|n| n.as_slice())
+    }
 }
 
 /// Structure detection (docs/method.md §4): `structure` is "lines" or
@@ -188,11 +223,8 @@ fn detect<'py>(
     progress: Option<Py<PyAny>>,
 ) -> PyResult<DetectOut<'py>> {
     let options = options::detect_options(structure, options)?;
-    let points = Points::extract(points)?;
-    let normals = normals.map(extract_normals).transpose()?;
-    let threads = thread_count(threads)?;
-    let pts = points.as_slice();
-    let normals = normals.as_ref().map(|n| n.as_slice());
+    let input = DetectInput::extract(points, normals, threads)?;
+    let (pts, normals, threads) = (input.points(), input.normals(), input.threads);
     // The whole call (estimation included) runs on the pool of `detached`,
     // which the library's parallel loops use: no `Detector::threads`, which
     // would start a second pool.

@@ -16,8 +16,8 @@ use pyo3::types::PyDict;
 
 use crate::convert::Points;
 use crate::errors::value_error;
-use crate::run::{detached, thread_count};
-use crate::{extract_normals, options, progress};
+use crate::run::detached;
+use crate::{options, progress, DetectInput};
 
 /// One joined part: id, structure, points, pieces, then a plane's
 /// `[a, b, c, d]` (and nothing) or a line's direction (and a point on it),
@@ -65,11 +65,8 @@ pub fn detect_regions<'py>(
         Some(j) if j >= 1 => j as usize,
         Some(j) => return Err(value_error(format!("jobs {j}: must be at least 1"))),
     };
-    let points = Points::extract(points)?;
-    let normals = normals.map(extract_normals).transpose()?;
-    let threads = thread_count(threads)?;
-    let pts = points.as_slice();
-    let normals = normals.as_ref().map(|n| n.as_slice());
+    let input = DetectInput::extract(points, normals, threads)?;
+    let (pts, normals, threads) = (input.points(), input.normals(), input.threads);
     let callback = progress.map(progress::Callback::new);
     let (run_side, side) = region_side(pts, side);
     let run = detached(py, threads, |_| {
@@ -250,11 +247,8 @@ pub fn region_task<'py>(
     threads: Option<i64>,
 ) -> PyResult<(&'static str, f64, Option<StepArrays<'py>>)> {
     let options = options::detect_options(structure, options)?;
-    let points = Points::extract(points)?;
-    let normals = normals.map(extract_normals).transpose()?;
-    let threads = thread_count(threads)?;
-    let pts = points.as_slice();
-    let normals = normals.as_ref().map(|n| n.as_slice());
+    let input = DetectInput::extract(points, normals, threads)?;
+    let (pts, normals, threads) = (input.points(), input.normals(), input.threads);
     let out = detached(py, threads, |_| {
         let detector = match options.build(pts, normals, aniso_alpha::options::Style::Python) {
             Ok(d) => d,

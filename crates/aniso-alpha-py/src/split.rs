@@ -17,7 +17,7 @@ use pyo3::prelude::*;
 use crate::convert::{rows_to_numpy, Points};
 use crate::errors::value_error;
 use crate::run::{detached, thread_count};
-use crate::{extract_normals, options, DetectOut, PyDetection};
+use crate::{options, DetectInput, DetectOut, PyDetection};
 use aniso_alpha::options::{run_warnings, Style};
 use pyo3::types::PyDict;
 
@@ -44,11 +44,8 @@ pub fn plan(
     normals: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<PyPlan> {
     let options = options::detect_options(structure, options)?;
-    let points = Points::extract(points)?;
-    let normals = normals.map(extract_normals).transpose()?;
-    let threads = thread_count(threads)?;
-    let pts = points.as_slice();
-    let normals = normals.as_ref().map(|n| n.as_slice());
+    let input = DetectInput::extract(points, normals, threads)?;
+    let (pts, normals, threads) = (input.points(), input.normals(), input.threads);
     let (plan, warnings) = detached(py, threads, |n| {
         let detector = options::build(&options, pts, normals)?;
         let warnings = run_warnings(&options, &detector, pts.len(), n, Style::Python);

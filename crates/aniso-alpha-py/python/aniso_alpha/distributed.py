@@ -81,9 +81,19 @@ def load(source: Source) -> np.ndarray:
     if isinstance(source, (list, tuple)) and source and all(
         isinstance(s, (str, os.PathLike)) for s in source
     ):
-        return np.ascontiguousarray(
-            np.concatenate([read(s, attributes=False).points for s in source])
-        )
+        # Each tile copied into one array and dropped as it goes: the
+        # array's pages are touched as they are written, so the peak is
+        # about the points once, not twice.
+        tiles = [read(s, attributes=False).points for s in source]
+        out = np.empty((sum(len(t) for t in tiles), 3), dtype=np.float64)
+        at = 0
+        tiles.reverse()
+        while tiles:
+            t = tiles.pop()
+            out[at : at + len(t)] = t
+            at += len(t)
+            del t
+        return out
     if hasattr(source, "compute") and hasattr(source, "chunks"):
         source = source.compute()
     a = np.ascontiguousarray(source, dtype=np.float64)
