@@ -29,6 +29,22 @@ fn scene(path: &Path) -> usize {
     rows.len()
 }
 
+/// [`scene`] as an ASCII PLY whose every point has the normal `normal`
+/// ("nx ny nz").
+fn scene_with_normal(path: &Path, normal: &str) {
+    let body: Vec<String> = scene_rows()
+        .iter()
+        .map(|r| format!("{r} {normal}"))
+        .collect();
+    let ply = format!(
+        "ply\nformat ascii 1.0\nelement vertex {}\nproperty double x\nproperty double y\n\
+         property double z\nproperty float nx\nproperty float ny\nproperty float nz\nend_header\n{}\n",
+        body.len(),
+        body.join("\n")
+    );
+    std::fs::write(path, ply).unwrap();
+}
+
 /// [`scene`]'s rows, x y z.
 fn scene_rows() -> Vec<String> {
     let mut rng = SplitMix64::new(3);
@@ -54,6 +70,37 @@ fn detect_planes(input: &Path, args: &[&str]) -> Output {
     run(&all)
 }
 
+/// `detect --regions 40` on `input` with `args`, writing labels and part
+/// labels (files named after `tag` in `d`): the output and both labels.
+fn labelled_run(
+    d: &TempDir,
+    input: &Path,
+    tag: &str,
+    args: &[&str],
+) -> (Output, Vec<i64>, Vec<i64>) {
+    let (labels, parts) = (
+        d.path(&format!("{tag}-l.txt")),
+        d.path(&format!("{tag}-p.txt")),
+    );
+    let mut all = vec![
+        "--regions",
+        "40",
+        "--labels",
+        labels.to_str().unwrap(),
+        "--part-labels",
+        parts.to_str().unwrap(),
+    ];
+    all.extend_from_slice(args);
+    let o = detect_planes(input, &all);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    (o, ints(&labels), ints(&parts))
+}
+
 fn ints(path: &Path) -> Vec<i64> {
     std::fs::read_to_string(path)
         .unwrap()
@@ -67,31 +114,15 @@ fn regions_label_every_point_and_join_the_ground_across_borders() {
     let d = TempDir::new("regions", "run");
     let input = d.path("scene.xyz");
     let n = scene(&input);
-    let (labels, parts, report) = (d.path("l.txt"), d.path("p.txt"), d.path("r.json"));
-    let o = detect_planes(
+    let report = d.path("r.json");
+    let (o, l, p) = labelled_run(
+        &d,
         &input,
-        &[
-            "--regions",
-            "40",
-            "--labels",
-            labels.to_str().unwrap(),
-            "--part-labels",
-            parts.to_str().unwrap(),
-            "--report",
-            report.to_str().unwrap(),
-            "--threads",
-            "1",
-        ],
-    );
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
+        "one",
+        &["--report", report.to_str().unwrap(), "--threads", "1"],
     );
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(out.contains("9 region(s) of side 40"), "{out}");
-    let (l, p) = (ints(&labels), ints(&parts));
     assert_eq!((l.len(), p.len()), (n, n));
     let r: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
@@ -121,24 +152,13 @@ fn regions_label_every_point_and_join_the_ground_across_borders() {
         roof.len()
     );
     // Nine regions at once on two threads: the same labels.
-    let (l2, p2) = (d.path("l2.txt"), d.path("p2.txt"));
-    let o = detect_planes(
+    let (_, l2, p2) = labelled_run(
+        &d,
         &input,
-        &[
-            "--regions",
-            "40",
-            "--region-jobs",
-            "9",
-            "--threads",
-            "2",
-            "--labels",
-            l2.to_str().unwrap(),
-            "--part-labels",
-            p2.to_str().unwrap(),
-        ],
+        "nine",
+        &["--region-jobs", "9", "--threads", "2"],
     );
-    assert_eq!(o.status.code(), Some(0));
-    assert_eq!((ints(&l2), ints(&p2)), (l, p));
+    assert_eq!((l2, p2), (l, p));
 }
 
 #[test]
@@ -176,30 +196,15 @@ fn regions_warn_once_for_normals_that_disagree() {
     // Every point given the normal 1 0 0 (a ground and a roof): no region
     // uses them, and one warning says so for all nine.
     let d = TempDir::new("regions", "normals");
-    let rows = scene_rows();
-    let body: Vec<String> = rows.iter().map(|r| format!("{r} 1 0 0")).collect();
-    let ply = format!(
-        "ply\nformat ascii 1.0\nelement vertex {}\nproperty double x\nproperty double y\n\
-         property double z\nproperty float nx\nproperty float ny\nproperty float nz\nend_header\n{}\n",
-        body.len(),
-        body.join("\n")
-    );
     let input = d.path("scene.ply");
-    std::fs::write(&input, ply).unwrap();
+    scene_with_normal(&input, "1 0 0");
     let o = detect_planes(&input, &["--regions", "40", "--threads", "1"]);
     assert_eq!(o.status.code(), Some(0));
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(err.matches("normals disagree").count(), 1, "{err}");
     assert!(err.contains("in 9 of 9 region(s)"), "{err}");
     // Normals that agree (0 0 1 on the ground, most of the points): no warning.
-    let body: Vec<String> = rows.iter().map(|r| format!("{r} 0 0 1")).collect();
-    let ply = format!(
-        "ply\nformat ascii 1.0\nelement vertex {}\nproperty double x\nproperty double y\n\
-         property double z\nproperty float nx\nproperty float ny\nproperty float nz\nend_header\n{}\n",
-        body.len(),
-        body.join("\n")
-    );
-    std::fs::write(&input, ply).unwrap();
+    scene_with_normal(&input, "0 0 1");
     let o = detect_planes(&input, &["--regions", "40", "--threads", "1"]);
     assert_eq!(o.status.code(), Some(0));
     assert!(!String::from_utf8_lossy(&o.stderr).contains("normals disagree"));

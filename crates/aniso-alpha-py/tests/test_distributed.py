@@ -123,6 +123,7 @@ def test_a_list_of_las_tiles(client, tmp_path):
     write_las(paths[1], east)
     whole = np.vstack([aa.read(p).points for p in paths])
     assert whole.shape == pts.shape
+    np.testing.assert_array_equal(distributed.load([str(p) for p in paths]), whole)
     ref = aa.detect(whole, "planes")
     det = distributed.detect([str(p) for p in paths], "planes", tile=3.0, client=client)
     assert_same(det, ref)
