@@ -97,48 +97,59 @@ pub fn modes(axes: &[[f64; 3]], h: f64, min_support: usize) -> Vec<Mode> {
             f(s, sign);
         });
     };
-    let density: Vec<u32> = samples
-        .iter()
-        .map(|&a| {
+    // Each sample's density, then each seed's climb: independent per
+    // sample, so parallel, and in the samples' order whatever the threads.
+    let density: Vec<u32> = crate::par::map_ranges(
+        ns,
+        || (),
+        |_, i| {
             let mut c = 0u32;
-            neighbours(a, &mut |_, _| c += 1);
+            neighbours(samples[i], &mut |_, _| c += 1);
             c
-        })
-        .collect();
-    let mut found: Vec<Mode> = Vec::new();
-    for (i, &a) in samples.iter().enumerate() {
+        },
+    );
+    let seed = |i: usize| {
         let mut peak = true;
-        neighbours(a, &mut |s, _| {
+        neighbours(samples[i], &mut |s, _| {
             if density[s] > density[i] || (density[s] == density[i] && s < i) {
                 peak = false;
             }
         });
-        if !peak {
-            continue;
-        }
-        // Mean shift from the seed.
-        let mut m = a;
-        for _ in 0..50 {
-            let mut sum = [0.0; 3];
-            neighbours(m, &mut |s, sign| {
-                for k in 0..3 {
-                    sum[k] += sign * samples[s][k];
+        peak
+    };
+    let seeds: Vec<usize> = crate::par::map_ranges(ns, || (), |_, i| seed(i))
+        .into_iter()
+        .enumerate()
+        .filter_map(|(i, peak)| peak.then_some(i))
+        .collect();
+    let mut found: Vec<Mode> = crate::par::map_ranges(
+        seeds.len(),
+        || (),
+        |_, k| {
+            // Mean shift from the seed.
+            let mut m = samples[seeds[k]];
+            for _ in 0..50 {
+                let mut sum = [0.0; 3];
+                neighbours(m, &mut |s, sign| {
+                    for k in 0..3 {
+                        sum[k] += sign * samples[s][k];
+                    }
+                });
+                let Some(next) = unit(sum) else { break };
+                let moved = dot(next, m).clamp(-1.0, 1.0).acos();
+                m = next;
+                if moved < 0.01f64.to_radians() {
+                    break;
                 }
-            });
-            let Some(next) = unit(sum) else { break };
-            let moved = dot(next, m).clamp(-1.0, 1.0).acos();
-            m = next;
-            if moved < 0.01f64.to_radians() {
-                break;
             }
-        }
-        let mut support = 0usize;
-        neighbours(m, &mut |_, _| support += 1);
-        found.push(Mode {
-            axis: canonical(m),
-            support: (support as f64 * scale).round() as usize,
-        });
-    }
+            let mut support = 0usize;
+            neighbours(m, &mut |_, _| support += 1);
+            Mode {
+                axis: canonical(m),
+                support: (support as f64 * scale).round() as usize,
+            }
+        },
+    );
     // Densest first (ties by axis, for determinism); merge close ones.
     found.sort_by(|a, b| {
         b.support.cmp(&a.support).then(
