@@ -143,11 +143,7 @@ pub fn run(
                 points,
                 side,
                 jobs,
-                |ids, sub| {
-                    let nsub: Option<Vec<[f64; 3]>> =
-                        normals.map(|n| ids.iter().map(|&i| n[i as usize]).collect());
-                    options.build(sub, nsub.as_deref(), Style::Cli)
-                },
+                |ids, sub| options.build_region(ids, sub, normals, Style::Cli),
                 &mut |done, total| {
                     bar.set_length(total as u64);
                     bar.set_position(done as u64);

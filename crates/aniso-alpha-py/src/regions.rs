@@ -24,15 +24,13 @@ use crate::{options, progress, DetectInput};
 /// and its RMS distance.
 type PartRow = (u32, u32, usize, usize, Vec<f64>, Vec<f64>, f64);
 
-/// What `detect_regions` returns: structure and part labels (int64 (n,)),
-/// the joined parts, the region side (`None`: one whole run, the cloud
-/// being about one region) and the region count, widenings, joins and
-/// regions of one position left as background.
-type RegionsOut<'py> = (
+/// A region run as Python takes it: structure and part labels (int64
+/// (n,)), the joined parts, the region count, widenings, joins, regions
+/// of one position left as background, and the run's warnings.
+type RunOut<'py> = (
     Bound<'py, PyArray1<i64>>,
     Bound<'py, PyArray1<i64>>,
     Vec<PartRow>,
-    Option<f64>,
     usize,
     usize,
     usize,
@@ -40,11 +38,28 @@ type RegionsOut<'py> = (
     Vec<String>,
 );
 
+/// [`RunOut`] of `run`.
+fn run_out(py: Python<'_>, run: RegionRun) -> RunOut<'_> {
+    let parts = part_rows(&run);
+    let warnings = region_warnings(&run);
+    (
+        run.labels.into_pyarray(py),
+        run.part_labels.into_pyarray(py),
+        parts,
+        run.regions,
+        run.widened,
+        run.joins,
+        run.skipped,
+        warnings,
+    )
+}
+
 /// The detection region by region (docs/method.md §8 "Regions"): regions of
 /// side `side` (input units), or of about 500,000 points when `side` is
 /// `None`; a cloud of about one region runs whole. `options`, `normals`,
 /// `threads` and `progress` (called after each region; `False` cancels)
-/// as for `detect`.
+/// as for `detect`. Returns the run ([`RunOut`]) and the region side
+/// (`None`: one whole run, the cloud being about one region).
 #[pyfunction]
 #[pyo3(signature = (points, structure, side = None, options = None, threads = None, normals = None, progress = None, jobs = None))]
 #[allow(clippy::too_many_arguments)]
@@ -58,7 +73,7 @@ pub fn detect_regions<'py>(
     normals: Option<&Bound<'py, PyAny>>,
     progress: Option<Py<PyAny>>,
     jobs: Option<i64>,
-) -> PyResult<RegionsOut<'py>> {
+) -> PyResult<(RunOut<'py>, Option<f64>)> {
     let options = options::detect_options(structure, options)?;
     let jobs = match jobs {
         None => 0,
@@ -71,9 +86,7 @@ pub fn detect_regions<'py>(
     let (run_side, side) = region_side(pts, side);
     let run = detached(py, threads, |_| {
         let build = |ids: &[u32], sub: &[[f64; 3]]| {
-            let nsub: Option<Vec<[f64; 3]>> =
-                normals.map(|n| ids.iter().map(|&i| n[i as usize]).collect());
-            options.build(sub, nsub.as_deref(), aniso_alpha::options::Style::Python)
+            options.build_region(ids, sub, normals, aniso_alpha::options::Style::Python)
         };
         let tick = callback.as_ref().map(|cb| cb.tick());
         let mut on_region =
@@ -85,19 +98,7 @@ pub fn detect_regions<'py>(
                 .unwrap_or_else(|| value_error(e))
         })
     })?;
-    let parts = part_rows(&run);
-    let warnings = region_warnings(&run);
-    Ok((
-        run.labels.into_pyarray(py),
-        run.part_labels.into_pyarray(py),
-        parts,
-        side,
-        run.regions,
-        run.widened,
-        run.joins,
-        run.skipped,
-        warnings,
-    ))
+    Ok((run_out(py, run), side))
 }
 
 /// The joined parts of a region run as rows ([`PartRow`]).
@@ -367,23 +368,13 @@ impl PyRegionJoin {
             .map_err(value_error)
     }
 
-    /// The joined run over `points`: (labels, part_labels, parts, regions,
-    /// widened, joins, skipped, warnings), as `detect_regions` gives them.
-    #[allow(clippy::type_complexity)]
+    /// The joined run over `points` ([`RunOut`]), as `detect_regions`
+    /// gives it.
     fn finish<'py>(
         &mut self,
         py: Python<'py>,
         points: &Bound<'py, PyAny>,
-    ) -> PyResult<(
-        Bound<'py, PyArray1<i64>>,
-        Bound<'py, PyArray1<i64>>,
-        Vec<PartRow>,
-        usize,
-        usize,
-        usize,
-        usize,
-        Vec<String>,
-    )> {
+    ) -> PyResult<RunOut<'py>> {
         let join = self
             .join
             .take()
@@ -391,18 +382,7 @@ impl PyRegionJoin {
         let points = Points::extract(points)?;
         let pts = points.as_slice();
         let run = detached(py, 1, |_| join.finish(pts).map_err(value_error))?;
-        let parts = part_rows(&run);
-        let warnings = region_warnings(&run);
-        Ok((
-            run.labels.into_pyarray(py),
-            run.part_labels.into_pyarray(py),
-            parts,
-            run.regions,
-            run.widened,
-            run.joins,
-            run.skipped,
-            warnings,
-        ))
+        Ok(run_out(py, run))
     }
 }
 

@@ -3,6 +3,7 @@ worker processes gives aa.detect's result, with tiles smaller than the
 structures (so structures cross tile borders and must come out whole), from
 every kind of source (array, point file, list of LAS tiles, Dask array)."""
 
+import contextlib
 import os
 import struct
 
@@ -193,11 +194,13 @@ def test_normals_equal_in_process(client):
         distributed.detect(pts, "planes", tile=2.0, client=client, normals=normals[:5])
 
 
+@contextlib.contextmanager
 def killing_cluster(marker, always=False, task="_run_tile"):
-    """A 2-process LocalCluster whose workers kill their own process when a
-    task (a tile's, or ``task``) starts: once (the first task of the run,
-    the marker file records it) or every time (``always``). The nannies
-    start a new worker in its place, as a cluster's would."""
+    """A client of a 2-process LocalCluster whose workers kill their own
+    process when a task (a tile's, or ``task``) starts: once (the first
+    task of the run, the marker file records it) or every time
+    (``always``). The nannies start a new worker in its place, as a
+    cluster's would. Both are closed on leaving."""
     from dask.distributed import Client, LocalCluster, WorkerPlugin
 
     class KillOnTile(WorkerPlugin):  # defined here: pickled by value
@@ -217,8 +220,12 @@ def killing_cluster(marker, always=False, task="_run_tile"):
         n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
     )
     c = Client(cluster)
-    c.register_plugin(KillOnTile())
-    return c, cluster
+    try:
+        c.register_plugin(KillOnTile())
+        yield c
+    finally:
+        c.close()
+        cluster.close()
 
 
 def test_a_worker_killed_mid_run_gives_the_same_labels(tmp_path):
@@ -227,25 +234,17 @@ def test_a_worker_killed_mid_run_gives_the_same_labels(tmp_path):
     pts = room(11)
     ref = aa.detect(pts, "planes")
     marker = tmp_path / "killed"
-    c, cluster = killing_cluster(str(marker))
-    try:
+    with killing_cluster(str(marker)) as c:
         det = distributed.detect(pts, "planes", tile=3.0, client=c)
-    finally:
-        c.close()
-        cluster.close()
     assert marker.exists(), "no worker was killed: the test tested nothing"
     assert_same(det, ref)
 
 
 def test_a_tile_that_always_kills_its_worker_is_a_clear_error(tmp_path):
     pts = room(13)
-    c, cluster = killing_cluster(str(tmp_path / "unused"), always=True)
-    try:
+    with killing_cluster(str(tmp_path / "unused"), always=True) as c:
         with pytest.raises(distributed.TileLost, match=r"was lost 3 times"):
             distributed.detect(pts, "planes", tile=100.0, client=c)
-    finally:
-        c.close()
-        cluster.close()
 
 
 def ground_and_roof():
@@ -289,22 +288,14 @@ def test_a_region_whose_worker_is_killed_gives_the_same_labels(tmp_path):
     pts = ground_and_roof()
     ref = aa.detect_regions(pts, "planes", side=30.0)
     marker = tmp_path / "killed"
-    c, cluster = killing_cluster(str(marker), task="_run_region")
-    try:
+    with killing_cluster(str(marker), task="_run_region") as c:
         r = distributed.detect_regions(pts, "planes", side=30.0, client=c)
-    finally:
-        c.close()
-        cluster.close()
     assert marker.exists(), "no worker was killed: the test tested nothing"
     assert_same_regions(r, ref)
 
 
 def test_a_region_that_always_kills_its_worker_is_a_clear_error(tmp_path):
     pts = ground_and_roof()
-    c, cluster = killing_cluster(str(tmp_path / "unused"), always=True, task="_run_region")
-    try:
+    with killing_cluster(str(tmp_path / "unused"), always=True, task="_run_region") as c:
         with pytest.raises(distributed.RegionLost, match=r"region \d+ \(\d+ points\) lost its worker"):
             distributed.detect_regions(pts, "planes", side=45.0, client=c)
-    finally:
-        c.close()
-        cluster.close()

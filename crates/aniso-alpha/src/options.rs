@@ -287,6 +287,25 @@ impl DetectOptions {
         };
         Ok(d.significance(self.epsilon).tile(self.tile))
     }
+
+    /// [`Self::build`] for one region of a region run
+    /// (`detect::regions`): the detector of a cloud's points `ids`
+    /// (`sub`: their coordinates), with those points' normals when the
+    /// cloud has `normals`.
+    ///
+    /// # Errors
+    /// As [`Self::build`].
+    pub fn build_region(
+        &self,
+        ids: &[u32],
+        sub: &[[f64; 3]],
+        normals: Option<&[[f64; 3]]>,
+        style: Style,
+    ) -> Result<Detector, DetectError> {
+        let nsub: Option<Vec<[f64; 3]>> =
+            normals.map(|n| ids.iter().map(|&i| n[i as usize]).collect());
+        self.build(sub, nsub.as_deref(), style)
+    }
 }
 
 /// Why the normals given with the points were not used (the detector's

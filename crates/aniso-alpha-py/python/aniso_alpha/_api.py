@@ -402,12 +402,17 @@ def detect_regions(
         step=step,
         epsilon=epsilon,
     )
-    labels, part_labels, rows, used, regions, widened, joins, skipped, messages = _native.detect_regions(
-        pts, structure, side, options, threads, nrm, progress, jobs
-    )
-    _warn(messages)
+    run, used = _native.detect_regions(pts, structure, side, options, threads, nrm, progress, jobs)
+    return _region_detection(run, used, structure)
+
+
+def _region_detection(run: Tuple[Any, ...], side: Optional[float], structure: str) -> RegionDetection:
+    """The :class:`RegionDetection` of the extension's region run (its
+    warnings raised as :class:`AnisoAlphaWarning`)."""
+    labels, part_labels, rows, regions, widened, joins, skipped, messages = run
+    _warn(messages, stacklevel=4)
     return RegionDetection(
-        labels, part_labels, _region_parts(rows, structure), used, regions, widened, joins, skipped, messages
+        labels, part_labels, _region_parts(rows, structure), side, regions, widened, joins, skipped, messages
     )
 
 

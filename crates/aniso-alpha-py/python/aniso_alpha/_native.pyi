@@ -42,6 +42,8 @@ def detect(
     warnings, the detection)."""
 
 _PartRow = Tuple[int, int, int, int, List[float], List[float], float]
+# A region run: labels, part_labels, parts, regions, widened, joins, skipped, warnings.
+_RunOut = Tuple[NDArray[np.int64], NDArray[np.int64], List[_PartRow], int, int, int, int, List[str]]
 
 def detect_regions(
     points: Any,
@@ -52,8 +54,8 @@ def detect_regions(
     normals: Optional[ArrayLike] = None,
     progress: Optional[Callable[[int, int], Optional[bool]]] = None,
     jobs: Optional[int] = None,
-) -> Tuple[NDArray[np.int64], NDArray[np.int64], List[_PartRow], Optional[float], int, int, int, int, List[str]]:
-    """(labels, part_labels, parts, side used, regions, widened, joins, skipped, warnings)."""
+) -> Tuple[_RunOut, Optional[float]]:
+    """(the run, the side used)."""
 
 class RegionPlan:
     """The regions of a cloud (aniso_alpha.distributed.detect_regions)."""
@@ -90,9 +92,7 @@ class RegionJoin:
     def add(
         self, ids: NDArray[np.uint32], core: NDArray[np.uint32], step: Optional[_StepArrays] = None
     ) -> None: ...
-    def finish(
-        self, points: ArrayLike
-    ) -> Tuple[NDArray[np.int64], NDArray[np.int64], List[_PartRow], int, int, int, int, List[str]]: ...
+    def finish(self, points: ArrayLike) -> _RunOut: ...
 
 class Plan:
     """A split detection run (aniso_alpha.distributed); made by `plan`."""

@@ -45,7 +45,7 @@ from numpy.typing import ArrayLike, NDArray
 from . import _native
 from ._api import Structure, detect_input, detect_options
 from ._io import Cloud, PathLike, _warn, read
-from ._results import Detection, RegionDetection, RegionPart
+from ._results import Detection, RegionDetection
 
 __all__ = ["RegionLost", "TileLost", "detect", "detect_regions", "load", "plan"]
 
@@ -570,20 +570,9 @@ def detect_regions(
             nxt = next(regions, None)
             if nxt is not None:
                 pending.add(submit(nxt, first, False))  # type: ignore[no-untyped-call]
-        labels, part_labels, rows, regions_n, widened_n, joins, skipped, messages = join.finish(points)
+        run = join.finish(points)
     finally:
         _close(own)
-    from ._api import _region_parts
+    from ._api import _region_detection
 
-    _warn(messages)
-    return RegionDetection(
-        labels,
-        part_labels,
-        _region_parts(rows, structure),
-        plan.side,
-        regions_n,
-        widened_n,
-        joins,
-        skipped,
-        messages,
-    )
+    return _region_detection(run, plan.side, structure)
