@@ -257,6 +257,10 @@ impl OutputPaths {
             Some(p) => common::cloud_output(p)? == common::CloudOutput::Labelled,
             None => false,
         };
+        let paths = OutputPaths {
+            labelled_output,
+            ..paths
+        };
         check_classify(args, labelled_output)?;
         crate::cmd_regions::check_outputs(args.regions, &paths.whole_outputs(args))?;
         if let Some(out) = &args.union {
@@ -276,10 +280,7 @@ impl OutputPaths {
                 ("--png", args.png.as_deref()),
             ],
         )?;
-        Ok(OutputPaths {
-            labelled_output,
-            ..paths
-        })
+        Ok(paths)
     }
 
     /// The outputs asked for that need a whole run (the views, the union,

@@ -151,14 +151,38 @@ fn regions_label_every_point_and_join_the_ground_across_borders() {
         "{same} of {}",
         roof.len()
     );
-    // Nine regions at once on two threads: the same labels.
+    // Nine regions at once on two threads: the same labels, and a
+    // labelled LAS output (refused once, as if it were a mesh) holds them.
+    let las = d.path("labelled.las");
     let (_, l2, p2) = labelled_run(
         &d,
         &input,
         "nine",
-        &["--region-jobs", "9", "--threads", "2"],
+        &[
+            "--region-jobs",
+            "9",
+            "--threads",
+            "2",
+            "--output",
+            las.to_str().unwrap(),
+        ],
     );
-    assert_eq!((l2, p2), (l, p));
+    assert_eq!((&l2, &p2), (&l, &p));
+    let options = aniso_alpha::io::ReadOptions {
+        attributes: true,
+        ..Default::default()
+    };
+    let back = aniso_alpha::io::read_points(&las, &options).unwrap();
+    let column = |name: &str| -> Vec<i64> {
+        let v = &back
+            .attributes
+            .iter()
+            .find(|a| a.name == name)
+            .unwrap()
+            .values;
+        (0..v.len()).map(|i| v.get_f64(i) as i64).collect()
+    };
+    assert_eq!((column("structure"), column("part")), (l, p));
 }
 
 #[test]
