@@ -28,7 +28,10 @@ tile instead of the town: SCAN (a PLY, e.g. the corpus's AHN tile) copied
 K x K times edge to edge, written as LAS files of G x G copies each (in
 `--workdir`, kept for the next run), the source the list of files, as a
 user's survey would come; the driver reads them (no in-process
-reference). `--memory-limit` gives each worker Dask's memory limit.
+reference). `--memory-limit` gives each worker Dask's memory limit. With `--tiles
+OUT` the run is `distributed.detect_tiles` instead: no process reads the
+cloud whole, and the labelled tiles are written to OUT (the F1 read back
+from them).
 
     .venv/bin/python scripts/bench_distributed.py --regions --workers 2 \
         --tiling ahn_2386_9702.ply 48 --per-file 8 --memory-limit 3GiB
@@ -92,6 +95,8 @@ def main() -> None:
     ap.add_argument("--per-file", type=int, default=8, help="copies per side in each LAS file of --tiling")
     ap.add_argument("--workdir", default="/tmp/aa_tiling", help="where --tiling writes its files")
     ap.add_argument("--memory-limit", default=None, help="each worker's Dask memory limit (e.g. 3GiB)")
+    ap.add_argument("--tiles", default=None, metavar="OUT",
+                    help="with --tiling: distributed.detect_tiles, the labelled tiles written to OUT")
     args = ap.parse_args()
     if args.regions:
         return regions(args)
@@ -190,23 +195,46 @@ def tiling(scan: str, k: int, per_file: int, workdir: str) -> list:
     return paths
 
 
-def tiling_f1(scan: str, pred: np.ndarray) -> float:
-    """Per-point plane F1 of a tiling's part labels against the tile's
-    plane labels (every copy is the tile's points in its order), one copy
-    at a time."""
+def tiling_counts(truth: np.ndarray, pred: np.ndarray) -> np.ndarray:
+    """True positives, false positives and false negatives of the plane
+    points of copies of a tile (every copy is the tile's points in its
+    order), one copy at a time."""
+    m = len(truth)
+    counts = np.zeros(3, dtype=np.int64)
+    for c in range(len(pred) // m):
+        got = pred[c * m : (c + 1) * m] >= 0
+        counts += [np.sum(truth & got), np.sum(~truth & got), np.sum(truth & ~got)]
+    return counts
+
+
+def tiling_truth(scan: str) -> np.ndarray:
+    """The tile's points that lie on a labelled plane."""
     sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "corpus"))
     from common import read_ply
 
-    truth = read_ply(scan)["plane"].astype(np.int64) >= 0
-    m = len(truth)
-    tp = fp = fn = 0
-    for c in range(len(pred) // m):
-        got = pred[c * m : (c + 1) * m] >= 0
-        tp += int(np.sum(truth & got))
-        fp += int(np.sum(~truth & got))
-        fn += int(np.sum(truth & ~got))
+    return read_ply(scan)["plane"].astype(np.int64) >= 0
+
+
+def f1_of(counts: np.ndarray) -> float:
+    tp, fp, fn = (int(c) for c in counts)
     p, r = tp / max(tp + fp, 1), tp / max(tp + fn, 1)
     return 2 * p * r / max(p + r, 1e-12)
+
+
+def tiling_f1(scan: str, pred: np.ndarray) -> float:
+    """Per-point plane F1 of a tiling's part labels against the tile's
+    plane labels."""
+    return f1_of(tiling_counts(tiling_truth(scan), pred))
+
+
+def tiles_f1(args: argparse.Namespace, outputs: list) -> float:
+    """tiling_f1 of a detect_tiles run, its part labels read back from
+    the labelled tiles one at a time."""
+    import aniso_alpha as aa
+
+    truth = tiling_truth(args.tiling[0])
+    counts = sum(tiling_counts(truth, aa.read(o).attributes["part"]) for o in outputs)
+    return f1_of(counts)
 
 
 def regions(args: argparse.Namespace) -> None:
@@ -244,7 +272,10 @@ def regions(args: argparse.Namespace) -> None:
             client = Client(cluster)
             try:
                 t0 = time.perf_counter()
-                r = distributed.detect_regions(pts, "planes", client=client)
+                if args.tiles:
+                    r = distributed.detect_tiles(pts, "planes", args.tiles, client=client)
+                else:
+                    r = distributed.detect_regions(pts, "planes", client=client)
                 t = time.perf_counter() - t0
                 workers = client.run(peak_rss_mib)
             finally:
@@ -252,11 +283,15 @@ def regions(args: argparse.Namespace) -> None:
                 cluster.close()
             same = "" if ref is None else (
                 "yes" if np.array_equal(r.part_labels, ref.part_labels) else "**NO**")
-            n = len(r.labels)
-            print(f"| {n:,} | {w} worker(s) | {t:.1f} | {r.regions} | {len(r.parts)} | {peak_rss_mib():.0f} "
-                  f"| {max(workers.values()):.0f} | {same} |", flush=True)
+            n = r.points if args.tiles else len(r.labels)
+            driver = peak_rss_mib()
+            print(f"| {n:,} | {w} worker(s){' (tiles)' if args.tiles else ''} | {t:.1f} | {r.regions} "
+                  f"| {len(r.parts)} | {driver:.0f} | {max(workers.values()):.0f} | {same} |", flush=True)
             if args.tiling:
-                print(f"plane F1 of the copies: {tiling_f1(args.tiling[0], r.part_labels):.3f}", flush=True)
+                # After the driver's peak was read: the labels are read back
+                # from the outputs one file at a time.
+                f1 = tiles_f1(args, r.outputs) if args.tiles else tiling_f1(args.tiling[0], r.part_labels)
+                print(f"plane F1 of the copies: {f1:.3f}", flush=True)
     print(f"load average after: {os.getloadavg()[0]:.2f}")
 
 

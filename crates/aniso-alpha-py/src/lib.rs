@@ -17,6 +17,7 @@ mod regions;
 mod report;
 mod run;
 mod split;
+mod tiles;
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -389,6 +390,8 @@ mod native {
     use super::regions::{detect_regions, region_plan, region_task, PyRegionJoin, PyRegionPlan};
     #[pymodule_export]
     use super::split::{plan, tile_step, PyPlan};
+    #[pymodule_export]
+    use super::tiles::{region_cells, region_grid, region_select, region_window, PyRegionJoined};
     #[pymodule_export]
     use super::{
         _panic, _points_address, alpha_intervals, delaunay, detect, read, write, PyDetection, PyLas,

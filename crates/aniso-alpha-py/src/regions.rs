@@ -3,8 +3,8 @@
 //! fit in memory.
 
 use aniso_alpha::detect::regions::{
-    detect_by_regions_with_progress, region_step, side_for, wider_margin, RegionJoin, RegionPlan,
-    RegionRun, RegionStep,
+    detect_by_regions_with_progress, region_step, wider_margin, RegionJoin, RegionPlan, RegionRun,
+    RegionStep,
 };
 use aniso_alpha::detect::DetectError;
 use aniso_alpha::detect::Primitive;
@@ -27,7 +27,7 @@ type PartRow = (u32, u32, usize, usize, Vec<f64>, Vec<f64>, f64);
 /// A region run as Python takes it: structure and part labels (int64
 /// (n,)), the joined parts, the region count, widenings, joins, regions
 /// of one position left as background, and the run's warnings.
-type RunOut<'py> = (
+pub type RunOut<'py> = (
     Bound<'py, PyArray1<i64>>,
     Bound<'py, PyArray1<i64>>,
     Vec<PartRow>,
@@ -39,7 +39,7 @@ type RunOut<'py> = (
 );
 
 /// [`RunOut`] of `run`.
-fn run_out(py: Python<'_>, run: RegionRun) -> RunOut<'_> {
+pub fn run_out(py: Python<'_>, run: RegionRun) -> RunOut<'_> {
     let parts = part_rows(&run);
     let warnings = region_warnings(&run);
     (
@@ -146,19 +146,14 @@ pub fn region_plan(points: &Bound<'_, PyAny>, side: Option<f64>) -> PyResult<PyR
     })
 }
 
-/// The side to run `pts` with and the side to report: `side` when given
-/// (checked by the run), else about 500,000 points a region; a cloud of
-/// about one region runs as one region holding it all, reported as
-/// `None`.
+/// The side to run `pts` with and the side to report
+/// ([`crate::tiles::region_side_extent`] of their bounding box).
 fn region_side(pts: &[[f64; 3]], side: Option<f64>) -> (f64, Option<f64>) {
-    match side.or_else(|| side_for(pts)) {
-        Some(s) => (s, Some(s)),
-        None if pts.is_empty() => (1.0, None),
-        None => {
-            let (lo, hi) = aniso_alpha::geometry::bounding_box(pts);
-            (2.0 * (hi[0] - lo[0]).max(hi[1] - lo[1]).max(1.0), None)
-        }
+    if pts.is_empty() {
+        return crate::tiles::region_side_extent([0.0; 3], [0.0; 3], 0, side);
     }
+    let (lo, hi) = aniso_alpha::geometry::bounding_box(pts);
+    crate::tiles::region_side_extent(lo, hi, pts.len(), side)
 }
 
 #[pymethods]
@@ -366,6 +361,17 @@ impl PyRegionJoin {
         self.get()?
             .add(ids, core, step.as_ref())
             .map_err(value_error)
+    }
+
+    /// The parts joined and numbered, for a driver that streams the
+    /// points (`RegionJoined`).
+    fn resolve(&mut self, py: Python<'_>) -> PyResult<crate::tiles::PyRegionJoined> {
+        let join = self
+            .join
+            .take()
+            .ok_or_else(|| PyValueError::new_err("this joining is finished"))?;
+        let joined = detached(py, 1, |_| join.resolve().map_err(value_error))?;
+        Ok(crate::tiles::PyRegionJoined::new(joined))
     }
 
     /// The joined run over `points` ([`RunOut`]), as `detect_regions`

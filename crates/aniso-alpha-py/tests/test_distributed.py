@@ -299,3 +299,88 @@ def test_a_region_that_always_kills_its_worker_is_a_clear_error(tmp_path):
     with killing_cluster(str(tmp_path / "unused"), always=True, task="_run_region") as c:
         with pytest.raises(distributed.RegionLost, match=r"region \d+ \(\d+ points\) lost its worker"):
             distributed.detect_regions(pts, "planes", side=45.0, client=c)
+
+
+def tiles_of(tmp_path, pts):
+    """``pts`` cut in three bands of y that the region grid does not
+    follow, as two LAS tiles and a text tile; their paths and their
+    points as read back, stacked in list order."""
+    bands = [pts[:, 1] < 17.0, (pts[:, 1] >= 17.0) & (pts[:, 1] < 41.0), pts[:, 1] >= 41.0]
+    paths = [str(tmp_path / "south.las"), str(tmp_path / "middle.xyz"), str(tmp_path / "north.las")]
+    write_las(paths[0], pts[bands[0]])
+    np.savetxt(paths[1], pts[bands[1]])
+    write_las(paths[2], pts[bands[2]])
+    return paths, distributed.load(paths)
+
+
+def assert_tiles_equal_regions(r, ref, n):
+    """A tiled run ``r`` whose outputs hold ``ref``'s labels, with its
+    parts fitted bit for bit as ``ref``'s."""
+    assert isinstance(r, aa.TileDetection) and r.points == n
+    labels = np.concatenate([aa.read(o).attributes["structure"] for o in r.outputs])
+    parts = np.concatenate([aa.read(o).attributes["part"] for o in r.outputs])
+    np.testing.assert_array_equal(labels, ref.labels)
+    np.testing.assert_array_equal(parts, ref.part_labels)
+    assert (r.side, r.regions, r.widened, r.joins, r.skipped) == (
+        ref.side, ref.regions, ref.widened, ref.joins, ref.skipped)
+    for a, b in zip(r.parts, ref.parts, strict=True):
+        assert (a.id, a.structure, a.points, a.pieces, a.rms) == (b.id, b.structure, b.points, b.pieces, b.rms)
+        assert a.equation.tobytes() == b.equation.tobytes()
+
+
+def test_tiles_equal_regions_on_the_stacked_points(client, tmp_path):
+    pts, _ = ground_and_roof_scene()
+    paths, stacked = tiles_of(tmp_path, pts)
+    ref = aa.detect_regions(stacked, "planes", side=30.0)
+    assert ref.regions == 6 and ref.widened == 6 and ref.joins > 0
+    out = tmp_path / "out"
+    r = distributed.detect_tiles(paths, "planes", out, side=30.0, client=client, classify=6)
+    assert [os.path.basename(o) for o in r.outputs] == ["south.las", "middle.ply", "north.las"]
+    assert_tiles_equal_regions(r, ref, len(stacked))
+    # A LAS tile's records are kept, the class set on the structures' points.
+    south = aa.read(r.outputs[0])
+    np.testing.assert_array_equal(south.points, aa.read(paths[0]).points)
+    on = south.attributes["structure"] >= 0
+    assert on.any() and (south.attributes["classification"][on] == 6).all()
+    # No folder: the parts alone; no side: one region, as in process.
+    bare = distributed.detect_tiles(paths, "planes", side=30.0, client=client)
+    assert bare.outputs == [] and [p.points for p in bare.parts] == [p.points for p in r.parts]
+    whole = distributed.detect_tiles(paths, "planes", tmp_path / "whole", client=client)
+    ref_whole = aa.detect_regions(stacked, "planes")
+    assert whole.side is None and whole.regions == 1
+    assert_tiles_equal_regions(whole, ref_whole, len(stacked))
+
+
+def test_tiles_refuse_bad_input_before_any_work(client, tmp_path):
+    pts, _ = ground_and_roof_scene()
+    paths, _ = tiles_of(tmp_path, pts)
+    with pytest.raises(ValueError, match="no tiles"):
+        distributed.detect_tiles([], "planes", tmp_path / "o", client=client)
+    with pytest.raises(ValueError, match="region side"):
+        distributed.detect_tiles(paths, "planes", tmp_path / "o", side=-1.0, client=client)
+    with pytest.raises(ValueError, match="classify"):
+        distributed.detect_tiles(paths, "planes", tmp_path / "o", classify=300, client=client)
+    (tmp_path / "b").mkdir()
+    twin = str(tmp_path / "b" / "south.las")
+    write_las(twin, pts[:100])
+    with pytest.raises(ValueError, match="would both be written as"):
+        distributed.detect_tiles(paths + [twin], "planes", tmp_path / "o", client=client)
+    with pytest.raises(ValueError, match="holds the tile itself"):
+        distributed.detect_tiles(paths, "planes", tmp_path, client=client)
+    assert not (tmp_path / "o").exists()
+    with pytest.raises(OSError):
+        distributed.detect_tiles([str(tmp_path / "missing.las")], "planes", client=client)
+
+
+def test_a_tiled_region_whose_worker_is_killed_gives_the_same_labels(tmp_path):
+    """The first region task kills its worker: Dask runs it again (it reads
+    its tiles from their paths) and the outputs are those of an
+    undisturbed run."""
+    pts, _ = ground_and_roof_scene()
+    paths, stacked = tiles_of(tmp_path, pts)
+    ref = aa.detect_regions(stacked, "planes", side=30.0)
+    marker = tmp_path / "killed"
+    with killing_cluster(str(marker), task="_tile_region") as c:
+        r = distributed.detect_tiles(paths, "planes", tmp_path / "out", side=30.0, client=c)
+    assert marker.exists(), "no worker was killed: the test tested nothing"
+    assert_tiles_equal_regions(r, ref, len(stacked))

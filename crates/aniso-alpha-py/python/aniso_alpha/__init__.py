@@ -38,7 +38,7 @@ from ._api import (
 )
 from ._io import AnisoAlphaWarning, Cloud, labelled_array, read, write
 from ._native import __version__
-from ._results import Detection, Plane, RegionDetection, RegionPart, Segment
+from ._results import Detection, Plane, RegionDetection, RegionPart, Segment, TileDetection
 
 __all__ = [
     "AlphaIntervals",
@@ -51,6 +51,7 @@ __all__ = [
     "Sampler",
     "Segment",
     "Structure",
+    "TileDetection",
     "__version__",
     "alpha_intervals",
     "delaunay",

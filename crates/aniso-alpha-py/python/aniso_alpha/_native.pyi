@@ -2,7 +2,7 @@
 # (crates/aniso-alpha-py/src/lib.rs). The public, documented API is the
 # package `aniso_alpha`; these are its private building blocks.
 
-from typing import Any, Callable, Dict, List, Optional, Tuple
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -92,7 +92,33 @@ class RegionJoin:
     def add(
         self, ids: NDArray[np.uint32], core: NDArray[np.uint32], step: Optional[_StepArrays] = None
     ) -> None: ...
+    def resolve(self) -> RegionJoined: ...
     def finish(self, points: ArrayLike) -> _RunOut: ...
+
+class RegionJoined:
+    """The joined parts of a region run, on a driver that streams the points
+    (aniso_alpha.distributed.detect_tiles)."""
+
+    def __len__(self) -> int: ...
+    def labels(self, first: int, n: int) -> Tuple[NDArray[np.int64], NDArray[np.int64]]:
+        """(structure labels, part labels) of points first..first + n."""
+    def refit(self, first: int, points: ArrayLike) -> None: ...
+    def end_pass(self) -> None: ...
+    def finish(self) -> _RunOut:
+        """The run, its labels empty."""
+
+def region_grid(
+    lo: Sequence[float], hi: Sequence[float], n: int, side: Optional[float] = None
+) -> Tuple[Tuple[float, float], float, Optional[float], float]:
+    """(origin, side run with, side reported, first margin)."""
+
+def region_cells(points: ArrayLike, origin: Tuple[float, float], side: float) -> NDArray[np.int64]: ...
+def region_window(
+    origin: Tuple[float, float], side: float, cell: Tuple[int, int], margin: float
+) -> Tuple[float, float, float, float]: ...
+def region_select(
+    points: ArrayLike, origin: Tuple[float, float], side: float, cell: Tuple[int, int], margin: float
+) -> Tuple[NDArray[np.uint32], NDArray[np.bool_]]: ...
 
 class Plan:
     """A split detection run (aniso_alpha.distributed); made by `plan`."""

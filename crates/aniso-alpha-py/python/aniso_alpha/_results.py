@@ -257,3 +257,31 @@ class RegionDetection:
     joins: int = 0
     skipped: int = 0
     warnings: List[str] = field(default_factory=list)
+
+
+@dataclass(frozen=True, eq=False)
+class TileDetection:
+    """What :func:`aniso_alpha.distributed.detect_tiles` returns: a region
+    run over a cloud held as tiles, each point's labels written to a copy
+    of its tile rather than returned.
+
+    Attributes:
+        outputs: the labelled tiles written, in the input's order (empty
+            when no folder was given).
+        points: the number of points over all tiles.
+        parts: the joined parts, by id (:class:`RegionPart`): those of
+            :func:`aniso_alpha.detect_regions` on the tiles' points stacked
+            in list order.
+        side, regions, widened, joins, skipped, warnings: as in
+            :class:`RegionDetection`.
+    """
+
+    outputs: List[str]
+    points: int
+    parts: List[RegionPart] = field(default_factory=list)
+    side: Optional[float] = None
+    regions: int = 1
+    widened: int = 0
+    joins: int = 0
+    skipped: int = 0
+    warnings: List[str] = field(default_factory=list)

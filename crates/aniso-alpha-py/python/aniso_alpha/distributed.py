@@ -37,7 +37,7 @@ import json
 import math
 import os
 import time
-from typing import Any, Dict, List, Optional, Sequence, Tuple, Type, Union
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Type, Union
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -45,9 +45,9 @@ from numpy.typing import ArrayLike, NDArray
 from . import _native
 from ._api import Structure, detect_input, detect_options
 from ._io import Cloud, PathLike, _warn, read
-from ._results import Detection, RegionDetection
+from ._results import Detection, RegionDetection, TileDetection
 
-__all__ = ["RegionLost", "TileLost", "detect", "detect_regions", "load", "plan"]
+__all__ = ["RegionLost", "TileLost", "detect", "detect_regions", "detect_tiles", "load", "plan"]
 
 Source = Union[PathLike, Sequence[PathLike], ArrayLike, Any]
 
@@ -435,6 +435,75 @@ def _run(
     return outputs
 
 
+def _aligned_step(step: Optional[Tuple[Any, ...]]) -> Optional[Tuple[Any, ...]]:
+    """A region step's arrays aligned (unpickled from one frame, they may
+    not be; see :func:`_run_tile`)."""
+    if step is None:
+        return None
+    return tuple(np.require(a, requirements=("C", "A")) if isinstance(a, np.ndarray) else a for a in step)
+
+
+def _run_regions(
+    client: Any,
+    n_regions: int,
+    first_margin: float,
+    submit: Callable[[int, float], Any],
+    size: Callable[[int], str],
+    join: Any,
+    add: Callable[[int, Optional[Tuple[Any, ...]], Tuple[Any, ...]], None],
+) -> None:
+    """Runs regions ``0..n_regions`` as tasks (``submit(r, margin)`` gives
+    region r's future, whose result is ``(kind, margin, step, ...)``), at
+    most a few per worker in flight, and adds each to ``join`` in the
+    plan's order (``add(r, step or None, result)``; steps done ahead of
+    their turn wait, joined ones are dropped). A region whose estimate
+    reaches past its margin is sent again with the margin it asks for
+    (each widening counted in ``join``, as the in-process run counts it). A
+    region whose task was lost with its worker on every try Dask allows
+    raises :class:`RegionLost` (``size(r)`` describes it)."""
+    from dask.distributed import as_completed
+
+    waiting: Dict[int, Tuple[Optional[Tuple[Any, ...]], Tuple[Any, ...], int]] = {}
+    joined = 0
+    region_of: Dict[str, Tuple[int, int]] = {}
+
+    def send(r: int, margin: float, widened: int) -> Any:
+        future = submit(r, margin)
+        region_of[future.key] = (r, widened)
+        return future
+
+    regions = iter(range(n_regions))
+    limit = 2 * _workers(client) + 2
+    pending = as_completed([send(r, first_margin, 0) for _, r in zip(range(limit), regions)])  # type: ignore[no-untyped-call]
+    lost_errors = _lost_worker_errors()
+    for done in pending:
+        r, widened = region_of.pop(done.key)
+        try:
+            out = done.result()
+        except lost_errors as e:
+            # Dask ran the task again on other workers (its inputs travel
+            # with it) until its allowed failures were spent.
+            raise RegionLost(
+                f"region {r} ({size(r)}) lost its worker on every try (its worker died "
+                f"or left the cluster); last error: {type(e).__name__}: {e}"
+            ) from e
+        done.release()
+        kind, margin = out[0], out[1]
+        if kind == "wider":
+            pending.add(send(r, margin, widened + 1))  # type: ignore[no-untyped-call]
+            continue
+        waiting[r] = (_aligned_step(out[2]) if kind == "step" else None, out, widened)
+        while joined in waiting:
+            step, res, times = waiting.pop(joined)
+            for _ in range(times):
+                join.widened()
+            add(joined, step, res)
+            joined += 1
+        nxt = next(regions, None)
+        if nxt is not None:
+            pending.add(send(nxt, first_margin, 0))  # type: ignore[no-untyped-call]
+
+
 def _run_region(
     points: NDArray[np.float64],
     normals: Optional[NDArray[np.float64]],
@@ -497,8 +566,6 @@ def detect_regions(
     >>> bool((r.part_labels == aa.detect_regions(sheet, "planes", side=30.0).part_labels).all())
     True
     """
-    from dask.distributed import as_completed
-
     points, normals = _source(source, normals, ignore_normals)
     nrm = None if normals is None else load(normals)
     if side is not None and not (math.isfinite(side) and side > 0):
@@ -507,29 +574,13 @@ def detect_regions(
     plan = _native.region_plan(points, side)
     client, own = _client(client, n_workers)
     try:
-        # Steps wait here until every earlier region is joined (the joining
-        # takes the plan's order); joined ones are dropped.
-        steps: Dict[int, Tuple[NDArray[np.uint32], Optional[Tuple[Any, ...]], bool]] = {}
         join = _native.RegionJoin(len(points))
-        joined = 0
+        ids_of: Dict[int, NDArray[np.uint32]] = {}
 
-        def join_ready() -> None:
-            nonlocal joined
-            while joined in steps:
-                ids, step, widened = steps.pop(joined)
-                if widened:
-                    join.widened()
-                join.add(ids, plan.core(joined), step)
-                joined += 1
-
-        meta: Dict[str, Tuple[int, NDArray[np.uint32], bool]] = {}
-        limit = 2 * _workers(client) + 2
-        regions = iter(range(len(plan)))
-
-        def submit(r: int, margin: float, widened: bool) -> Any:
-            ids = plan.points_within(points, r, margin)
+        def submit(r: int, margin: float) -> Any:
+            ids = ids_of[r] = plan.points_within(points, r, margin)
             sub_n = None if nrm is None else np.ascontiguousarray(nrm[ids])
-            future = client.submit(
+            return client.submit(
                 _run_region,
                 np.ascontiguousarray(points[ids]),
                 sub_n,
@@ -539,40 +590,210 @@ def detect_regions(
                 task_threads,
                 pure=False,
             )
-            meta[future.key] = (r, ids, widened)
-            return future
 
-        first = plan.first_margin
-        pending = as_completed([submit(r, first, False) for _, r in zip(range(limit), regions)])  # type: ignore[no-untyped-call]
-        lost_errors = _lost_worker_errors()
-        for done in pending:
-            r, ids, widened = meta.pop(done.key)
-            try:
-                kind, margin, step = done.result()
-            except lost_errors as e:
-                # Dask ran the task again on other workers (its points travel
-                # with it) until its allowed failures were spent.
-                raise RegionLost(
-                    f"region {r} ({len(ids)} points) lost its worker on every try (its worker died "
-                    f"or left the cluster); last error: {type(e).__name__}: {e}"
-                ) from e
-            done.release()
-            if kind == "wider":
-                pending.add(submit(r, margin, True))  # type: ignore[no-untyped-call]
-                continue
-            if step is not None:
-                # Unpickled from one frame, the arrays may be unaligned.
-                step = tuple(
-                    np.require(a, requirements=("C", "A")) if isinstance(a, np.ndarray) else a for a in step
-                )
-            steps[r] = (ids, step if kind == "step" else None, widened)
-            join_ready()
-            nxt = next(regions, None)
-            if nxt is not None:
-                pending.add(submit(nxt, first, False))  # type: ignore[no-untyped-call]
+        def size(r: int) -> str:
+            return f"{len(ids_of[r])} points"
+
+        def add(r: int, step: Optional[Tuple[Any, ...]], out: Tuple[Any, ...]) -> None:
+            join.add(ids_of.pop(r), plan.core(r), step)
+
+        _run_regions(client, len(plan), plan.first_margin, submit, size, join, add)
         run = join.finish(points)
     finally:
         _close(own)
     from ._api import _region_detection
 
     return _region_detection(run, plan.side, structure)
+
+
+def _tile_bounds(path: str) -> Tuple[int, NDArray[np.float64], NDArray[np.float64]]:
+    """A tile's task: its number of points and bounding box."""
+    pts = read(path, attributes=False).points
+    return len(pts), pts.min(axis=0), pts.max(axis=0)
+
+
+def _tile_cells(path: str, origin: Tuple[float, float], side: float) -> NDArray[np.int64]:
+    """A tile's task: the region cells its points occupy."""
+    return _native.region_cells(read(path, attributes=False).points, origin, side)
+
+
+def _tile_region(
+    tiles: Sequence[Tuple[str, int]],
+    origin: Tuple[float, float],
+    side: float,
+    cell: Tuple[int, int],
+    margin: float,
+    structure: str,
+    options: Dict[str, Any],
+    task_threads: int,
+) -> Tuple[Any, ...]:
+    """A region's task of :func:`detect_tiles`: its points cut from the
+    tiles that meet its window (each tile's path and the input index of
+    its first point), in input order, then :func:`_native.region_task`.
+    Returns the task's ``(kind, margin, step)`` and, for a step, the
+    region's input indices (uint32, ascending) and its core's."""
+    points, ids, core = [], [], []
+    for path, first in tiles:
+        pts = read(path, attributes=False).points
+        idx, is_core = _native.region_select(pts, origin, side, cell, margin)
+        points.append(pts[idx])
+        glob = (idx.astype(np.uint64) + np.uint64(first)).astype(np.uint32)
+        ids.append(glob)
+        core.append(glob[is_core])
+        del pts
+    sub = np.ascontiguousarray(np.concatenate(points)) if points else np.empty((0, 3))
+    kind, m, step = _native.region_task(sub, structure, margin, options, None, task_threads)
+    if kind != "step":
+        return kind, m, None, None, None
+    return kind, m, step, np.concatenate(ids), np.concatenate(core)
+
+
+def _output_names(tiles: Sequence[str], out: str) -> List[str]:
+    """The labelled copy of each tile in ``out``: its name, a LAS, LAZ or
+    PLY tile keeping its format and any other format written as PLY."""
+    names = []
+    for t in tiles:
+        base = os.path.basename(t)
+        stem, ext = os.path.splitext(base)
+        names.append(os.path.join(out, base if ext.lower() in (".las", ".laz", ".ply") else stem + ".ply"))
+    seen: Dict[str, str] = {}
+    for t, n in zip(tiles, names):
+        if n in seen:
+            raise ValueError(f"tiles {seen[n]} and {t} would both be written as {n}")
+        seen[n] = t
+        if os.path.abspath(n) == os.path.abspath(t):
+            raise ValueError(f"{n}: the output folder holds the tile itself")
+    return names
+
+
+def detect_tiles(
+    tiles: Sequence[PathLike],
+    structure: Structure,
+    out: Optional[PathLike] = None,
+    *,
+    side: Optional[float] = None,
+    client: Any = None,
+    n_workers: Optional[int] = None,
+    task_threads: int = 1,
+    classify: Optional[int] = None,
+    **options: Any,
+) -> TileDetection:
+    """:func:`detect_regions` over a cloud held as tiles (point files, such
+    as LAS/LAZ tiles), which no process reads whole: each point's labels
+    are written to a copy of its tile instead of returned.
+
+    Args:
+        tiles: the tiles' paths (any format :func:`aniso_alpha.read`
+            reads); the cloud is their points in list order.
+        structure: ``"lines"`` or ``"planes"``.
+        out: a folder (made if missing) for the labelled tiles: each tile
+            as :func:`aniso_alpha.write` writes it (a LAS/LAZ tile's header
+            and records kept, the ids added as ``structure`` and ``part``),
+            under its own name (a tile that is neither LAS, LAZ nor PLY as
+            PLY); ``None`` writes nothing and returns the parts.
+        side, client, n_workers, task_threads, options: as for
+            :func:`detect_regions`. The normals of the tiles are not read:
+            each region estimates its own.
+        classify: a LAS classification given to the structures' points in
+            the outputs (as :func:`aniso_alpha.write`'s).
+
+    Returns:
+        a :class:`~aniso_alpha.TileDetection`: the parts, outputs and counts
+        of :func:`detect_regions` on the tiles' points stacked in list
+        order (the same labels, in the outputs).
+
+    What each process holds: a worker, one region (the tiles that meet
+    its window are read one at a time and cut); the driver, the tiles'
+    bounds, the regions' cells, one part id a point (4 bytes) and the
+    regions' margin labels for the joining, and one tile at a time while
+    it writes the labels and refits the joined parts (three passes over
+    the tiles in input order: the same fits as of the stacked points).
+    Tasks read their tiles from the paths, so a task whose worker dies is
+    run again by Dask with the same result; the paths must be readable
+    from every worker.
+
+    >>> import os, tempfile, numpy as np, aniso_alpha as aa
+    >>> from aniso_alpha import distributed
+    >>> d = tempfile.mkdtemp()
+    >>> x, y = (a.ravel() for a in np.meshgrid(np.arange(60.0), np.arange(30.0)))
+    >>> sheet = np.c_[x, y, np.random.default_rng(2).normal(0, 0.01, x.size)]
+    >>> paths = [os.path.join(d, f"t{k}.xyz") for k in range(2)]
+    >>> for k, p in enumerate(paths):
+    ...     np.savetxt(p, sheet[k * 900 : (k + 1) * 900])
+    >>> r = distributed.detect_tiles(paths, "planes", os.path.join(d, "out"), side=30.0, n_workers=2)
+    >>> [os.path.basename(o) for o in r.outputs], r.parts[0].points
+    (['t0.ply', 't1.ply'], 1800)
+    """
+    paths = [os.fspath(t) for t in tiles]
+    if not paths:
+        raise ValueError("no tiles")
+    if side is not None and not (math.isfinite(side) and side > 0):
+        raise ValueError(f"region side {side}: must be positive and finite")
+    if classify is not None and not (isinstance(classify, (int, np.integer)) and 0 <= int(classify) <= 255):
+        raise ValueError(f"classify must be a LAS class between 0 and 255, got {classify!r}")
+    names = _output_names(paths, os.fspath(out)) if out is not None else []
+    opts = detect_options(**options)
+    client, own = _client(client, n_workers)
+    try:
+        bounds = client.gather(client.map(_tile_bounds, paths, pure=False))
+        counts = [int(b[0]) for b in bounds]
+        firsts = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(int).tolist()
+        lo = np.min([b[1] for b in bounds], axis=0)
+        hi = np.max([b[2] for b in bounds], axis=0)
+        origin, run_side, reported, first_margin = _native.region_grid(
+            [float(v) for v in lo], [float(v) for v in hi], sum(counts), side
+        )
+        tile_cells = client.gather(client.map(_tile_cells, paths, origin=origin, side=run_side, pure=False))
+        cells = np.unique(np.concatenate(tile_cells), axis=0)
+        join = _native.RegionJoin(sum(counts))
+
+        def submit(r: int, margin: float) -> Any:
+            cell = (int(cells[r][0]), int(cells[r][1]))
+            x0, y0, x1, y1 = _native.region_window(origin, run_side, cell, margin)
+            meets = [
+                (p, f)
+                for p, f, (_, tlo, thi) in zip(paths, firsts, bounds)
+                if tlo[0] <= x1 and thi[0] >= x0 and tlo[1] <= y1 and thi[1] >= y0
+            ]
+            return client.submit(
+                _tile_region, meets, origin, run_side, cell, margin, structure, opts, task_threads, pure=False
+            )
+
+        def add(r: int, step: Optional[Tuple[Any, ...]], res: Tuple[Any, ...]) -> None:
+            if step is None:
+                join.add(np.empty(0, np.uint32), np.empty(0, np.uint32), None)
+            else:
+                join.add(np.require(res[3], requirements=("C", "A")), np.require(res[4], requirements=("C", "A")), step)
+
+        _run_regions(client, len(cells), first_margin, submit, lambda r: f"cell {tuple(cells[r])}", join, add)
+    finally:
+        _close(own)
+    joined = join.resolve()
+    for k in range(3):
+        for i, (path, first, n) in enumerate(zip(paths, firsts, counts)):
+            cloud = read(path, attributes=k == 0 and out is not None)
+            if len(cloud.points) != n:
+                raise ValueError(f"{path}: {len(cloud.points)} points, {n} when the run began")
+            joined.refit(first, cloud.points)
+            if k == 0 and out is not None:
+                os.makedirs(os.fspath(out), exist_ok=True)
+                labels, part_labels = joined.labels(first, n)
+                _native.write(
+                    names[i],
+                    cloud.points,
+                    list(cloud.attributes.items()),
+                    cloud._las,
+                    labels,
+                    part_labels,
+                    None,
+                    None if classify is None else int(classify),
+                )
+            del cloud
+        joined.end_pass()
+    _, _, rows, regions, widened, joins, skipped, messages = joined.finish()
+    _warn(messages)
+    from ._api import _region_parts
+
+    return TileDetection(
+        names, sum(counts), _region_parts(rows, structure), reported, regions, widened, joins, skipped, messages
+    )

@@ -200,35 +200,52 @@ fn unit(u: [f64; 3]) -> [f64; 3] {
     [u[0] / n, u[1] / n, u[2] / n]
 }
 
-/// Centroid and covariance (divided by `n`) of `n` points given by `get`:
-/// the one place the detector forms a second-moment matrix from points.
-pub(crate) fn moments(n: usize, get: impl Fn(usize) -> [f64; 3]) -> ([f64; 3], Mat3) {
+/// Adds a point to a centroid's running sum (the first pass of a fit).
+#[inline]
+fn add_sum(sum: &mut [f64; 3], p: [f64; 3]) {
+    for k in 0..3 {
+        sum[k] += p[k];
+    }
+}
+
+/// Adds a point to a covariance's running sum about `c` (the second pass),
+/// upper triangle only.
+#[inline]
+fn add_moment(m: &mut Mat3, c: [f64; 3], p: [f64; 3]) {
+    let d = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
+    for r in 0..3 {
+        for s in r..3 {
+            m[r][s] += d[r] * d[s];
+        }
+    }
+}
+
+/// The covariance of `n` points from its running sum (divided by `n`,
+/// made symmetric).
+fn end_moments(mut m: Mat3, n: usize) -> Mat3 {
     let nf = n as f64;
-    let mut c = [0.0; 3];
-    for i in 0..n {
-        let p = get(i);
-        for k in 0..3 {
-            c[k] += p[k];
-        }
-    }
-    c = c.map(|x| x / nf);
-    let mut m = [[0.0; 3]; 3];
-    for i in 0..n {
-        let p = get(i);
-        let d = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
-        for r in 0..3 {
-            for s in r..3 {
-                m[r][s] += d[r] * d[s];
-            }
-        }
-    }
     for r in 0..3 {
         for s in r..3 {
             m[r][s] /= nf;
             m[s][r] = m[r][s];
         }
     }
-    (c, m)
+    m
+}
+
+/// Centroid and covariance (divided by `n`) of `n` points given by `get`:
+/// the one place the detector forms a second-moment matrix from points.
+pub(crate) fn moments(n: usize, get: impl Fn(usize) -> [f64; 3]) -> ([f64; 3], Mat3) {
+    let mut sum = [0.0; 3];
+    for i in 0..n {
+        add_sum(&mut sum, get(i));
+    }
+    let c = sum.map(|x| x / n as f64);
+    let mut m = [[0.0; 3]; 3];
+    for i in 0..n {
+        add_moment(&mut m, c, get(i));
+    }
+    (c, end_moments(m, n))
 }
 
 fn check(n: usize, needed: usize, get: &dyn Fn(usize) -> [f64; 3]) -> Result<(), FitError> {
@@ -243,62 +260,239 @@ fn check(n: usize, needed: usize, get: &dyn Fn(usize) -> [f64; 3]) -> Result<(),
     Ok(())
 }
 
-fn line_impl(n: usize, get: &dyn Fn(usize) -> [f64; 3]) -> Result<LineFit, FitError> {
-    check(n, 2, get)?;
-    let (c, m) = moments(n, get);
-    let (vals, vecs) = symmetric_eigen(m);
-    if vals[0].is_nan() || vals[0] <= 0.0 {
-        return Err(FitError::Degenerate);
+/// A fitted primitive's frame, from the covariance: a line's direction, or
+/// a plane's normal and in-plane axes.
+#[derive(Debug, Clone, Copy)]
+enum Frame {
+    Line([f64; 3]),
+    Plane([f64; 3], [f64; 3], [f64; 3]),
+}
+
+impl Frame {
+    /// The frame of covariance `m` (`line`: a line's, else a plane's).
+    fn of(m: Mat3, line: bool) -> Result<Frame, FitError> {
+        let (vals, vecs) = symmetric_eigen(m);
+        if vals[0].is_nan() || vals[0] <= 0.0 {
+            return Err(FitError::Degenerate);
+        }
+        if line {
+            return Ok(Frame::Line(canonical_sign(unit(vecs[0]))));
+        }
+        if vals[1] <= 64.0 * f64::EPSILON * vals[0] {
+            return Err(FitError::Degenerate);
+        }
+        let normal = canonical_sign(unit(vecs[2]));
+        let a0 = canonical_sign(unit(vecs[0]));
+        Ok(Frame::Plane(normal, a0, cross(normal, a0)))
     }
-    let d = canonical_sign(unit(vecs[0]));
-    let (mut lo, mut hi, mut ss) = (f64::INFINITY, f64::NEG_INFINITY, 0.0);
-    for i in 0..n {
-        let p = get(i);
+}
+
+/// The third pass of a fit: the squared residuals and the extents of the
+/// projections on the frame's axes (a line: one axis, its direction).
+#[derive(Debug, Clone, Copy)]
+struct Spread {
+    lo: [f64; 2],
+    hi: [f64; 2],
+    ss: f64,
+}
+
+impl Spread {
+    fn new() -> Self {
+        Spread {
+            lo: [f64::INFINITY; 2],
+            hi: [f64::NEG_INFINITY; 2],
+            ss: 0.0,
+        }
+    }
+
+    #[inline]
+    fn add(&mut self, frame: &Frame, c: [f64; 3], p: [f64; 3]) {
+        match *frame {
+            Frame::Line(d) => self.add_line(d, c, p),
+            Frame::Plane(normal, a0, a1) => self.add_plane([normal, a0, a1], c, p),
+        }
+    }
+
+    #[inline]
+    fn add_line(&mut self, d: [f64; 3], c: [f64; 3], p: [f64; 3]) {
         let q = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
         let t = dot(q, d);
-        lo = lo.min(t);
-        hi = hi.max(t);
+        self.lo[0] = self.lo[0].min(t);
+        self.hi[0] = self.hi[0].max(t);
         // The perpendicular part itself, not |q|² − t² (cancellation).
         let r = [q[0] - t * d[0], q[1] - t * d[1], q[2] - t * d[2]];
-        ss += dot(r, r);
+        self.ss += dot(r, r);
     }
-    Ok(LineFit {
-        centroid: c,
-        direction: d,
-        rms_residual: (ss / n as f64).sqrt(),
-        extent: hi - lo,
-    })
+
+    #[inline]
+    fn add_plane(&mut self, [normal, a0, a1]: [[f64; 3]; 3], c: [f64; 3], p: [f64; 3]) {
+        let q = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
+        let h = dot(q, normal);
+        self.ss += h * h;
+        for (k, a) in [a0, a1].iter().enumerate() {
+            let t = dot(q, *a);
+            self.lo[k] = self.lo[k].min(t);
+            self.hi[k] = self.hi[k].max(t);
+        }
+    }
+}
+
+/// A fitted line or plane.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Fitted {
+    /// A line.
+    Line(LineFit),
+    /// A plane.
+    Plane(PlaneFit),
+}
+
+/// The fit of `n` points with centroid `c`, frame and spread.
+fn fitted(c: [f64; 3], frame: Frame, spread: &Spread, n: usize) -> Fitted {
+    let rms_residual = (spread.ss / n as f64).sqrt();
+    match frame {
+        Frame::Line(direction) => Fitted::Line(LineFit {
+            centroid: c,
+            direction,
+            rms_residual,
+            extent: spread.hi[0] - spread.lo[0],
+        }),
+        Frame::Plane(normal, a0, a1) => Fitted::Plane(PlaneFit {
+            centroid: c,
+            normal,
+            axes: [a0, a1],
+            rms_residual,
+            extent: [spread.hi[0] - spread.lo[0], spread.hi[1] - spread.lo[1]],
+        }),
+    }
+}
+
+fn fit_impl(n: usize, line: bool, get: &dyn Fn(usize) -> [f64; 3]) -> Result<Fitted, FitError> {
+    check(n, if line { 2 } else { 3 }, get)?;
+    let (c, m) = moments(n, get);
+    let frame = Frame::of(m, line)?;
+    let mut spread = Spread::new();
+    // One loop per kind: the frame is matched once, not per point.
+    match frame {
+        Frame::Line(d) => (0..n).for_each(|i| spread.add_line(d, c, get(i))),
+        Frame::Plane(nm, a0, a1) => (0..n).for_each(|i| spread.add_plane([nm, a0, a1], c, get(i))),
+    }
+    Ok(fitted(c, frame, &spread, n))
+}
+
+fn line_impl(n: usize, get: &dyn Fn(usize) -> [f64; 3]) -> Result<LineFit, FitError> {
+    match fit_impl(n, true, get)? {
+        Fitted::Line(f) => Ok(f),
+        Fitted::Plane(_) => unreachable!("a line's frame is a line"),
+    }
 }
 
 fn plane_impl(n: usize, get: &dyn Fn(usize) -> [f64; 3]) -> Result<PlaneFit, FitError> {
-    check(n, 3, get)?;
-    let (c, m) = moments(n, get);
-    let (vals, vecs) = symmetric_eigen(m);
-    if vals[0].is_nan() || vals[0] <= 0.0 || vals[1] <= 64.0 * f64::EPSILON * vals[0] {
-        return Err(FitError::Degenerate);
+    match fit_impl(n, false, get)? {
+        Fitted::Plane(f) => Ok(f),
+        Fitted::Line(_) => unreachable!("a plane's frame is a plane"),
     }
-    let normal = canonical_sign(unit(vecs[2]));
-    let a0 = canonical_sign(unit(vecs[0]));
-    let a1 = cross(normal, a0);
-    let (mut lo, mut hi, mut ss) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2], 0.0);
-    for i in 0..n {
-        let p = get(i);
-        let q = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
-        let h = dot(q, normal);
-        ss += h * h;
-        for (k, a) in [a0, a1].iter().enumerate() {
-            let t = dot(q, *a);
-            lo[k] = lo[k].min(t);
-            hi[k] = hi[k].max(t);
+}
+
+/// A line or plane fitted over points streamed to it in input order, in
+/// the three passes [`fit_line`] and [`fit_plane`] make (the centroid's
+/// sums, the covariance about it, then the residuals and extents along the
+/// fitted axes): the same arithmetic in the same order, so the same fit
+/// bit for bit as of the points gathered in that order, without holding
+/// them. Feed every point to [`Self::add_sum`], then [`Self::end_sums`];
+/// again to [`Self::add_moment`], then [`Self::end_moments`]; again to
+/// [`Self::add_residual`], then [`Self::finish`].
+///
+/// ```
+/// use aniso_alpha::detect::fit::{fit_plane, Fitted, PassFit};
+/// let pts = [[0.0, 0.0, 1.0], [2.0, 0.0, 1.1], [0.0, 1.0, 0.9], [2.0, 1.0, 1.0]];
+/// let mut f = PassFit::new(false);
+/// pts.iter().for_each(|&p| f.add_sum(p));
+/// f.end_sums();
+/// pts.iter().for_each(|&p| f.add_moment(p));
+/// f.end_moments();
+/// pts.iter().for_each(|&p| f.add_residual(p));
+/// assert_eq!(f.finish(), Ok(Fitted::Plane(fit_plane(&pts).unwrap())));
+/// ```
+#[derive(Debug, Clone)]
+pub struct PassFit {
+    line: bool,
+    n: usize,
+    finite: bool,
+    c: [f64; 3],
+    m: Mat3,
+    frame: Option<Result<Frame, FitError>>,
+    spread: Spread,
+}
+
+impl PassFit {
+    /// A fit of a line (`line`) or a plane, before any point.
+    pub fn new(line: bool) -> Self {
+        PassFit {
+            line,
+            n: 0,
+            finite: true,
+            c: [0.0; 3],
+            m: [[0.0; 3]; 3],
+            frame: None,
+            spread: Spread::new(),
         }
     }
-    Ok(PlaneFit {
-        centroid: c,
-        normal,
-        axes: [a0, a1],
-        rms_residual: (ss / n as f64).sqrt(),
-        extent: [hi[0] - lo[0], hi[1] - lo[1]],
-    })
+
+    /// The first pass: one point.
+    #[inline]
+    pub fn add_sum(&mut self, p: [f64; 3]) {
+        self.n += 1;
+        self.finite &= p.iter().all(|x| x.is_finite());
+        add_sum(&mut self.c, p);
+    }
+
+    /// Ends the first pass (the centroid).
+    pub fn end_sums(&mut self) {
+        let n = self.n as f64;
+        self.c = self.c.map(|x| x / n);
+    }
+
+    /// The second pass: one point.
+    #[inline]
+    pub fn add_moment(&mut self, p: [f64; 3]) {
+        add_moment(&mut self.m, self.c, p);
+    }
+
+    /// Ends the second pass (the frame, or why there is none).
+    pub fn end_moments(&mut self) {
+        let needed = if self.line { 2 } else { 3 };
+        self.frame = Some(if self.n < needed {
+            Err(FitError::TooFewPoints {
+                needed,
+                got: self.n,
+            })
+        } else if !self.finite {
+            Err(FitError::NonFinite { index: 0 })
+        } else {
+            Frame::of(end_moments(self.m, self.n), self.line)
+        });
+    }
+
+    /// The third pass: one point.
+    #[inline]
+    pub fn add_residual(&mut self, p: [f64; 3]) {
+        if let Some(Ok(frame)) = &self.frame {
+            self.spread.add(frame, self.c, p);
+        }
+    }
+
+    /// The fit, after the three passes.
+    ///
+    /// # Errors
+    /// As [`fit_line`] or [`fit_plane`] (a non-finite point is reported at
+    /// index 0); [`FitError::Degenerate`] when a pass was not ended.
+    pub fn finish(&self) -> Result<Fitted, FitError> {
+        match &self.frame {
+            Some(Ok(frame)) => Ok(fitted(self.c, *frame, &self.spread, self.n)),
+            Some(Err(e)) => Err(e.clone()),
+            None => Err(FitError::Degenerate),
+        }
+    }
 }
 
 fn subset<'a>(
@@ -349,6 +543,54 @@ mod tests {
         (dot(a, b).abs() / (dot(a, a) * dot(b, b)).sqrt())
             .min(1.0)
             .acos()
+    }
+
+    /// A [`PassFit`] fed `pts` in three passes.
+    fn passes(pts: &[[f64; 3]], line: bool) -> Result<Fitted, FitError> {
+        let mut f = PassFit::new(line);
+        pts.iter().for_each(|&p| f.add_sum(p));
+        f.end_sums();
+        pts.iter().for_each(|&p| f.add_moment(p));
+        f.end_moments();
+        pts.iter().for_each(|&p| f.add_residual(p));
+        f.finish()
+    }
+
+    #[test]
+    fn a_fit_in_passes_is_the_fit_of_the_gathered_points_bit_for_bit() {
+        let mut rng = Rng::new(5);
+        for case in 0..500 {
+            let n = case % 9;
+            let mut pts: Vec<[f64; 3]> = (0..n * 7)
+                .map(|_| {
+                    [
+                        rng.range(-1e3, 1e3),
+                        rng.range(-5.0, 5.0),
+                        rng.range(0.0, 1e-3),
+                    ]
+                })
+                .collect();
+            match case % 5 {
+                // All on one line (a degenerate plane), all one point.
+                1 => pts.iter_mut().for_each(|p| *p = [p[0], 2.0 * p[0], 1.0]),
+                2 => pts.iter_mut().for_each(|p| *p = [3.0, 4.0, 5.0]),
+                _ => {}
+            }
+            let plane = passes(&pts, false);
+            match fit_plane(&pts) {
+                Ok(f) => assert_eq!(plane, Ok(Fitted::Plane(f)), "case {case}"),
+                Err(e) => assert!(plane.is_err(), "case {case}: {e}"),
+            }
+            let line = passes(&pts, true);
+            match fit_line(&pts) {
+                Ok(f) => assert_eq!(line, Ok(Fitted::Line(f)), "case {case}"),
+                Err(e) => assert!(line.is_err(), "case {case}: {e}"),
+            }
+        }
+        // A non-finite point, and a pass not ended, are errors.
+        let bad = [[0.0, 0.0, 0.0], [1.0, 0.0, f64::NAN], [0.0, 1.0, 0.0]];
+        assert!(passes(&bad, false).is_err());
+        assert_eq!(PassFit::new(false).finish(), Err(FitError::Degenerate));
     }
 
     #[test]

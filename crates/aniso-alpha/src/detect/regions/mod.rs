@@ -42,11 +42,16 @@
 //! Deterministic: a region's result depends on its own points (in input
 //! order) only, and the joining takes the regions in the plan's order.
 
+mod join;
+mod plan;
+
+pub use join::{PartsRefit, RegionJoin, RegionJoined};
+pub use plan::{side_for, side_for_extent, RegionGrid, RegionPlan, RegionWindow, FIRST_MARGIN};
+
 use super::detection::{Detection, Primitive};
 use super::scan::halo_width;
 use super::{DetectError, Detector};
-use crate::unionfind::UnionFind;
-use std::collections::{BTreeMap, HashMap};
+use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
 
@@ -54,10 +59,6 @@ use std::sync::Mutex;
 /// part for the two to be joined: a majority, as in the assembly's
 /// same-primitive test.
 pub const SAME_SHARE: f64 = 0.5;
-
-/// The first margin, as a fraction of the side (a region's run is widened
-/// when its reach asks for more).
-pub const FIRST_MARGIN: f64 = 1.0 / 16.0;
 
 /// A margin widened for a detector's reach r becomes r times this (the
 /// estimate on the wider margin may reach a little farther).
@@ -109,139 +110,11 @@ pub struct RegionRun {
     pub normals_ignored: usize,
 }
 
-/// The side of square regions holding about [`REGION_POINTS`] points each
-/// at the cloud's mean density over its x–y extent; `None` when the whole
-/// cloud is about one region (or flat in x or y).
-pub fn side_for(points: &[[f64; 3]]) -> Option<f64> {
-    if points.len() <= 2 * REGION_POINTS {
-        return None;
-    }
-    let (lo, hi) = crate::geometry::bounding_box(points);
-    let (w, h) = (hi[0] - lo[0], hi[1] - lo[1]);
-    if !(w > 0.0 && h > 0.0) {
-        return None;
-    }
-    Some((w * h * REGION_POINTS as f64 / points.len() as f64).sqrt())
-}
-
 /// How far a detector's ellipsoids reach: the largest 2α·λ_max of its
 /// orientations (the halo of the tiled scan).
 pub fn reach(detector: &Detector) -> Result<f64, DetectError> {
     let (jobs, _) = detector.scan_jobs(detector.modes())?;
     Ok(jobs.iter().map(halo_width).fold(0.0, f64::max))
-}
-
-/// The region grid of a cloud: origin and side in x–y.
-#[derive(Debug, Clone, Copy)]
-struct Grid {
-    origin: [f64; 2],
-    side: f64,
-}
-
-impl Grid {
-    fn cell(&self, p: &[f64; 3]) -> (i64, i64) {
-        (
-            ((p[0] - self.origin[0]) / self.side).floor() as i64,
-            ((p[1] - self.origin[1]) / self.side).floor() as i64,
-        )
-    }
-}
-
-/// The regions of a cloud (module doc, step 1): the grid, and each
-/// non-empty region's core points, regions in (x, y) cell order. What a
-/// driver keeps while the regions run elsewhere.
-#[derive(Debug, Clone)]
-pub struct RegionPlan {
-    grid: Grid,
-    cells: BTreeMap<(i64, i64), Vec<u32>>,
-    order: Vec<(i64, i64)>,
-}
-
-impl RegionPlan {
-    /// The regions of side `side` of `points`.
-    ///
-    /// # Errors
-    /// No points; a side that is not positive and finite.
-    pub fn new(points: &[[f64; 3]], side: f64) -> Result<Self, DetectError> {
-        if !(side.is_finite() && side > 0.0) {
-            return Err(DetectError::BadParameter(format!(
-                "region side {side}: must be positive and finite"
-            )));
-        }
-        if points.is_empty() {
-            return Err(DetectError::Empty);
-        }
-        let (lo, _) = crate::geometry::bounding_box(points);
-        let grid = Grid {
-            origin: [lo[0], lo[1]],
-            side,
-        };
-        let mut cells: BTreeMap<(i64, i64), Vec<u32>> = BTreeMap::new();
-        for (i, p) in points.iter().enumerate() {
-            cells.entry(grid.cell(p)).or_default().push(i as u32);
-        }
-        let order = cells.keys().copied().collect();
-        Ok(RegionPlan { grid, cells, order })
-    }
-
-    /// The number of regions.
-    pub fn len(&self) -> usize {
-        self.order.len()
-    }
-
-    /// Whether there is no region (never, for a plan made of points).
-    pub fn is_empty(&self) -> bool {
-        self.order.is_empty()
-    }
-
-    /// The side of the regions.
-    pub fn side(&self) -> f64 {
-        self.grid.side
-    }
-
-    /// Region `r`'s cell (column indices in x and y).
-    pub fn cell(&self, r: usize) -> (i64, i64) {
-        self.order[r]
-    }
-
-    /// Region `r`'s core points (input indices, ascending).
-    pub fn core(&self, r: usize) -> &[u32] {
-        &self.cells[&self.order[r]]
-    }
-
-    /// The first margin of every region ([`FIRST_MARGIN`] × side).
-    pub fn first_margin(&self) -> f64 {
-        FIRST_MARGIN * self.grid.side
-    }
-
-    /// Region `r`'s points grown by `margin` in x and y (input indices,
-    /// ascending): its core and its margin.
-    pub fn points_within(&self, points: &[[f64; 3]], r: usize, margin: f64) -> Vec<u32> {
-        let (grid, cell) = (&self.grid, self.order[r]);
-        let reach = (margin / grid.side).ceil() as i64;
-        let lo = [
-            grid.origin[0] + cell.0 as f64 * grid.side - margin,
-            grid.origin[1] + cell.1 as f64 * grid.side - margin,
-        ];
-        let hi = [
-            lo[0] + grid.side + 2.0 * margin,
-            lo[1] + grid.side + 2.0 * margin,
-        ];
-        let mut ids = Vec::new();
-        for cx in cell.0 - reach..=cell.0 + reach {
-            for (_, list) in self
-                .cells
-                .range((cx, cell.1 - reach)..=(cx, cell.1 + reach))
-            {
-                ids.extend(list.iter().copied().filter(|&i| {
-                    let p = &points[i as usize];
-                    p[0] >= lo[0] && p[0] <= hi[0] && p[1] >= lo[1] && p[1] <= hi[1]
-                }));
-            }
-        }
-        ids.sort_unstable();
-        ids
-    }
 }
 
 /// The margin a region's detector asks for (module doc, step 2): `None`
@@ -314,151 +187,6 @@ fn step_of(det: &Detection, part_angle: f64) -> RegionStep {
         part_angle,
         lines: det.kind == super::StructureKind::Lines,
         normals_ignored: false,
-    }
-}
-
-/// The joining of region steps (module doc, steps 3–5): add each region's
-/// step (in the plan's order, or any fixed order), then [`Self::finish`].
-#[derive(Debug, Clone)]
-pub struct RegionJoin {
-    part_of: Vec<u32>,
-    structure_of: Vec<u32>,
-    results: Vec<RegionResult>,
-    n_parts: u32,
-    n_structures: u32,
-    angle: f64,
-    lines: bool,
-    widened: usize,
-    skipped: usize,
-    normals_ignored: usize,
-}
-
-/// What one region's run leaves for the joining: per region part, its
-/// structure and axis; the (point, part) labels of its margin.
-#[derive(Debug, Clone)]
-struct RegionResult {
-    parts: Vec<(u32, Option<[f64; 3]>)>,
-    margin: Vec<(u32, u32)>,
-}
-
-impl RegionJoin {
-    /// A joining over a cloud of `n` points.
-    pub fn new(n: usize) -> Self {
-        RegionJoin {
-            part_of: vec![u32::MAX; n],
-            structure_of: vec![u32::MAX; n],
-            results: Vec::new(),
-            n_parts: 0,
-            n_structures: 0,
-            angle: 0.0,
-            lines: false,
-            widened: 0,
-            skipped: 0,
-            normals_ignored: 0,
-        }
-    }
-
-    /// Counts a region whose margin was widened for its reach.
-    pub fn widened(&mut self) {
-        self.widened += 1;
-    }
-
-    /// Adds a region: its points `ids` (ascending), its `core` (ascending,
-    /// a subset of `ids`) and its step, or `None` for a region of one
-    /// position (its points stay background).
-    ///
-    /// # Errors
-    /// A step whose labels do not match `ids`.
-    pub fn add(
-        &mut self,
-        ids: &[u32],
-        core: &[u32],
-        step: Option<&RegionStep>,
-    ) -> Result<(), DetectError> {
-        let Some(step) = step else {
-            self.skipped += 1;
-            self.results.push(RegionResult {
-                parts: Vec::new(),
-                margin: Vec::new(),
-            });
-            return Ok(());
-        };
-        if step.part.len() != ids.len() || step.structure.len() != ids.len() {
-            return Err(DetectError::BadParameter(format!(
-                "a region step of {} labels for {} points",
-                step.part.len(),
-                ids.len()
-            )));
-        }
-        let (first_part, first_structure) = (self.n_parts, self.n_structures);
-        let parts = step
-            .parts
-            .iter()
-            .map(|&(s, a)| (first_structure + s, a))
-            .collect::<Vec<_>>();
-        let mut margin = Vec::new();
-        let mut c = 0usize;
-        for (k, &i) in ids.iter().enumerate() {
-            let is_core = c < core.len() && core[c] == i;
-            if is_core {
-                c += 1;
-            }
-            let (lp, ls) = (step.part[k], step.structure[k]);
-            if lp < 0 {
-                continue;
-            }
-            if is_core {
-                self.part_of[i as usize] = first_part + lp as u32;
-                self.structure_of[i as usize] = first_structure + ls as u32;
-            } else {
-                margin.push((i, first_part + lp as u32));
-            }
-        }
-        self.n_parts += parts.len() as u32;
-        self.n_structures += step.structures;
-        self.angle = self.angle.max(step.part_angle);
-        self.lines |= step.lines;
-        self.normals_ignored += usize::from(step.normals_ignored);
-        self.results.push(RegionResult { parts, margin });
-        Ok(())
-    }
-
-    /// The joined run over `points` (module doc, steps 4–5).
-    ///
-    /// # Errors
-    /// [`DetectError::NoSpacing`] when every region was of one position
-    /// (the whole cloud's answer).
-    pub fn finish(self, points: &[[f64; 3]]) -> Result<RegionRun, DetectError> {
-        self.finish_with(points, true)
-    }
-
-    fn finish_with(self, points: &[[f64; 3]], joining: bool) -> Result<RegionRun, DetectError> {
-        if self.skipped == self.results.len() {
-            return Err(DetectError::NoSpacing);
-        }
-        let (n_parts, n_structures) = (self.n_parts as usize, self.n_structures as usize);
-        let (mut parts_uf, mut structures_uf, joins) = if joining {
-            join(
-                &self.results,
-                &self.part_of,
-                n_parts,
-                n_structures,
-                self.angle,
-            )
-        } else {
-            (UnionFind::new(n_parts), UnionFind::new(n_structures), 0)
-        };
-        let (part_labels, labels, parts) = number(points, &self, &mut parts_uf, &mut structures_uf);
-        Ok(RegionRun {
-            labels,
-            part_labels,
-            parts,
-            regions: self.results.len(),
-            widened: self.widened,
-            joins,
-            skipped: self.skipped,
-            normals_ignored: self.normals_ignored,
-        })
     }
 }
 
@@ -639,159 +367,12 @@ fn regions_run(
     st.joined.finish_with(points, joining)
 }
 
-/// Whether two axes (planes: normals; lines: directions) agree within
-/// `angle_deg`, either way.
-fn agree(a: Option<[f64; 3]>, b: Option<[f64; 3]>, angle_deg: f64) -> bool {
-    match (a, b) {
-        (Some(u), Some(v)) => {
-            let c = (u[0] * v[0] + u[1] * v[1] + u[2] * v[2]).abs();
-            c >= angle_deg.to_radians().cos()
-        }
-        _ => false,
-    }
-}
-
-/// The joining (module doc, step 4): union-finds over the global part and
-/// structure ids, and the number of joins.
-fn join(
-    results: &[RegionResult],
-    part_of: &[u32],
-    n_parts: usize,
-    n_structures: usize,
-    angle_deg: f64,
-) -> (UnionFind, UnionFind, usize) {
-    // Per global part: its region, structure and primitive.
-    let mut info: Vec<(usize, u32, Option<[f64; 3]>)> = Vec::with_capacity(n_parts);
-    for (r, res) in results.iter().enumerate() {
-        for &(s, a) in &res.parts {
-            info.push((r, s, a));
-        }
-    }
-    // Pairs (part in the margin, part of the core owner), counted; and
-    // per (margin part, owner region) the doubly labelled points.
-    let mut pairs: HashMap<(u32, u32), u32> = HashMap::new();
-    let mut over: HashMap<(u32, usize), u32> = HashMap::new();
-    for res in results {
-        for &(i, pm) in &res.margin {
-            let owner = part_of[i as usize];
-            if owner == u32::MAX {
-                continue;
-            }
-            let owner_region = info[owner as usize].0;
-            *pairs.entry((pm, owner)).or_insert(0) += 1;
-            *over.entry((pm, owner_region)).or_insert(0) += 1;
-        }
-    }
-    // Counts the other way: for a core part `owner` seen from region r,
-    // how many of its points r's margin labelled.
-    let mut seen: HashMap<(u32, usize), u32> = HashMap::new();
-    for (&(pm, owner), &c) in &pairs {
-        *seen.entry((owner, info[pm as usize].0)).or_insert(0) += c;
-    }
-    let mut keys: Vec<(u32, u32)> = pairs.keys().copied().collect();
-    keys.sort_unstable();
-    let mut parts_uf = UnionFind::new(n_parts);
-    let mut structures_uf = UnionFind::new(n_structures);
-    let mut joins = 0usize;
-    for (pm, owner) in keys {
-        let c = f64::from(pairs[&(pm, owner)]);
-        let (rm, sm, prim_m) = info[pm as usize];
-        let (ro, so, prim_o) = info[owner as usize];
-        let of_margin = f64::from(over[&(pm, ro)]);
-        let of_owner = f64::from(seen[&(owner, rm)]);
-        let majority = c >= SAME_SHARE * of_margin || c >= SAME_SHARE * of_owner;
-        if majority && agree(prim_m, prim_o, angle_deg) && parts_uf.union_min_root(pm, owner) {
-            joins += 1;
-            structures_uf.union_min_root(sm, so);
-        }
-    }
-    (parts_uf, structures_uf, joins)
-}
-
-/// Final ids (module doc, step 5) and the joined parts' summaries.
-fn number(
-    points: &[[f64; 3]],
-    join: &RegionJoin,
-    parts_uf: &mut UnionFind,
-    structures_uf: &mut UnionFind,
-) -> (Vec<i64>, Vec<i64>, Vec<RegionPart>) {
-    let RegionJoin {
-        part_of,
-        structure_of,
-        results,
-        lines: is_line,
-        n_structures,
-        ..
-    } = join;
-    let (is_line, n_structures) = (*is_line, *n_structures as usize);
-    let n_parts: usize = results.iter().map(|r| r.parts.len()).sum();
-    // Points per root, in one pass.
-    let mut part_count = vec![0usize; n_parts];
-    let mut structure_count = vec![0usize; n_structures];
-    for (&p, &s) in part_of.iter().zip(structure_of) {
-        if p != u32::MAX {
-            part_count[parts_uf.find(p) as usize] += 1;
-            structure_count[structures_uf.find(s) as usize] += 1;
-        }
-    }
-    let rank = |count: &[usize]| -> Vec<u32> {
-        let mut roots: Vec<u32> = (0..count.len() as u32)
-            .filter(|&r| count[r as usize] > 0)
-            .collect();
-        roots.sort_by(|&a, &b| count[b as usize].cmp(&count[a as usize]).then(a.cmp(&b)));
-        let mut id = vec![u32::MAX; count.len()];
-        for (k, &r) in roots.iter().enumerate() {
-            id[r as usize] = k as u32;
-        }
-        id
-    };
-    let part_id = rank(&part_count);
-    let structure_id = rank(&structure_count);
-    let mut part_labels = vec![-1i64; part_of.len()];
-    let mut labels = vec![-1i64; part_of.len()];
-    let n_final = part_count.iter().filter(|&&c| c > 0).count();
-    let mut members: Vec<Vec<u32>> = vec![Vec::new(); n_final];
-    let mut pieces = vec![0usize; n_final];
-    let mut structure_of_part = vec![0u32; n_final];
-    for (i, (&p, &s)) in part_of.iter().zip(structure_of).enumerate() {
-        if p != u32::MAX {
-            let pid = part_id[parts_uf.find(p) as usize];
-            let sid = structure_id[structures_uf.find(s) as usize];
-            part_labels[i] = i64::from(pid);
-            labels[i] = i64::from(sid);
-            members[pid as usize].push(i as u32);
-            structure_of_part[pid as usize] = sid;
-        }
-    }
-    for p in 0..n_parts as u32 {
-        let id = part_id[parts_uf.find(p) as usize];
-        if id != u32::MAX {
-            pieces[id as usize] += 1;
-        }
-    }
-    let parts = members
-        .iter()
-        .enumerate()
-        .map(|(k, m)| RegionPart {
-            id: k as u32,
-            structure: structure_of_part[k],
-            points: m.len(),
-            primitive: if is_line {
-                super::fit::fit_line_indices(points, m).map_or(Primitive::None, Primitive::Line)
-            } else {
-                super::fit::fit_plane_indices(points, m).map_or(Primitive::None, Primitive::Plane)
-            },
-            pieces: pieces[k],
-        })
-        .collect();
-    (part_labels, labels, parts)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::detect::{Given, StructureKind};
     use crate::rng::SplitMix64;
+    use std::collections::HashMap;
 
     /// A jittered grid of spacing 1 over `[x0, x1) × [y0, y1)` at height
     /// `z(x, y)`.
@@ -932,6 +513,19 @@ mod tests {
             let mut widened = false;
             let (ids, sub, d) = loop {
                 let ids = plan.points_within(&pts, r, margin);
+                // A driver of tiles finds the same points and core by the
+                // window's own test over every point.
+                let window = plan.grid().window(plan.cell(r), margin);
+                let tested: Vec<u32> = (0..pts.len() as u32)
+                    .filter(|&i| window.contains(&pts[i as usize]))
+                    .collect();
+                assert_eq!(tested, ids, "region {r}, margin {margin}");
+                let core: Vec<u32> = ids
+                    .iter()
+                    .copied()
+                    .filter(|&i| window.is_core(&pts[i as usize]))
+                    .collect();
+                assert_eq!(core, plan.core(r));
                 let sub: Vec<[f64; 3]> = ids.iter().map(|&i| pts[i as usize]).collect();
                 let d = build(&sub).unwrap();
                 match wider_margin(&d, margin).unwrap() {
@@ -954,11 +548,45 @@ mod tests {
             }
             join.add(ids, plan.core(*r), Some(step)).unwrap();
         }
+        let streamed = join.clone();
         assert_eq!(join.finish(&pts).unwrap(), want);
-        // A step of the wrong length is refused.
+        // Streamed in uneven chunks (tiles in input order): labels chunk by
+        // chunk and three refit passes give the same run, fits bit for bit.
+        let joined = streamed.resolve().unwrap();
+        let chunks = [0, 1000, 1001, 5000, pts.len()];
+        let (mut part_labels, mut labels) = (Vec::new(), Vec::new());
+        let mut refit = joined.refit();
+        for pass in 0..3 {
+            for w in chunks.windows(2) {
+                if pass == 0 {
+                    let (p, l) = joined.labels(w[0], w[1] - w[0]);
+                    part_labels.extend(p);
+                    labels.extend(l);
+                }
+                refit.add_points(&joined, w[0], &pts[w[0]..w[1]]);
+            }
+            refit.end_pass();
+        }
+        let run = RegionRun {
+            labels,
+            part_labels,
+            ..joined.run(&refit)
+        };
+        assert_eq!(run, want);
+        // A step of the wrong length, one naming points past the cloud, and
+        // one that gives a point another structure than its part's are
+        // refused.
         let mut join = RegionJoin::new(pts.len());
         let (r, ids, step, _) = &steps[0];
         assert!(join.add(&ids[1..], plan.core(*r), Some(step)).is_err());
+        let mut small = RegionJoin::new(ids[ids.len() - 1] as usize);
+        let err = small.add(ids, plan.core(*r), Some(step)).unwrap_err();
+        assert!(err.to_string().contains("past"), "{err}");
+        let mut bad = step.clone();
+        let k = bad.part.iter().position(|&p| p >= 0).unwrap();
+        bad.structure[k] = i64::from(bad.structures);
+        let err = join.add(ids, plan.core(*r), Some(&bad)).unwrap_err();
+        assert!(err.to_string().contains("structure"), "{err}");
     }
 
     #[test]
