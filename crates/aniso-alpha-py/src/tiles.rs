@@ -37,6 +37,18 @@ pub fn region_side_extent(
     }
 }
 
+/// A region grid as Python takes it: origin (x, y), the side its regions
+/// run with, the side to report (`None`: one region holds the cloud) and
+/// the first margin.
+type GridOut = ((f64, f64), f64, Option<f64>, f64);
+
+/// A region's points among some points: their indices and which are its
+/// core.
+type Selection<'py> = (Bound<'py, PyArray1<u32>>, Bound<'py, PyArray1<bool>>);
+
+/// Structure and part labels (int64, −1: none).
+type LabelsOut<'py> = (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<i64>>);
+
 fn grid(origin: (f64, f64), side: f64) -> PyResult<RegionGrid> {
     RegionGrid::of_extent([origin.0, origin.1, 0.0], side).map_err(value_error)
 }
@@ -46,12 +58,7 @@ fn grid(origin: (f64, f64), side: f64) -> PyResult<RegionGrid> {
 /// (`None`: one region holds the cloud) and the first margin.
 #[pyfunction]
 #[pyo3(signature = (lo, hi, n, side = None))]
-pub fn region_grid(
-    lo: [f64; 3],
-    hi: [f64; 3],
-    n: usize,
-    side: Option<f64>,
-) -> PyResult<((f64, f64), f64, Option<f64>, f64)> {
+pub fn region_grid(lo: [f64; 3], hi: [f64; 3], n: usize, side: Option<f64>) -> PyResult<GridOut> {
     if n == 0 {
         return Err(PyValueError::new_err("no points"));
     }
@@ -109,7 +116,7 @@ pub fn region_select<'py>(
     side: f64,
     cell: (i64, i64),
     margin: f64,
-) -> PyResult<(Bound<'py, PyArray1<u32>>, Bound<'py, PyArray1<bool>>)> {
+) -> PyResult<Selection<'py>> {
     let window = grid(origin, side)?.window(cell, margin);
     let points = Points::extract(points)?;
     let pts = points.as_slice();
@@ -168,13 +175,7 @@ impl PyRegionJoined {
 
     /// The structure and part labels (int64, −1: none) of the `n` points
     /// from input index `first` on.
-    #[allow(clippy::type_complexity)]
-    fn labels<'py>(
-        &self,
-        py: Python<'py>,
-        first: usize,
-        n: usize,
-    ) -> PyResult<(Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<i64>>)> {
+    fn labels<'py>(&self, py: Python<'py>, first: usize, n: usize) -> PyResult<LabelsOut<'py>> {
         self.check(first, n)?;
         let (parts, structures) = self.joined.labels(first, n);
         Ok((structures.into_pyarray(py), parts.into_pyarray(py)))

@@ -269,7 +269,12 @@ def test_regions_equal_in_process(client):
     # Each region's estimate reaches past side/16: every task is sent
     # again with a wider margin, and the ground crosses every border.
     assert ref.regions == 6 and ref.widened == 6 and ref.parts[0].pieces == 6
-    assert_same_regions(distributed.detect_regions(pts, "planes", side=30.0, client=client), ref)
+    seen = []
+    r = distributed.detect_regions(pts, "planes", side=30.0, client=client, progress=lambda d, t: seen.append((d, t)))
+    assert_same_regions(r, ref)
+    assert seen == [(k, 6) for k in range(1, 7)]
+    with pytest.raises(RuntimeError, match="cancelled by the progress callback"):
+        distributed.detect_regions(pts, "planes", side=30.0, client=client, progress=lambda d, t: False)
     # No side: about one region here, as aa.detect_regions.
     whole = distributed.detect_regions(pts, "planes", client=client)
     assert whole.side is None and whole.regions == 1
@@ -334,7 +339,11 @@ def test_tiles_equal_regions_on_the_stacked_points(client, tmp_path):
     ref = aa.detect_regions(stacked, "planes", side=30.0)
     assert ref.regions == 6 and ref.widened == 6 and ref.joins > 0
     out = tmp_path / "out"
-    r = distributed.detect_tiles(paths, "planes", out, side=30.0, client=client, classify=6)
+    seen = []
+    r = distributed.detect_tiles(
+        paths, "planes", out, side=30.0, client=client, classify=6, progress=lambda d, t: seen.append((d, t))
+    )
+    assert seen == [(k, 6) for k in range(1, 7)]
     assert [os.path.basename(o) for o in r.outputs] == ["south.las", "middle.ply", "north.las"]
     assert_tiles_equal_regions(r, ref, len(stacked))
     # A LAS tile's records are kept, the class set on the structures' points.
@@ -370,6 +379,10 @@ def test_tiles_refuse_bad_input_before_any_work(client, tmp_path):
     assert not (tmp_path / "o").exists()
     with pytest.raises(OSError):
         distributed.detect_tiles([str(tmp_path / "missing.las")], "planes", client=client)
+    with pytest.raises(RuntimeError, match="cancelled by the progress callback"):
+        distributed.detect_tiles(paths, "planes", tmp_path / "o", side=30.0, client=client,
+                                 progress=lambda d, t: d < 2 and None)
+    assert not (tmp_path / "o").exists()
 
 
 def test_a_tiled_region_whose_worker_is_killed_gives_the_same_labels(tmp_path):

@@ -451,6 +451,7 @@ def _run_regions(
     size: Callable[[int], str],
     join: Any,
     add: Callable[[int, Optional[Tuple[Any, ...]], Tuple[Any, ...]], None],
+    progress: Optional[Callable[[int, int], Optional[bool]]] = None,
 ) -> None:
     """Runs regions ``0..n_regions`` as tasks (``submit(r, margin)`` gives
     region r's future, whose result is ``(kind, margin, step, ...)``), at
@@ -460,7 +461,9 @@ def _run_regions(
     reaches past its margin is sent again with the margin it asks for
     (each widening counted in ``join``, as the in-process run counts it). A
     region whose task was lost with its worker on every try Dask allows
-    raises :class:`RegionLost` (``size(r)`` describes it)."""
+    raises :class:`RegionLost` (``size(r)`` describes it). ``progress(done,
+    total)`` is called after each region joined; ``False`` cancels
+    (``RuntimeError``)."""
     from dask.distributed import as_completed
 
     waiting: Dict[int, Tuple[Optional[Tuple[Any, ...]], Tuple[Any, ...], int]] = {}
@@ -499,6 +502,10 @@ def _run_regions(
                 join.widened()
             add(joined, step, res)
             joined += 1
+            if progress is not None and progress(joined, n_regions) is False:
+                for f in list(pending.futures):
+                    f.cancel()
+                raise RuntimeError("the region run was cancelled by the progress callback")
         nxt = next(regions, None)
         if nxt is not None:
             pending.add(send(nxt, first_margin, 0))  # type: ignore[no-untyped-call]
@@ -529,6 +536,7 @@ def detect_regions(
     task_threads: int = 1,
     normals: Optional[ArrayLike] = None,
     ignore_normals: bool = False,
+    progress: Optional[Callable[[int, int], Optional[bool]]] = None,
     **options: Any,
 ) -> RegionDetection:
     """:func:`aniso_alpha.detect_regions` with each region run as a Dask
@@ -543,6 +551,9 @@ def detect_regions(
             ``LocalCluster`` of ``n_workers`` processes, one thread each.
         n_workers: the workers of that LocalCluster (default: one per core).
         task_threads: threads of each region task.
+        progress: called as ``progress(done, total)`` on this process after
+            each region joined (in the plan's order); ``False`` cancels
+            (``RuntimeError``).
         normals, ignore_normals, options: as for
             :func:`aniso_alpha.detect_regions`; the parameters are
             estimated in each task, from its region's points.
@@ -597,7 +608,7 @@ def detect_regions(
         def add(r: int, step: Optional[Tuple[Any, ...]], out: Tuple[Any, ...]) -> None:
             join.add(ids_of.pop(r), plan.core(r), step)
 
-        _run_regions(client, len(plan), plan.first_margin, submit, size, join, add)
+        _run_regions(client, len(plan), plan.first_margin, submit, size, join, add, progress)
         run = join.finish(points)
     finally:
         _close(own)
@@ -676,6 +687,7 @@ def detect_tiles(
     n_workers: Optional[int] = None,
     task_threads: int = 1,
     classify: Optional[int] = None,
+    progress: Optional[Callable[[int, int], Optional[bool]]] = None,
     **options: Any,
 ) -> TileDetection:
     """:func:`detect_regions` over a cloud held as tiles (point files, such
@@ -691,9 +703,10 @@ def detect_tiles(
             and records kept, the ids added as ``structure`` and ``part``),
             under its own name (a tile that is neither LAS, LAZ nor PLY as
             PLY); ``None`` writes nothing and returns the parts.
-        side, client, n_workers, task_threads, options: as for
-            :func:`detect_regions`. The normals of the tiles are not read:
-            each region estimates its own.
+        side, client, n_workers, task_threads, progress, options: as for
+            :func:`detect_regions` (``progress`` counts the regions). The
+            normals of the tiles are not read: each region estimates its
+            own.
         classify: a LAS classification given to the structures' points in
             the outputs (as :func:`aniso_alpha.write`'s).
 
@@ -765,7 +778,9 @@ def detect_tiles(
             else:
                 join.add(np.require(res[3], requirements=("C", "A")), np.require(res[4], requirements=("C", "A")), step)
 
-        _run_regions(client, len(cells), first_margin, submit, lambda r: f"cell {tuple(cells[r])}", join, add)
+        _run_regions(
+            client, len(cells), first_margin, submit, lambda r: f"cell {tuple(cells[r])}", join, add, progress
+        )
     finally:
         _close(own)
     joined = join.resolve()
