@@ -444,7 +444,7 @@ impl RegionJoined {
 
 /// The fits of a region run's joined parts over points streamed in input
 /// order ([`PassFit`] per part): three passes, each over every point in
-/// input order (in chunks: [`Self::add`] with each chunk's first input
+/// input order (in chunks: [`Self::add_points`] with each chunk's first input
 /// index), each ended by [`Self::end_pass`]. The fits are those of the
 /// points gathered, bit for bit.
 #[derive(Debug, Clone)]
