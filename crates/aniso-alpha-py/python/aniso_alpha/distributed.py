@@ -734,8 +734,12 @@ def detect_tiles(
     >>> for k, p in enumerate(paths):
     ...     np.savetxt(p, sheet[k * 900 : (k + 1) * 900])
     >>> r = distributed.detect_tiles(paths, "planes", os.path.join(d, "out"), side=30.0, n_workers=2)
-    >>> [os.path.basename(o) for o in r.outputs], r.parts[0].points
-    (['t0.ply', 't1.ply'], 1800)
+    >>> [os.path.basename(o) for o in r.outputs]
+    ['t0.ply', 't1.ply']
+    >>> ref = aa.detect_regions(distributed.load(paths), "planes", side=30.0)
+    >>> labels = np.concatenate([aa.read(o).attributes["part"] for o in r.outputs])
+    >>> bool((labels == ref.part_labels).all()), r.parts[0].points == ref.parts[0].points
+    (True, True)
     """
     paths = [os.fspath(t) for t in tiles]
     if not paths:
