@@ -385,6 +385,24 @@ def test_tiles_refuse_bad_input_before_any_work(client, tmp_path):
     assert not (tmp_path / "o").exists()
 
 
+def test_a_tiled_run_that_fails_writes_no_labelled_tile(client, tmp_path):
+    """A tile rewritten during the run (fewer points) is an error when the
+    driver reads it back; the labelled tiles already written are not left
+    in the folder."""
+    pts, _ = ground_and_roof_scene()
+    paths, _ = tiles_of(tmp_path, pts)
+    north = pts[pts[:, 1] >= 41.0]
+
+    def shrink_north(done, total):
+        if done == total:
+            write_las(paths[2], north[:-10])
+
+    out = tmp_path / "out"
+    with pytest.raises(ValueError, match="north.las: .* when the run began"):
+        distributed.detect_tiles(paths, "planes", out, side=30.0, client=client, progress=shrink_north)
+    assert list(out.iterdir()) == []
+
+
 def test_a_tiled_region_whose_worker_is_killed_gives_the_same_labels(tmp_path):
     """The first region task kills its worker: Dask runs it again (it reads
     its tiles from their paths) and the outputs are those of an

@@ -36,6 +36,8 @@ from __future__ import annotations
 import json
 import math
 import os
+import shutil
+import tempfile
 import time
 from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Type, Union
 
@@ -677,6 +679,40 @@ def _output_names(tiles: Sequence[str], out: str) -> List[str]:
     return names
 
 
+def _labels_and_fits(
+    joined: Any,
+    paths: Sequence[str],
+    firsts: Sequence[int],
+    counts: Sequence[int],
+    staging: Optional[str],
+    names: Sequence[str],
+    classify: Optional[int],
+) -> None:
+    """The driver's three passes over the tiles in input order: the first
+    writes each tile's labelled copy into ``staging`` (when given) and
+    feeds the joined parts' refit, the two others finish the refit."""
+    for k in range(3):
+        for i, (path, first, n) in enumerate(zip(paths, firsts, counts)):
+            cloud = read(path, attributes=k == 0 and staging is not None)
+            if len(cloud.points) != n:
+                raise ValueError(f"{path}: {len(cloud.points)} points, {n} when the run began")
+            joined.refit(first, cloud.points)
+            if k == 0 and staging is not None:
+                labels, part_labels = joined.labels(first, n)
+                _native.write(
+                    os.path.join(staging, os.path.basename(names[i])),
+                    cloud.points,
+                    list(cloud.attributes.items()),
+                    cloud._las,
+                    labels,
+                    part_labels,
+                    None,
+                    None if classify is None else int(classify),
+                )
+            del cloud
+        joined.end_pass()
+
+
 def detect_tiles(
     tiles: Sequence[PathLike],
     structure: Structure,
@@ -702,7 +738,10 @@ def detect_tiles(
             as :func:`aniso_alpha.write` writes it (a LAS/LAZ tile's header
             and records kept, the ids added as ``structure`` and ``part``),
             under its own name (a tile that is neither LAS, LAZ nor PLY as
-            PLY); ``None`` writes nothing and returns the parts.
+            PLY); ``None`` writes nothing and returns the parts. The
+            labelled tiles are written in a hidden folder inside ``out``
+            and moved in together once all are complete: a run that fails
+            leaves none.
         side, client, n_workers, task_threads, progress, options: as for
             :func:`detect_regions` (``progress`` counts the regions). The
             normals of the tiles are not read: each region estimates its
@@ -788,27 +827,18 @@ def detect_tiles(
     finally:
         _close(own)
     joined = join.resolve()
-    for k in range(3):
-        for i, (path, first, n) in enumerate(zip(paths, firsts, counts)):
-            cloud = read(path, attributes=k == 0 and out is not None)
-            if len(cloud.points) != n:
-                raise ValueError(f"{path}: {len(cloud.points)} points, {n} when the run began")
-            joined.refit(first, cloud.points)
-            if k == 0 and out is not None:
-                os.makedirs(os.fspath(out), exist_ok=True)
-                labels, part_labels = joined.labels(first, n)
-                _native.write(
-                    names[i],
-                    cloud.points,
-                    list(cloud.attributes.items()),
-                    cloud._las,
-                    labels,
-                    part_labels,
-                    None,
-                    None if classify is None else int(classify),
-                )
-            del cloud
-        joined.end_pass()
+    staging = None
+    if out is not None:
+        os.makedirs(os.fspath(out), exist_ok=True)
+        staging = tempfile.mkdtemp(prefix=".aniso-alpha-", dir=os.fspath(out))
+    try:
+        _labels_and_fits(joined, paths, firsts, counts, staging, names, classify)
+        # Every labelled tile is complete: they enter the folder together.
+        for name in names:
+            os.replace(os.path.join(str(staging), os.path.basename(name)), name)
+    finally:
+        if staging is not None:
+            shutil.rmtree(staging, ignore_errors=True)
     _, _, rows, regions, widened, joins, skipped, messages = joined.finish()
     _warn(messages)
     from ._api import _region_parts
