@@ -36,9 +36,14 @@
 //! (by default as many as there are threads), each parallel inside: a
 //! region's serial stages overlap another's.
 //!
-//! Memory: the cloud, two labels per point and up to `jobs` regions' runs
-//! at a time (their triangulations and assembly, which dominate a whole
-//! run's peak), with the steps of regions done ahead of their turn.
+//! Memory: the cloud, one part id a point (a point's structure is its
+//! part's), the margins' labels and up to `jobs` regions' runs at a time
+//! (their triangulations and assembly, which dominate a whole run's
+//! peak), with the steps of regions done ahead of their turn. A driver
+//! that does not hold the cloud (tiles read region by region) takes the
+//! same pieces: the grid and windows of `plan.rs`, and the joining's
+//! labels and fits streamed over the points in input order
+//! ([`RegionJoin::resolve`], [`RegionJoined::labels`], [`PartsRefit`]).
 //! Deterministic: a region's result depends on its own points (in input
 //! order) only, and the joining takes the regions in the plan's order.
 
