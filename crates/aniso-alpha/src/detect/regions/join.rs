@@ -6,8 +6,10 @@
 //! a tile at a time ([`RegionJoined::labels`], [`PartsRefit`]), with the
 //! same result bit for bit.
 //!
-//! Memory: one part id a point (4 bytes) and the regions' parts and
-//! margin labels; structures are the parts' own.
+//! Memory: one part id a point (4 bytes), the regions' parts, the pair
+//! counts, and the margin labels whose core region was not added yet
+//! (those of regions added before are counted at once); structures are
+//! the parts' own.
 
 use super::{RegionPart, RegionRun, RegionStep, SAME_SHARE};
 use crate::detect::detection::Primitive;
@@ -16,13 +18,30 @@ use crate::detect::DetectError;
 use crate::unionfind::UnionFind;
 use std::collections::HashMap;
 
+/// A point whose core region was not added yet.
+const UNSEEN: u32 = u32::MAX;
+/// A point its core region left as background.
+const NONE: u32 = u32::MAX - 1;
+
+/// The part id of a `part_of` entry, if it is one.
+fn part_id(p: u32) -> Option<u32> {
+    (p < NONE).then_some(p)
+}
+
 /// The joining of region steps: add each region's step (in the plan's
 /// order, or any fixed order), then [`Self::finish`] (a cloud in memory)
 /// or [`Self::resolve`] (a cloud streamed).
 #[derive(Debug, Clone)]
 pub struct RegionJoin {
-    /// Per point: the global region part its core region gave it, or MAX.
+    /// Per point: the global region part its core region gave it,
+    /// [`NONE`], or [`UNSEEN`].
     part_of: Vec<u32>,
+    /// Per global region part: its region.
+    part_region: Vec<u32>,
+    /// Doubly labelled points per (part in a margin, part of the core
+    /// owner), and per (part in a margin, owner's region).
+    pairs: HashMap<(u32, u32), u32>,
+    over: HashMap<(u32, u32), u32>,
     results: Vec<RegionResult>,
     n_parts: u32,
     n_structures: u32,
@@ -34,7 +53,8 @@ pub struct RegionJoin {
 }
 
 /// What one region's run leaves for the joining: per region part, its
-/// structure and axis; the (point, part) labels of its margin.
+/// structure and axis; the (point, part) labels of its margin whose core
+/// region was not added yet.
 #[derive(Debug, Clone)]
 struct RegionResult {
     parts: Vec<(u32, Option<[f64; 3]>)>,
@@ -45,7 +65,10 @@ impl RegionJoin {
     /// A joining over a cloud of `n` points.
     pub fn new(n: usize) -> Self {
         RegionJoin {
-            part_of: vec![u32::MAX; n],
+            part_of: vec![UNSEEN; n],
+            part_region: Vec::new(),
+            pairs: HashMap::new(),
+            over: HashMap::new(),
             results: Vec::new(),
             n_parts: 0,
             n_structures: 0,
@@ -98,6 +121,7 @@ impl RegionJoin {
             ));
         }
         let first_part = self.n_parts;
+        let region = self.results.len() as u32;
         let mut margin = Vec::new();
         let mut c = 0usize;
         for (k, &i) in ids.iter().enumerate() {
@@ -106,19 +130,25 @@ impl RegionJoin {
                 c += 1;
             }
             let (lp, ls) = (step.part[k], step.structure[k]);
-            if lp < 0 {
-                continue;
+            if lp >= 0 {
+                match step.parts.get(lp as usize) {
+                    Some(&(s, _)) if i64::from(s) == ls => {}
+                    _ => return bad(format!("gives point {i} part {lp} and structure {ls}")),
+                }
             }
-            match step.parts.get(lp as usize) {
-                Some(&(s, _)) if i64::from(s) == ls => {}
-                _ => return bad(format!("gives point {i} part {lp} and structure {ls}")),
-            }
-            if is_core {
-                self.part_of[i as usize] = first_part + lp as u32;
-            } else {
-                margin.push((i, first_part + lp as u32));
+            let part = (lp >= 0).then(|| first_part + lp as u32);
+            match (is_core, part) {
+                (true, p) => self.part_of[i as usize] = p.unwrap_or(NONE),
+                (false, Some(pm)) => match self.part_of[i as usize] {
+                    UNSEEN => margin.push((i, pm)),
+                    owner => self.pair(pm, owner),
+                },
+                (false, None) => {}
             }
         }
+        margin.shrink_to_fit();
+        self.part_region
+            .extend(std::iter::repeat_n(region, step.parts.len()));
         let first_structure = self.n_structures;
         let parts = step
             .parts
@@ -141,6 +171,16 @@ impl RegionJoin {
     /// (the whole cloud's answer).
     pub fn finish(self, points: &[[f64; 3]]) -> Result<RegionRun, DetectError> {
         self.finish_with(points, true)
+    }
+
+    /// Counts a doubly labelled point: part `pm` in a margin, `owner` (a
+    /// `part_of` entry) of its core region.
+    fn pair(&mut self, pm: u32, owner: u32) {
+        if let Some(owner) = part_id(owner) {
+            let owner_region = self.part_region[owner as usize];
+            *self.pairs.entry((pm, owner)).or_insert(0) += 1;
+            *self.over.entry((pm, owner_region)).or_insert(0) += 1;
+        }
     }
 
     /// [`Self::finish`], with or without the joining of step 4.
@@ -172,19 +212,19 @@ impl RegionJoin {
         self.resolve_with(true)
     }
 
-    fn resolve_with(self, joining: bool) -> Result<RegionJoined, DetectError> {
+    fn resolve_with(mut self, joining: bool) -> Result<RegionJoined, DetectError> {
         if self.skipped == self.results.len() {
             return Err(DetectError::NoSpacing);
         }
+        // The margin labels whose core region came later.
+        for r in 0..self.results.len() {
+            for (i, pm) in std::mem::take(&mut self.results[r].margin) {
+                self.pair(pm, self.part_of[i as usize]);
+            }
+        }
         let (n_parts, n_structures) = (self.n_parts as usize, self.n_structures as usize);
         let (mut parts_uf, mut structures_uf, joins) = if joining {
-            join(
-                &self.results,
-                &self.part_of,
-                n_parts,
-                n_structures,
-                self.angle,
-            )
+            join(&self, n_parts, n_structures)
         } else {
             (UnionFind::new(n_parts), UnionFind::new(n_structures), 0)
         };
@@ -209,40 +249,20 @@ fn agree(a: Option<[f64; 3]>, b: Option<[f64; 3]>, angle_deg: f64) -> bool {
     }
 }
 /// The joining (module doc, step 4): union-finds over the global part and
-/// structure ids, and the number of joins.
-fn join(
-    results: &[RegionResult],
-    part_of: &[u32],
-    n_parts: usize,
-    n_structures: usize,
-    angle_deg: f64,
-) -> (UnionFind, UnionFind, usize) {
+/// structure ids, and the number of joins, from the pair counts of `j`.
+fn join(j: &RegionJoin, n_parts: usize, n_structures: usize) -> (UnionFind, UnionFind, usize) {
+    let (pairs, over, angle_deg) = (&j.pairs, &j.over, j.angle);
     // Per global part: its region, structure and primitive.
-    let mut info: Vec<(usize, u32, Option<[f64; 3]>)> = Vec::with_capacity(n_parts);
-    for (r, res) in results.iter().enumerate() {
+    let mut info: Vec<(u32, u32, Option<[f64; 3]>)> = Vec::with_capacity(n_parts);
+    for (r, res) in j.results.iter().enumerate() {
         for &(s, a) in &res.parts {
-            info.push((r, s, a));
-        }
-    }
-    // Pairs (part in the margin, part of the core owner), counted; and
-    // per (margin part, owner region) the doubly labelled points.
-    let mut pairs: HashMap<(u32, u32), u32> = HashMap::new();
-    let mut over: HashMap<(u32, usize), u32> = HashMap::new();
-    for res in results {
-        for &(i, pm) in &res.margin {
-            let owner = part_of[i as usize];
-            if owner == u32::MAX {
-                continue;
-            }
-            let owner_region = info[owner as usize].0;
-            *pairs.entry((pm, owner)).or_insert(0) += 1;
-            *over.entry((pm, owner_region)).or_insert(0) += 1;
+            info.push((r as u32, s, a));
         }
     }
     // Counts the other way: for a core part `owner` seen from region r,
     // how many of its points r's margin labelled.
-    let mut seen: HashMap<(u32, usize), u32> = HashMap::new();
-    for (&(pm, owner), &c) in &pairs {
+    let mut seen: HashMap<(u32, u32), u32> = HashMap::new();
+    for (&(pm, owner), &c) in pairs {
         *seen.entry((owner, info[pm as usize].0)).or_insert(0) += c;
     }
     let mut keys: Vec<(u32, u32)> = pairs.keys().copied().collect();
@@ -322,7 +342,7 @@ impl RegionJoined {
         // Points per global region part, in one pass over the points.
         let mut held = vec![0usize; n_parts];
         for &p in &join.part_of {
-            if p != u32::MAX {
+            if let Some(p) = part_id(p) {
                 held[p as usize] += 1;
             }
         }
@@ -378,8 +398,7 @@ impl RegionJoined {
 
     /// The final part of point `i`, or `None`.
     fn final_part(&self, i: usize) -> Option<(u32, u32)> {
-        let p = self.part_of[i];
-        (p != u32::MAX).then(|| self.final_of[p as usize])
+        part_id(self.part_of[i]).map(|p| self.final_of[p as usize])
     }
 
     /// The part and structure labels (−1: none) of the `n` points from
