@@ -757,9 +757,10 @@ def detect_tiles(
     What each process holds: a worker, one region (the tiles that meet
     its window are read one at a time and cut); the driver, the tiles'
     bounds, the regions' cells, one part id a point (4 bytes) and the
-    regions' margin labels for the joining, and one tile at a time while
-    it writes the labels and refits the joined parts (three passes over
-    the tiles in input order: the same fits as of the stacked points).
+    margin labels still waiting for their core region, and one tile at a
+    time while it writes the labels and refits the joined parts (three
+    passes over the tiles in input order: the same fits as of the stacked
+    points).
     Tasks read their tiles from the paths, so a task whose worker dies is
     run again by Dask with the same result; the paths must be readable
     from every worker.
