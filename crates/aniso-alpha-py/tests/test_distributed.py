@@ -347,8 +347,11 @@ def test_tiles_equal_regions_on_the_stacked_points(client, tmp_path):
     assert [os.path.basename(o) for o in r.outputs] == ["south.las", "middle.ply", "north.las"]
     assert_tiles_equal_regions(r, ref, len(stacked))
     # A LAS tile's records are kept, the class set on the structures' points.
-    south = aa.read(r.outputs[0])
-    np.testing.assert_array_equal(south.points, aa.read(paths[0]).points)
+    south, tile = aa.read(r.outputs[0]), aa.read(paths[0])
+    np.testing.assert_array_equal(south.points, tile.points)
+    for name, values in tile.attributes.items():
+        if name != "classification":
+            np.testing.assert_array_equal(south.attributes[name], values, err_msg=name)
     on = south.attributes["structure"] >= 0
     assert on.any() and (south.attributes["classification"][on] == 6).all()
     # No folder: the parts alone; no side: one region, as in process.

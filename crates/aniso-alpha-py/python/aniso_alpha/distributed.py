@@ -699,10 +699,13 @@ def _labels_and_fits(
             joined.refit(first, cloud.points)
             if k == 0 and staging is not None:
                 labels, part_labels = joined.labels(first, n)
+                # A LAS/LAZ tile written as LAS/LAZ keeps its records byte
+                # for byte: the writer has no use for the decoded attributes.
+                as_las = cloud._las is not None and names[i].lower().endswith((".las", ".laz"))
                 _native.write(
                     os.path.join(staging, os.path.basename(names[i])),
                     cloud.points,
-                    list(cloud.attributes.items()),
+                    [] if as_las else list(cloud.attributes.items()),
                     cloud._las,
                     labels,
                     part_labels,
