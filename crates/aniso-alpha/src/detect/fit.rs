@@ -208,6 +208,12 @@ fn add_sum(sum: &mut [f64; 3], p: [f64; 3]) {
     }
 }
 
+/// The centroid of `n` points from their sum (the end of the first pass).
+fn centroid(sum: [f64; 3], n: usize) -> [f64; 3] {
+    let n = n as f64;
+    sum.map(|x| x / n)
+}
+
 /// Adds a point to a covariance's running sum about `c` (the second pass),
 /// upper triangle only.
 #[inline]
@@ -240,7 +246,7 @@ pub(crate) fn moments(n: usize, get: impl Fn(usize) -> [f64; 3]) -> ([f64; 3], M
     for i in 0..n {
         add_sum(&mut sum, get(i));
     }
-    let c = sum.map(|x| x / n as f64);
+    let c = centroid(sum, n);
     let mut m = [[0.0; 3]; 3];
     for i in 0..n {
         add_moment(&mut m, c, get(i));
@@ -448,8 +454,7 @@ impl PassFit {
 
     /// Ends the first pass (the centroid).
     pub fn end_sums(&mut self) {
-        let n = self.n as f64;
-        self.c = self.c.map(|x| x / n);
+        self.c = centroid(self.c, self.n);
     }
 
     /// The second pass: one point.

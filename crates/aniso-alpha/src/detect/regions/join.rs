@@ -173,6 +173,11 @@ impl RegionJoin {
         self.finish_with(points, true)
     }
 
+    /// Every global region part, in order: its structure and axis.
+    fn parts(&self) -> impl Iterator<Item = (u32, Option<[f64; 3]>)> + '_ {
+        self.results.iter().flat_map(|r| r.parts.iter().copied())
+    }
+
     /// Counts a doubly labelled point: part `pm` in a margin, `owner` (a
     /// `part_of` entry) of its core region.
     fn pair(&mut self, pm: u32, owner: u32) {
@@ -248,22 +253,18 @@ fn agree(a: Option<[f64; 3]>, b: Option<[f64; 3]>, angle_deg: f64) -> bool {
         _ => false,
     }
 }
+
 /// The joining (module doc, step 4): union-finds over the global part and
 /// structure ids, and the number of joins, from the pair counts of `j`.
 fn join(j: &RegionJoin, n_parts: usize, n_structures: usize) -> (UnionFind, UnionFind, usize) {
-    let (pairs, over, angle_deg) = (&j.pairs, &j.over, j.angle);
-    // Per global part: its region, structure and primitive.
-    let mut info: Vec<(u32, u32, Option<[f64; 3]>)> = Vec::with_capacity(n_parts);
-    for (r, res) in j.results.iter().enumerate() {
-        for &(s, a) in &res.parts {
-            info.push((r as u32, s, a));
-        }
-    }
+    let (pairs, over, angle_deg, region) = (&j.pairs, &j.over, j.angle, &j.part_region);
+    // Per global part: its structure and primitive.
+    let info: Vec<(u32, Option<[f64; 3]>)> = j.parts().collect();
     // Counts the other way: for a core part `owner` seen from region r,
     // how many of its points r's margin labelled.
     let mut seen: HashMap<(u32, u32), u32> = HashMap::new();
     for (&(pm, owner), &c) in pairs {
-        *seen.entry((owner, info[pm as usize].0)).or_insert(0) += c;
+        *seen.entry((owner, region[pm as usize])).or_insert(0) += c;
     }
     let mut keys: Vec<(u32, u32)> = pairs.keys().copied().collect();
     keys.sort_unstable();
@@ -272,8 +273,8 @@ fn join(j: &RegionJoin, n_parts: usize, n_structures: usize) -> (UnionFind, Unio
     let mut joins = 0usize;
     for (pm, owner) in keys {
         let c = f64::from(pairs[&(pm, owner)]);
-        let (rm, sm, prim_m) = info[pm as usize];
-        let (ro, so, prim_o) = info[owner as usize];
+        let ((sm, prim_m), rm) = (info[pm as usize], region[pm as usize]);
+        let ((so, prim_o), ro) = (info[owner as usize], region[owner as usize]);
         let of_margin = f64::from(over[&(pm, ro)]);
         let of_owner = f64::from(seen[&(owner, rm)]);
         let majority = c >= SAME_SHARE * of_margin || c >= SAME_SHARE * of_owner;
@@ -290,7 +291,8 @@ fn join(j: &RegionJoin, n_parts: usize, n_structures: usize) -> (UnionFind, Unio
 /// in memory or streamed in input order.
 #[derive(Debug, Clone)]
 pub struct RegionJoined {
-    /// Per point: its global region part, or MAX.
+    /// Per point: its global region part, [`NONE`], or [`UNSEEN`] (as in
+    /// [`RegionJoin`]).
     part_of: Vec<u32>,
     /// Per global region part: its final part and structure ids (MAX:
     /// a part no core point holds).
@@ -333,11 +335,7 @@ impl RegionJoined {
         structures_uf: &mut UnionFind,
         joins: usize,
     ) -> Self {
-        let structure_of: Vec<u32> = join
-            .results
-            .iter()
-            .flat_map(|r| r.parts.iter().map(|&(s, _)| s))
-            .collect();
+        let structure_of: Vec<u32> = join.parts().map(|(s, _)| s).collect();
         let n_parts = structure_of.len();
         // Points per global region part, in one pass over the points.
         let mut held = vec![0usize; n_parts];
