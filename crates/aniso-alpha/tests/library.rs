@@ -37,6 +37,8 @@ mod io_attributes;
 mod io_formats;
 #[path = "io_never_panics.rs"]
 mod io_never_panics;
+#[path = "las_range.rs"]
+mod las_range;
 #[path = "lines_pipeline_bruteforce.rs"]
 mod lines_pipeline_bruteforce;
 #[path = "normals.rs"]

@@ -310,15 +310,7 @@ pub(crate) fn atomic_write_file<F>(path: &Path, write: F) -> Result<(), IoError>
 where
     F: FnOnce(File) -> std::io::Result<File>,
 {
-    let target = checked_target(path)?;
-    let werr = |source| IoError::Write {
-        path: path.to_path_buf(),
-        source,
-    };
-    let (guard, file) = TempGuard::create(temp_name(&target, "tmp")).map_err(werr)?;
-    if let Ok(meta) = fs::metadata(&target) {
-        let _ = fs::set_permissions(&guard.path, meta.permissions());
-    }
+    let (pending, file) = PendingFile::create(path)?;
     // Test hook (CLI tests of the signal handler): hold the temporary file
     // open for this many milliseconds before writing.
     if let Some(ms) = std::env::var_os("ANISO_ALPHA_TEST_WRITE_DELAY_MS")
@@ -326,10 +318,53 @@ where
     {
         std::thread::sleep(std::time::Duration::from_millis(ms));
     }
-    let file = write(file).map_err(werr)?;
-    file.sync_all().map_err(werr)?;
-    drop(file);
-    guard.commit(&target).map_err(werr)
+    let file = write(file).map_err(|source| IoError::Write {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    pending.commit(file)
+}
+
+/// An output written over several calls, atomically as [`atomic_write`]
+/// writes: a temporary file in the output's folder, renamed onto the
+/// output by [`PendingFile::commit`], removed if dropped before.
+pub(crate) struct PendingFile {
+    guard: TempGuard,
+    target: PathBuf,
+    path: PathBuf,
+}
+
+impl PendingFile {
+    /// Checks `path` as [`atomic_write`] does and creates the temporary
+    /// file (with the permissions of the file it will replace).
+    pub(crate) fn create(path: &Path) -> Result<(PendingFile, File), IoError> {
+        let target = checked_target(path)?;
+        let (guard, file) =
+            TempGuard::create(temp_name(&target, "tmp")).map_err(|source| IoError::Write {
+                path: path.to_path_buf(),
+                source,
+            })?;
+        if let Ok(meta) = fs::metadata(&target) {
+            let _ = fs::set_permissions(&guard.path, meta.permissions());
+        }
+        let pending = PendingFile {
+            guard,
+            target,
+            path: path.to_path_buf(),
+        };
+        Ok((pending, file))
+    }
+
+    /// Syncs `file` (the temporary file) and renames it onto the output.
+    pub(crate) fn commit(self, file: File) -> Result<(), IoError> {
+        let werr = |source| IoError::Write {
+            path: self.path.clone(),
+            source,
+        };
+        file.sync_all().map_err(werr)?;
+        drop(file);
+        self.guard.commit(&self.target).map_err(werr)
+    }
 }
 
 #[cfg(test)]

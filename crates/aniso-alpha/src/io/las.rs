@@ -13,12 +13,13 @@
 //! size: the declared point count is capped by [`MAX_LAZ_RATIO`] times the
 //! compressed bytes.
 
-use std::io::Cursor;
+use std::io::{Seek, SeekFrom};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::Path;
 
 use super::attributes::LasSource;
 use super::las_attrs::{parse_vlrs, record_attributes};
+use super::las_bytes::{u16_at, u32_at, u64_at, u8_at, ByteReader, LasBytes};
 use super::{check_finite, non_empty, ClassSet, IoError, PointCloud};
 
 /// The largest accepted ratio of decompressed point bytes to compressed
@@ -38,25 +39,66 @@ pub(crate) struct Layout {
     pub(crate) offset: [f64; 3],
 }
 
-/// Reads a LAS/LAZ file; with `labels`, the classification gives the
-/// labels, the classes in the set read as background (-1); with
-/// `attributes`, the records are kept ([`PointCloud::las`]) and decoded
-/// into [`PointCloud::attributes`].
+/// Reads a LAS/LAZ file held in memory; with `labels`, the
+/// classification gives the labels, the classes in the set read as
+/// background (-1); with `attributes`, the records are kept
+/// ([`PointCloud::las`]) and decoded into [`PointCloud::attributes`].
 pub(crate) fn read_las(
     path: &Path,
     bytes: &[u8],
     labels_with: Option<ClassSet>,
     attributes: bool,
 ) -> Result<PointCloud, IoError> {
+    read_las_from(path, bytes, None, labels_with, attributes, &mut |_, _| {})
+}
+
+/// The number of points a LAS/LAZ file declares, checked as a read
+/// checks it (a LAZ file's chunk table must hold them).
+pub(crate) fn las_points<B: LasBytes + ?Sized>(path: &Path, bytes: &B) -> Result<u64, IoError> {
+    let bad = |m: String| IoError::format(path, format!("invalid LAS/LAZ file: {m}"));
+    precheck(bytes).map_err(bad)?;
+    let (layout, _) = contain(path, || header_layout(bytes))?.map_err(bad)?;
+    Ok(layout.points)
+}
+
+/// The points `start..start + count` of a LAS/LAZ file (a range past the
+/// end is cut at it), read from `bytes` without the rest of the point
+/// records: the records of an uncompressed file are read at their offset,
+/// a LAZ file's from the chunk that holds `start`. The checks of a hostile
+/// file are those of a whole read. With `attributes`, the range's records
+/// are kept, with the file's header, VLRs and trailing data.
+/// `progress(bytes, file_size)` is called after each batch of records
+/// (the bytes as the share of the range's points read).
+pub(crate) fn read_las_from<B: LasBytes + ?Sized>(
+    path: &Path,
+    bytes: &B,
+    range: Option<(u64, u64)>,
+    labels_with: Option<ClassSet>,
+    attributes: bool,
+    progress: &mut dyn FnMut(u64, u64),
+) -> Result<PointCloud, IoError> {
     let read_labels = labels_with.is_some();
     let background = labels_with.unwrap_or(ClassSet::EMPTY);
     let bad = |m: String| IoError::format(path, format!("invalid LAS/LAZ file: {m}"));
     precheck(bytes).map_err(bad)?;
     let (layout, laz) = contain(path, || header_layout(bytes))?.map_err(bad)?;
+    let (start, count) = match range {
+        None => (0, layout.points),
+        Some((s, _)) if s >= layout.points && layout.points > 0 => {
+            return Err(IoError::format(
+                path,
+                format!(
+                    "point range starts at {s}, the file has {} points",
+                    layout.points
+                ),
+            ))
+        }
+        Some((s, n)) => (s, n.min(layout.points.saturating_sub(s))),
+    };
     let mut cloud = PointCloud::default();
-    let cap = usize::try_from(layout.points)
+    let cap = usize::try_from(count)
         .unwrap_or(usize::MAX)
-        .min(bytes.len() / 4);
+        .min(usize::try_from(bytes.size() / 4).unwrap_or(usize::MAX));
     cloud.points.reserve(cap);
     let mut labels = Vec::new();
     if read_labels {
@@ -66,7 +108,13 @@ pub(crate) fn read_las(
     let class_mask = if layout.extended { 0xFF } else { 0x1F };
     let mut kept: Vec<u8> = Vec::new();
     if attributes {
-        kept.reserve(cap.saturating_mul(layout.record_len).min(bytes.len() * 4));
+        kept.reserve(
+            cap.saturating_mul(layout.record_len).min(
+                usize::try_from(bytes.size())
+                    .unwrap_or(usize::MAX)
+                    .saturating_mul(4),
+            ),
+        );
     }
     let mut sink = |records: &[u8]| -> Result<(), IoError> {
         if attributes {
@@ -95,49 +143,62 @@ pub(crate) fn read_las(
         }
         Ok(())
     };
+    let len = layout.record_len as u64;
+    let batch = batch_size(layout.record_len, bytes.size());
     match laz {
         None => {
-            let n = usize::try_from(layout.points).unwrap_or(usize::MAX);
-            let end = n
-                .checked_mul(layout.record_len)
-                .and_then(|b| b.checked_add(layout.data_start))
-                .filter(|&e| e <= bytes.len())
-                .ok_or_else(|| {
-                    IoError::format(
-                        path,
-                        format!(
-                            "LAS file truncated: header declares {} points of {} bytes, file has {} bytes",
-                            layout.points,
-                            layout.record_len,
-                            bytes.len()
-                        ),
-                    )
-                })?;
-            sink(&bytes[layout.data_start..end])?;
+            let truncated = || {
+                IoError::format(
+                    path,
+                    format!(
+                        "LAS file truncated: header declares {} points of {} bytes, file has {} bytes",
+                        layout.points,
+                        layout.record_len,
+                        bytes.size()
+                    ),
+                )
+            };
+            let mut at = start;
+            while at < start + count {
+                let n = (start + count - at).min(batch);
+                let offset = at
+                    .checked_mul(len)
+                    .and_then(|o| o.checked_add(layout.data_start as u64))
+                    .ok_or_else(truncated)?;
+                let records = bytes.piece(offset, n * len).ok_or_else(truncated)?;
+                sink(&records)?;
+                at += n;
+                progress(share(at - start, count, bytes.size()), bytes.size());
+            }
         }
         Some(vlr) => {
-            let mut source = Cursor::new(bytes);
-            source.set_position(layout.data_start as u64);
+            let mut source = std::io::BufReader::new(ByteReader::new(bytes));
+            source
+                .seek(SeekFrom::Start(layout.data_start as u64))
+                .map_err(|e| bad(format!("LAZ: {e}")))?;
             let mut dec = contain(path, move || laz::LasZipDecompressor::new(source, vlr))?
                 .map_err(|e| bad(format!("LAZ: {e}")))?;
-            let batch = batch_size(layout.record_len, bytes.len());
+            let corrupt = |done: u64, e: &dyn std::fmt::Display| {
+                IoError::format(
+                    path,
+                    format!(
+                        "LAZ data corrupt or truncated after {done} of {} points: {e}",
+                        layout.points
+                    ),
+                )
+            };
+            if start > 0 {
+                contain(path, || dec.seek(start))?.map_err(|e| corrupt(start, &e))?;
+            }
             let mut buf = Vec::new();
-            let mut left = layout.points;
-            while left > 0 {
-                let n = left.min(batch) as usize;
+            let mut at = start;
+            while at < start + count {
+                let n = (start + count - at).min(batch) as usize;
                 buf.resize(n * layout.record_len, 0);
-                let done = layout.points - left;
-                contain(path, || dec.decompress_many(&mut buf))?.map_err(|e| {
-                    IoError::format(
-                        path,
-                        format!(
-                            "LAZ data corrupt or truncated after {done} of {} points: {e}",
-                            layout.points
-                        ),
-                    )
-                })?;
+                contain(path, || dec.decompress_many(&mut buf))?.map_err(|e| corrupt(at, &e))?;
                 sink(&buf)?;
-                left -= n as u64;
+                at += n as u64;
+                progress(share(at - start, count, bytes.size()), bytes.size());
             }
         }
     }
@@ -154,15 +215,21 @@ pub(crate) fn read_las(
 
 /// The header, VLRs and data after the points of a LAS file, with its
 /// `records`.
-fn source(bytes: &[u8], layout: &Layout, records: Vec<u8>) -> Result<LasSource, String> {
-    let header_size = u16_at(bytes, 94).ok_or("short header")? as usize;
+fn source<B: LasBytes + ?Sized>(
+    bytes: &B,
+    layout: &Layout,
+    records: Vec<u8>,
+) -> Result<LasSource, String> {
+    let header_size = u16_at(bytes, 94).ok_or("short header")?;
     let n_vlrs = u32_at(bytes, 100).ok_or("short header")?;
-    let header = bytes
-        .get(..header_size)
-        .filter(|_| header_size <= layout.data_start)
-        .ok_or("header size past the point data")?
-        .to_vec();
-    let (vlrs, padding) = parse_vlrs(bytes, header_size, n_vlrs, layout.data_start)?;
+    if header_size > layout.data_start as u64 {
+        return Err("header size past the point data".into());
+    }
+    let head = bytes
+        .piece(0, layout.data_start as u64)
+        .ok_or("header size past the point data")?;
+    let header = head[..header_size as usize].to_vec();
+    let (vlrs, padding) = parse_vlrs(&head, header_size as usize, n_vlrs, layout.data_start)?;
     // What follows the points: LAS 1.4 extended VLRs, or a LAS 1.3+
     // waveform record stored in the file (global encoding bit 1).
     let points_end = if layout.compressed {
@@ -170,9 +237,9 @@ fn source(bytes: &[u8], layout: &Layout, records: Vec<u8>) -> Result<LasSource, 
     } else {
         layout.data_start as u64 + layout.points * layout.record_len as u64
     };
-    let len = bytes.len() as u64;
+    let len = bytes.size();
     let mut tail_start = u64::MAX;
-    let minor = bytes.get(25).copied().unwrap_or(0);
+    let minor = u8_at(bytes, 25).unwrap_or(0);
     let global = u16_at(bytes, 6).unwrap_or(0);
     if minor >= 3 && header_size >= 235 && global & 2 != 0 {
         let wf = u64_at(bytes, 227).unwrap_or(0);
@@ -189,13 +256,16 @@ fn source(bytes: &[u8], layout: &Layout, records: Vec<u8>) -> Result<LasSource, 
     let (tail_start, tail) = if tail_start == u64::MAX {
         (0, Vec::new())
     } else {
-        (tail_start, bytes[tail_start as usize..].to_vec())
+        let tail = bytes
+            .piece(tail_start, len - tail_start)
+            .ok_or("trailing data past the end of the file")?;
+        (tail_start, tail.into_owned())
     };
     Ok(LasSource {
         header,
         vlrs,
         padding,
-        point_format: bytes.get(104).copied().unwrap_or(0) & 0x3F,
+        point_format: u8_at(bytes, 104).unwrap_or(0) & 0x3F,
         record_len: layout.record_len,
         records,
         tail_start,
@@ -221,8 +291,9 @@ pub(crate) fn contain<T>(path: &Path, f: impl FnOnce() -> T) -> Result<T, IoErro
 
 /// Parses the header with the `las` crate and, for LAZ, checks the laszip
 /// VLR and chunk table ([`laz_precheck`]).
-fn header_layout(bytes: &[u8]) -> Result<(Layout, Option<laz::LazVlr>), String> {
-    let header = las::Header::new(Cursor::new(bytes)).map_err(|e| e.to_string())?;
+fn header_layout<B: LasBytes + ?Sized>(bytes: &B) -> Result<(Layout, Option<laz::LazVlr>), String> {
+    let header = las::Header::new(std::io::BufReader::new(ByteReader::new(bytes)))
+        .map_err(|e| e.to_string())?;
     let format = header.point_format();
     let t = header.transforms();
     let layout = Layout {
@@ -245,31 +316,13 @@ fn header_layout(bytes: &[u8]) -> Result<(Layout, Option<laz::LazVlr>), String> 
     Ok((layout, laz))
 }
 
-fn u16_at(b: &[u8], o: usize) -> Option<u64> {
-    Some(u64::from(u16::from_le_bytes(
-        b.get(o..o.checked_add(2)?)?.try_into().ok()?,
-    )))
-}
-
-fn u32_at(b: &[u8], o: usize) -> Option<u64> {
-    Some(u64::from(u32::from_le_bytes(
-        b.get(o..o.checked_add(4)?)?.try_into().ok()?,
-    )))
-}
-
-fn u64_at(b: &[u8], o: usize) -> Option<u64> {
-    Some(u64::from_le_bytes(
-        b.get(o..o.checked_add(8)?)?.try_into().ok()?,
-    ))
-}
-
 /// Checks the header fields that the `las` crate trusts for allocations
 /// and arithmetic (it panics or aborts on some lies): the point data size
 /// must not overflow, and an extended VLR must fit in the file. Fields that
 /// are missing (a short file) are left to the crate, which reports them.
-fn precheck(b: &[u8]) -> Result<(), String> {
-    let len = b.len() as u64;
-    let (Some(major), Some(minor)) = (b.get(24).copied(), b.get(25).copied()) else {
+fn precheck<B: LasBytes + ?Sized>(b: &B) -> Result<(), String> {
+    let len = b.size();
+    let (Some(major), Some(minor)) = (u8_at(b, 24), u8_at(b, 25)) else {
         return Ok(());
     };
     let v14 = major > 1 || (major == 1 && minor >= 4);
@@ -283,7 +336,7 @@ fn precheck(b: &[u8]) -> Result<(), String> {
         .checked_mul(record_len)
         .and_then(|n| n.checked_add(offset))
         .ok_or("point count × record length overflows")?;
-    let compressed = b.get(104).is_some_and(|f| f & 0xC0 != 0);
+    let compressed = u8_at(b, 104).is_some_and(|f| f & 0xC0 != 0);
     if !compressed && end > len && record_len > 0 {
         return Err(format!(
             "truncated: header declares {count} points of {record_len} bytes, file has {len} bytes"
@@ -299,9 +352,9 @@ fn precheck(b: &[u8]) -> Result<(), String> {
         let start = u64_at(b, 235).unwrap_or(0);
         let n = u32_at(b, 243).unwrap_or(0);
         if start > 0 && n > 0 {
-            let rec = usize::try_from(start)
-                .ok()
-                .and_then(|s| u64_at(b, s.checked_add(20)?))
+            let rec = start
+                .checked_add(20)
+                .and_then(|at| u64_at(b, at))
                 .ok_or("extended VLR starts past the end of the file")?;
             if rec.checked_add(start + 60).is_none_or(|e| e > len) {
                 return Err("extended VLR extends past the end of the file".into());
@@ -313,20 +366,20 @@ fn precheck(b: &[u8]) -> Result<(), String> {
 
 /// The laszip VLR's payload: the VLRs are walked here (bounded by the
 /// header's count and the file), `None` if there is no laszip VLR.
-fn find_laszip_vlr(b: &[u8]) -> Option<&[u8]> {
-    let header_size = u16_at(b, 94)? as usize;
+fn find_laszip_vlr<B: LasBytes + ?Sized>(b: &B) -> Option<Vec<u8>> {
+    let header_size = u16_at(b, 94)?;
     let n = u32_at(b, 100)?;
     let mut pos = header_size;
     for _ in 0..n {
-        let head = b.get(pos..pos.checked_add(54)?)?;
-        let len = usize::from(u16::from_le_bytes([head[20], head[21]]));
-        let data = b.get(pos + 54..pos + 54 + len)?;
+        let head = b.piece(pos, 54)?;
+        let len = u64::from(u16::from_le_bytes([head[20], head[21]]));
         let user = &head[2..18];
         let user = &user[..user.iter().position(|&c| c == 0).unwrap_or(16)];
         let record = u16::from_le_bytes([head[18], head[19]]);
         if user == b"laszip encoded" && record == 22204 {
-            return Some(data);
+            return b.piece(pos + 54, len).map(|d| d.into_owned());
         }
+        b.piece(pos + 54, len)?;
         pos += 54 + len;
     }
     None
@@ -386,7 +439,10 @@ fn item_layers(item: Item) -> u64 {
 
 /// Validates a LAZ file before the `laz` crate reads it; returns the
 /// parsed laszip VLR. See the module docs.
-pub(crate) fn laz_precheck(b: &[u8], layout: &Layout) -> Result<laz::LazVlr, String> {
+pub(crate) fn laz_precheck<B: LasBytes + ?Sized>(
+    b: &B,
+    layout: &Layout,
+) -> Result<laz::LazVlr, String> {
     let data = find_laszip_vlr(b).ok_or("compressed point format but no laszip VLR")?;
     let field = |o: usize, n: usize| data.get(o..o + n).ok_or("laszip VLR is too short");
     let compressor = u16::from_le_bytes(field(0, 2)?.try_into().unwrap_or_default());
@@ -417,7 +473,7 @@ pub(crate) fn laz_precheck(b: &[u8], layout: &Layout) -> Result<laz::LazVlr, Str
             )
         })
         .collect();
-    let format = b.get(104).copied().unwrap_or(0) & 0x3F;
+    let format = u8_at(b, 104).unwrap_or(0) & 0x3F;
     let base = match format {
         0 => 20,
         1 => 28,
@@ -469,16 +525,16 @@ pub(crate) fn laz_precheck(b: &[u8], layout: &Layout) -> Result<laz::LazVlr, Str
             "LAZ compressor {compressor} does not fit point format {format}"
         ));
     }
-    let vlr = laz::LazVlr::from_buffer(data).map_err(|e| format!("laszip VLR: {e}"))?;
+    let vlr = laz::LazVlr::from_buffer(&data).map_err(|e| format!("laszip VLR: {e}"))?;
     let variable = chunk_size == 0 || chunk_size == u32::MAX;
 
     // The chunk table: its offset is the first 8 bytes of the point data
     // (or, when the writer could not seek back, the last 8 bytes of the file).
-    let len = b.len() as u64;
+    let len = b.size();
     let start = layout.data_start as u64;
-    let mut table = u64_at(b, layout.data_start).ok_or("no LAZ point data")? as i64;
+    let mut table = u64_at(b, start).ok_or("no LAZ point data")? as i64;
     if table <= start as i64 {
-        table = u64_at(b, b.len().saturating_sub(8)).unwrap_or(0) as i64;
+        table = u64_at(b, len.saturating_sub(8)).unwrap_or(0) as i64;
     }
     if table <= start as i64 {
         return Err("LAZ file has no chunk table".into());
@@ -489,7 +545,7 @@ pub(crate) fn laz_precheck(b: &[u8], layout: &Layout) -> Result<laz::LazVlr, Str
             "LAZ chunk table offset {table} is outside the file ({len} bytes)"
         ));
     }
-    let count = u32_at(b, table as usize + 4).unwrap_or(0);
+    let count = u32_at(b, table + 4).unwrap_or(0);
     let compressed_bytes = table - start - 8;
     // Every chunk starts with one raw record: this bounds the count (and the
     // table's allocation) by the compressed data's size.
@@ -505,8 +561,9 @@ pub(crate) fn laz_precheck(b: &[u8], layout: &Layout) -> Result<laz::LazVlr, Str
         }
         return Ok(vlr);
     }
-    let mut cur = Cursor::new(b);
-    cur.set_position(table);
+    let mut cur = ByteReader::new(b);
+    cur.seek(SeekFrom::Start(table))
+        .map_err(|e| format!("LAZ chunk table: {e}"))?;
     let entries = laz::laszip::ChunkTable::read(&mut cur, variable)
         .map_err(|e| format!("LAZ chunk table: {e}"))?;
     let entries: Vec<(u64, u64)> = entries
@@ -552,11 +609,14 @@ pub(crate) fn laz_precheck(b: &[u8], layout: &Layout) -> Result<laz::LazVlr, Str
             if bytes < head {
                 return Err("LAZ chunk too short for its layer sizes".into());
             }
-            let sizes_at = (at + record_len + 4) as usize;
-            let mut sum = 0u64;
-            for k in 0..layers as usize {
-                sum += u32_at(b, sizes_at + 4 * k).ok_or("LAZ chunk past the end of the file")?;
-            }
+            let sizes_at = at + record_len + 4;
+            let sizes = b
+                .piece(sizes_at, 4 * layers)
+                .ok_or("LAZ chunk past the end of the file")?;
+            let sum: u64 = sizes
+                .chunks_exact(4)
+                .map(|c| u64::from(u32::from_le_bytes([c[0], c[1], c[2], c[3]])))
+                .sum();
             if sum > bytes - head {
                 return Err(format!(
                     "LAZ chunk declares {sum} bytes of layers in {} bytes",
@@ -569,13 +629,17 @@ pub(crate) fn laz_precheck(b: &[u8], layout: &Layout) -> Result<laz::LazVlr, Str
     Ok(vlr)
 }
 
+/// `size` times `done / count`.
+fn share(done: u64, count: u64, size: u64) -> u64 {
+    (size as f64 * done as f64 / count.max(1) as f64) as u64
+}
+
 /// Points per batch: at most 65536, at most 16 MiB of records, and no more
 /// records than the file could hold uncompressed (LAZ aside), at least 1.
-fn batch_size(record_len: usize, file_len: usize) -> u64 {
-    let record_len = record_len.max(1);
-    let n = (16usize << 20) / record_len;
-    let n = n.min(1 << 16).min(file_len / record_len + 1).max(1);
-    n as u64
+fn batch_size(record_len: usize, file_len: u64) -> u64 {
+    let record_len = record_len.max(1) as u64;
+    let n = (16u64 << 20) / record_len;
+    n.min(1 << 16).min(file_len / record_len + 1).max(1)
 }
 
 #[cfg(test)]

@@ -1,13 +1,17 @@
 //! LAS/LAZ files of a labelled cloud: see [`super::labelled`].
 
-use std::io::Cursor;
+use std::fs::File;
+use std::io::{BufWriter, Cursor, Seek, SeekFrom, Write};
+use std::path::{Path, PathBuf};
+
+use super::atomic::PendingFile;
 
 use super::attributes::{AttributeType, LasSource, Values, Vlr};
 use super::labelled::Labelled;
 use super::las_attrs::{
     base_len, extra_bytes_vlr, extra_entry, parse_extra_fields, ExtraField, EXTRA_ENTRY_LEN,
 };
-use super::PointCloud;
+use super::{IoError, PointCloud};
 
 /// `user` as a NUL-padded 16-byte user id.
 fn user_id(user: &[u8]) -> [u8; 16] {
@@ -73,10 +77,6 @@ fn put_u32(h: &mut [u8], at: usize, v: u32) {
     h[at..at + 4].copy_from_slice(&v.to_le_bytes());
 }
 
-fn put_u64(h: &mut [u8], at: usize, v: u64) {
-    h[at..at + 8].copy_from_slice(&v.to_le_bytes());
-}
-
 fn get_u64(h: &[u8], at: usize) -> u64 {
     h.get(at..at + 8)
         .and_then(|b| b.try_into().ok())
@@ -91,30 +91,318 @@ pub(crate) fn labelled_file(
     labelled: &Labelled<'_>,
     laz: bool,
 ) -> Result<Vec<u8>, String> {
-    let format = src.point_format;
-    let base = base_len(format).ok_or_else(|| format!("unknown LAS point format {format}"))?;
-    let old_len = src.record_len;
-    let extra = old_len
-        .checked_sub(base)
-        .ok_or("record length shorter than the point format")?;
-    let new_len = old_len + 8;
-    let new_len16 =
-        u16::try_from(new_len).map_err(|_| format!("record length {new_len} exceeds 65535"))?;
-    if src.header.len() < 227 {
-        return Err("LAS header shorter than 227 bytes".into());
-    }
-    // The classification byte and its mask.
-    let (class_at, class_mask) = if format >= 6 { (16, 0xFF) } else { (15, 0x1F) };
-    if let Some(c) = labelled.classify {
-        if c & !class_mask != 0 {
-            return Err(format!(
-                "classification {c} does not fit point format {format} (0-31)"
-            ));
+    let n = src.records.len() / src.record_len.max(1);
+    let mut w = LasLabeller::new(
+        Cursor::new(Vec::new()),
+        src,
+        n as u64,
+        laz,
+        labelled.classify,
+    )?;
+    w.append(&src.records, labelled.structure, labelled.part)?;
+    Ok(w.finish()?.into_inner())
+}
+
+/// Where a labeller's records go: the file itself (LAS) or a LAZ
+/// compressor writing into it.
+enum Sink<W: Write + Seek + Send + Sync + 'static> {
+    Las(W),
+    Laz(Box<laz::LasZipCompressor<'static, W>>),
+}
+
+/// Writes a labelled copy of a LAS/LAZ file into `W` a range of records
+/// at a time: the header and VLRs of the source with the Extra Bytes VLR
+/// extended by `structure` and `part` (int32), each record copied byte for
+/// byte with the two ids appended (and `classify` as the structures'
+/// classification), then what followed the points in the source.
+pub(crate) struct LasLabeller<W: Write + Seek + Send + Sync + 'static> {
+    sink: Sink<W>,
+    /// The header as written (its offsets into the trailing data are
+    /// updated when that data is written).
+    header: Vec<u8>,
+    tail_start: u64,
+    tail: Vec<u8>,
+    old_len: usize,
+    new_len: usize,
+    class_at: usize,
+    class_mask: u8,
+    classify: Option<u8>,
+    /// Records expected and records written.
+    points: u64,
+    written: u64,
+    records: Vec<u8>,
+}
+
+impl<W: Write + Seek + Send + Sync + 'static> LasLabeller<W> {
+    /// Writes the header and VLRs of `src`'s labelled copy into `out` (at
+    /// its current position, which must be 0) for `points` records.
+    pub(crate) fn new(
+        mut out: W,
+        src: &LasSource,
+        points: u64,
+        laz: bool,
+        classify: Option<u8>,
+    ) -> Result<Self, String> {
+        let format = src.point_format;
+        let base = base_len(format).ok_or_else(|| format!("unknown LAS point format {format}"))?;
+        let old_len = src.record_len;
+        let extra = old_len
+            .checked_sub(base)
+            .ok_or("record length shorter than the point format")?;
+        let new_len = old_len + 8;
+        let new_len16 =
+            u16::try_from(new_len).map_err(|_| format!("record length {new_len} exceeds 65535"))?;
+        if src.header.len() < 227 {
+            return Err("LAS header shorter than 227 bytes".into());
         }
+        // The classification byte and its mask.
+        let (class_at, class_mask) = if format >= 6 { (16, 0xFF) } else { (15, 0x1F) };
+        if let Some(c) = classify {
+            if c & !class_mask != 0 {
+                return Err(format!(
+                    "classification {c} does not fit point format {format} (0-31)"
+                ));
+            }
+        }
+        let (vlrs, laz_vlr) = labelled_vlrs(src, format, extra, laz)?;
+        let mut header = src.header.clone();
+        let mut head_len = header.len();
+        for v in &vlrs {
+            head_len += 54 + v.data.len();
+        }
+        head_len += src.padding.len();
+        let data_start = u32::try_from(head_len).map_err(|_| "header and VLRs exceed 4 GiB")?;
+        put_u32(&mut header, 96, data_start);
+        put_u32(&mut header, 100, vlrs.len() as u32);
+        header[104] = format | if laz { 0x80 } else { 0 };
+        put_u16(&mut header, 105, new_len16);
+
+        let mut head = Vec::with_capacity(head_len);
+        head.extend_from_slice(&header);
+        for v in &vlrs {
+            v.to_bytes(&mut head);
+        }
+        head.extend_from_slice(&src.padding);
+        debug_assert_eq!(head.len(), head_len);
+        out.write_all(&head).map_err(|e| e.to_string())?;
+        let sink = match laz_vlr {
+            None => Sink::Las(out),
+            Some(vlr) => Sink::Laz(Box::new(
+                laz::LasZipCompressor::new(out, vlr).map_err(|e| format!("LAZ: {e}"))?,
+            )),
+        };
+        Ok(LasLabeller {
+            sink,
+            header,
+            tail_start: src.tail_start,
+            tail: src.tail.clone(),
+            old_len,
+            new_len,
+            class_at,
+            class_mask,
+            classify,
+            points,
+            written: 0,
+            records: Vec::new(),
+        })
     }
 
-    // VLRs: the old ones but the Extra Bytes (rebuilt in place) and the
-    // laszip VLR (dropped; a new one for LAZ).
+    /// Appends `records` (the source's, in file order after those already
+    /// written) with one structure and part id each.
+    pub(crate) fn append(
+        &mut self,
+        records: &[u8],
+        structure: &[i64],
+        part: &[i64],
+    ) -> Result<(), String> {
+        let n = records.len() / self.old_len.max(1);
+        if records.len() != n * self.old_len || structure.len() != n || part.len() != n {
+            return Err(format!(
+                "{} bytes of {}-byte records with {} structure and {} part ids",
+                records.len(),
+                self.old_len,
+                structure.len(),
+                part.len()
+            ));
+        }
+        if self.written + n as u64 > self.points {
+            return Err(format!(
+                "{} records past the {} the header declares",
+                self.written + n as u64,
+                self.points
+            ));
+        }
+        self.records.clear();
+        self.records.reserve(n * self.new_len);
+        for (i, rec) in records.chunks_exact(self.old_len).enumerate() {
+            let start = self.records.len();
+            self.records.extend_from_slice(rec);
+            let s = structure[i];
+            if let (Some(c), true) = (self.classify, s >= 0) {
+                let b = &mut self.records[start + self.class_at];
+                *b = (*b & !self.class_mask) | c;
+            }
+            self.records.extend_from_slice(&(s as i32).to_le_bytes());
+            self.records
+                .extend_from_slice(&(part[i] as i32).to_le_bytes());
+        }
+        match &mut self.sink {
+            Sink::Las(w) => w.write_all(&self.records).map_err(|e| e.to_string())?,
+            Sink::Laz(c) => c
+                .compress_many(&self.records)
+                .map_err(|e| format!("LAZ: {e}"))?,
+        }
+        self.written += n as u64;
+        Ok(())
+    }
+
+    /// Ends the points (a LAZ file's chunk table), writes what followed
+    /// them in the source and the header's offsets into it; gives back
+    /// the writer. Every declared record must have been appended.
+    pub(crate) fn finish(self) -> Result<W, String> {
+        if self.written != self.points {
+            return Err(format!(
+                "{} records written, the header declares {}",
+                self.written, self.points
+            ));
+        }
+        let io = |e: std::io::Error| e.to_string();
+        let mut out = match self.sink {
+            Sink::Las(w) => w,
+            Sink::Laz(mut c) => {
+                c.done().map_err(|e| format!("LAZ: {e}"))?;
+                let mut w = c.into_inner();
+                w.seek(SeekFrom::End(0)).map_err(io)?;
+                w
+            }
+        };
+        if !self.tail.is_empty() {
+            let new_start = out.stream_position().map_err(io)?;
+            out.write_all(&self.tail).map_err(io)?;
+            let moved = |old: u64| {
+                if old >= self.tail_start && old < self.tail_start + self.tail.len() as u64 {
+                    old - self.tail_start + new_start
+                } else {
+                    old
+                }
+            };
+            for (at, min_len) in [(227, 235), (235, 247)] {
+                if self.header.len() >= min_len {
+                    out.seek(SeekFrom::Start(at as u64)).map_err(io)?;
+                    out.write_all(&moved(get_u64(&self.header, at)).to_le_bytes())
+                        .map_err(io)?;
+                }
+            }
+            out.seek(SeekFrom::End(0)).map_err(io)?;
+        }
+        out.flush().map_err(io)?;
+        Ok(out)
+    }
+}
+
+/// A labelled copy of a LAS/LAZ file written a range of points at a time,
+/// for a file larger than memory read with [`super::read_las_range`]:
+/// the same file as [`super::write_labelled_cloud`] writes of the whole
+/// cloud (LAZ for a `.laz` path), without ever holding its records.
+/// Written atomically: the output appears complete at
+/// [`LasLabelWriter::finish`], or not at all (dropping the writer before
+/// removes the temporary file).
+///
+/// ```
+/// use aniso_alpha::io::{read_las_range, read_points, LasLabelWriter, ReadOptions};
+/// let dir = std::env::temp_dir().join(format!("las-label-doc-{}", std::process::id()));
+/// std::fs::create_dir_all(&dir).unwrap();
+/// let input = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/las/simple.las");
+/// let options = ReadOptions { attributes: true, ..ReadOptions::default() };
+/// let first = read_las_range(&input, 0, 1000, &options)?;
+/// let rest = read_las_range(&input, 1000, u64::MAX, &options)?;
+/// let out = dir.join("labelled.laz");
+/// let mut w = LasLabelWriter::create(&out, first.las.as_deref().unwrap(), 1065, Some(6))?;
+/// for piece in [&first, &rest] {
+///     let ids = vec![0i64; piece.points.len()];
+///     w.append(&piece.las.as_ref().unwrap().records, &ids, &ids)?;
+/// }
+/// w.finish()?;
+/// assert_eq!(read_points(&out, &ReadOptions::default())?.points.len(), 1065);
+/// # std::fs::remove_dir_all(&dir).unwrap();
+/// # Ok::<(), aniso_alpha::io::IoError>(())
+/// ```
+pub struct LasLabelWriter {
+    inner: LasLabeller<BufWriter<File>>,
+    pending: PendingFile,
+    path: PathBuf,
+}
+
+impl LasLabelWriter {
+    /// Starts the labelled copy of `source` (the header, VLRs and trailing
+    /// data of a LAS/LAZ file as read; its records are not used) at
+    /// `path`, for `points` records (the source file's count); LAZ when
+    /// `path` ends in `.laz`. `classify` is the LAS classification given
+    /// to the structures' points.
+    pub fn create(
+        path: &Path,
+        source: &LasSource,
+        points: u64,
+        classify: Option<u8>,
+    ) -> Result<LasLabelWriter, IoError> {
+        let laz = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("laz"));
+        let (pending, file) = PendingFile::create(path)?;
+        let out = BufWriter::with_capacity(1 << 20, file);
+        let inner = LasLabeller::new(out, source, points, laz, classify)
+            .map_err(|m| write_error(path, m))?;
+        Ok(LasLabelWriter {
+            inner,
+            pending,
+            path: path.to_path_buf(),
+        })
+    }
+
+    /// Appends the next `records` of the source (in file order, the
+    /// source's record length each) with one structure and part id each.
+    pub fn append(
+        &mut self,
+        records: &[u8],
+        structure: &[i64],
+        part: &[i64],
+    ) -> Result<(), IoError> {
+        self.inner
+            .append(records, structure, part)
+            .map_err(|m| write_error(&self.path, m))
+    }
+
+    /// Completes the file (every declared record must have been appended)
+    /// and moves it onto the output path.
+    pub fn finish(self) -> Result<(), IoError> {
+        let out = self
+            .inner
+            .finish()
+            .map_err(|m| write_error(&self.path, m))?;
+        let file = out.into_inner().map_err(|e| IoError::Write {
+            path: self.path.clone(),
+            source: e.into_error(),
+        })?;
+        self.pending.commit(file)
+    }
+}
+
+/// An [`IoError::Write`] of `path` with `message`.
+fn write_error(path: &Path, message: String) -> IoError {
+    IoError::Write {
+        path: path.to_path_buf(),
+        source: std::io::Error::new(std::io::ErrorKind::InvalidInput, message),
+    }
+}
+
+/// The VLRs of a labelled copy: the source's but the Extra Bytes (rebuilt
+/// in place) and the laszip VLR (dropped; a new one for LAZ, returned).
+fn labelled_vlrs(
+    src: &LasSource,
+    format: u8,
+    extra: usize,
+    laz: bool,
+) -> Result<(Vec<Vlr>, Option<laz::LazVlr>), String> {
     let old_eb = extra_bytes_vlr(&src.vlrs).map(|v| v.data.as_slice());
     let eb = extra_entries(old_eb, extra);
     if eb.len() > usize::from(u16::MAX) {
@@ -145,90 +433,22 @@ pub(crate) fn labelled_file(
     if !placed {
         vlrs.push(eb_vlr);
     }
-    let laz_vlr = if laz {
-        let items =
-            laz::LazItemRecordBuilder::default_for_point_format_id(format, extra as u16 + 8)
-                .map_err(|e| format!("LAZ: {e}"))?;
-        let vlr = laz::LazVlr::from_laz_items(items);
-        let mut data = Vec::new();
-        vlr.write_to(&mut data).map_err(|e| e.to_string())?;
-        vlrs.push(Vlr {
-            reserved: 0,
-            user_id: user_id(b"laszip encoded"),
-            record_id: 22204,
-            description: field32("laz-rs"),
-            data,
-        });
-        Some(vlr)
-    } else {
-        None
-    };
-
-    let mut header = src.header.clone();
-    let mut head_len = header.len();
-    for v in &vlrs {
-        head_len += 54 + v.data.len();
+    if !laz {
+        return Ok((vlrs, None));
     }
-    head_len += src.padding.len();
-    let data_start = u32::try_from(head_len).map_err(|_| "header and VLRs exceed 4 GiB")?;
-    put_u32(&mut header, 96, data_start);
-    put_u32(&mut header, 100, vlrs.len() as u32);
-    header[104] = format | if laz { 0x80 } else { 0 };
-    put_u16(&mut header, 105, new_len16);
-
-    let n = src.records.len() / old_len.max(1);
-    let mut records = Vec::with_capacity(n * new_len);
-    for (i, rec) in src.records.chunks_exact(old_len).enumerate() {
-        let start = records.len();
-        records.extend_from_slice(rec);
-        let s = labelled.structure[i];
-        if let (Some(c), true) = (labelled.classify, s >= 0) {
-            let b = &mut records[start + class_at];
-            *b = (*b & !class_mask) | c;
-        }
-        records.extend_from_slice(&(s as i32).to_le_bytes());
-        records.extend_from_slice(&(labelled.part[i] as i32).to_le_bytes());
-    }
-
-    let mut out = Vec::with_capacity(head_len + records.len() + src.tail.len());
-    out.extend_from_slice(&header);
-    for v in &vlrs {
-        v.to_bytes(&mut out);
-    }
-    out.extend_from_slice(&src.padding);
-    debug_assert_eq!(out.len(), head_len);
-    match laz_vlr {
-        None => out.extend_from_slice(&records),
-        Some(vlr) => {
-            let mut cur = Cursor::new(out);
-            cur.set_position(head_len as u64);
-            let mut c = laz::LasZipCompressor::new(cur, vlr).map_err(|e| format!("LAZ: {e}"))?;
-            c.compress_many(&records).map_err(|e| format!("LAZ: {e}"))?;
-            c.done().map_err(|e| format!("LAZ: {e}"))?;
-            out = c.into_inner().into_inner();
-        }
-    }
-    // What followed the points, and the header offsets into it.
-    if !src.tail.is_empty() {
-        let new_start = out.len() as u64;
-        let moved = |old: u64| {
-            if old >= src.tail_start && old < src.tail_start + src.tail.len() as u64 {
-                old - src.tail_start + new_start
-            } else {
-                old
-            }
-        };
-        if header.len() >= 235 {
-            let wf = get_u64(&header, 227);
-            put_u64(&mut out, 227, moved(wf));
-        }
-        if header.len() >= 247 {
-            let ev = get_u64(&header, 235);
-            put_u64(&mut out, 235, moved(ev));
-        }
-        out.extend_from_slice(&src.tail);
-    }
-    Ok(out)
+    let items = laz::LazItemRecordBuilder::default_for_point_format_id(format, extra as u16 + 8)
+        .map_err(|e| format!("LAZ: {e}"))?;
+    let vlr = laz::LazVlr::from_laz_items(items);
+    let mut data = Vec::new();
+    vlr.write_to(&mut data).map_err(|e| e.to_string())?;
+    vlrs.push(Vlr {
+        reserved: 0,
+        user_id: user_id(b"laszip encoded"),
+        record_id: 22204,
+        description: field32("laz-rs"),
+        data,
+    });
+    Ok((vlrs, Some(vlr)))
 }
 
 /// LAS type code (1–10) of an attribute type.

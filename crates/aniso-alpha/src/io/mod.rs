@@ -38,6 +38,8 @@ mod las;
 #[cfg(feature = "las")]
 mod las_attrs;
 #[cfg(feature = "las")]
+mod las_bytes;
+#[cfg(feature = "las")]
 mod las_write;
 mod lzf;
 mod obj;
@@ -57,6 +59,8 @@ pub use attributes::{Attribute, AttributeType, LasSource, Values, Vlr};
 pub use error::IoError;
 pub use labelled::{write_labelled_cloud, Labelled};
 pub use labels::{read_labels, read_labels_bytes, write_labels};
+#[cfg(feature = "las")]
+pub use las_write::LasLabelWriter;
 pub use obj::write_obj;
 pub use ply::{write_ply, write_ply_to, Mesh, PlyEncoding};
 pub use scene::{write_scene, write_xyz_labels, write_xyz_labels_parts};
@@ -324,7 +328,8 @@ pub fn read_points(path: &Path, options: &ReadOptions) -> Result<PointCloud, IoE
 
 /// [`read_points`], calling `progress(bytes_read, file_size)` while the
 /// file is read (for a progress bar). `-` reads standard input. Text is
-/// streamed through one buffer; the other formats are loaded whole.
+/// streamed through one buffer and LAS/LAZ read at offsets (neither file
+/// is held in memory); the other formats are loaded whole.
 pub fn read_points_with_progress(
     path: &Path,
     options: &ReadOptions,
@@ -345,6 +350,20 @@ pub fn read_points_with_progress(
             options.label_column,
             usize::try_from(total).unwrap_or(0),
             &mut |done| progress(done, total.max(done)),
+        );
+    }
+    #[cfg(feature = "las")]
+    if format == Format::Las && !is_stdin(path) {
+        // Read at offsets: the file's bytes are never all in memory.
+        let (file, total) = open_file(path)?;
+        let bytes = las_bytes::FileBytes::new(file, total);
+        return las::read_las_from(
+            path,
+            &bytes,
+            None,
+            options.read_labels.then_some(options.background_classes),
+            options.attributes,
+            progress,
         );
     }
     let bytes = if is_stdin(path) {
@@ -403,6 +422,75 @@ pub(crate) fn read_file(
         progress(bytes.len() as u64, total.max(bytes.len() as u64));
     }
     Ok(bytes)
+}
+
+/// The points `start..start + count` of a LAS/LAZ file, in file order
+/// (a range that passes the end is cut at it; one that starts past it is
+/// an error), as [`read_points`] reads them, without holding the file's
+/// other points or bytes: an uncompressed file's records are read at their
+/// offset, a LAZ file's from the start of the chunk that holds `start`. So
+/// a file larger than memory is read a range at a time; with
+/// `options.attributes`, [`PointCloud::las`] holds the range's records
+/// with the file's header and VLRs. Needs the cargo feature `las`.
+///
+/// ```no_run
+/// use aniso_alpha::io::{las_point_count, read_las_range, ReadOptions};
+/// let path = "big.laz".as_ref();
+/// let n = las_point_count(path)?;
+/// let mut start = 0;
+/// while start < n {
+///     let piece = read_las_range(path, start, 1 << 22, &ReadOptions::default())?;
+///     start += piece.points.len() as u64;
+/// }
+/// # Ok::<(), aniso_alpha::io::IoError>(())
+/// ```
+pub fn read_las_range(
+    path: &Path,
+    start: u64,
+    count: u64,
+    options: &ReadOptions,
+) -> Result<PointCloud, IoError> {
+    #[cfg(feature = "las")]
+    {
+        let (file, total) = open_file(path)?;
+        las::read_las_from(
+            path,
+            &las_bytes::FileBytes::new(file, total),
+            Some((start, count)),
+            options.read_labels.then_some(options.background_classes),
+            options.attributes,
+            &mut |_, _| {},
+        )
+    }
+    #[cfg(not(feature = "las"))]
+    {
+        let _ = (start, count, options);
+        Err(las_unsupported(path))
+    }
+}
+
+/// The number of points a LAS/LAZ file's header declares, after the
+/// checks a read makes of the header (and of a LAZ file's chunk table),
+/// without reading the points. Needs the cargo feature `las`.
+pub fn las_point_count(path: &Path) -> Result<u64, IoError> {
+    #[cfg(feature = "las")]
+    {
+        let (file, total) = open_file(path)?;
+        las::las_points(path, &las_bytes::FileBytes::new(file, total))
+    }
+    #[cfg(not(feature = "las"))]
+    {
+        Err(las_unsupported(path))
+    }
+}
+
+/// The error of a LAS/LAZ function built without the `las` feature.
+#[cfg(not(feature = "las"))]
+fn las_unsupported(path: &Path) -> IoError {
+    IoError::Unsupported {
+        path: path.to_path_buf(),
+        message: "LAS/LAZ support is not compiled in (cargo feature `las`)",
+    }
 }
 
 /// Parses a point file held in memory; `path` picks the format by
@@ -504,10 +592,7 @@ pub fn read_las_bytes(
     #[cfg(not(feature = "las"))]
     {
         let _ = (bytes, options);
-        Err(IoError::Unsupported {
-            path: name.to_path_buf(),
-            message: "LAS/LAZ support is not compiled in (cargo feature `las`)",
-        })
+        Err(las_unsupported(name))
     }
 }
 

@@ -202,7 +202,13 @@ impl<'a, R: Read + Seek + Send + Sync + 'a> LasZipDecompressor<'a, R> {
 
         if let Some((chunk_of_point, start_of_chunk)) = chunk_info {
             self.current_chunk = chunk_of_point as usize;
-            let delta = point_idx % chunk_table[self.current_chunk].point_count;
+            // The point's place in its chunk: chunks of variable size
+            // (COPC's, for one) do not start at multiples of a chunk's count.
+            let first_of_chunk: u64 = chunk_table.as_ref()[..self.current_chunk]
+                .iter()
+                .map(|e| e.point_count)
+                .sum();
+            let delta = point_idx - first_of_chunk;
             let seeked_point_belong_to_last_chunk = chunk_of_point == (chunk_table.len() - 1);
             // When the index of the point belongs to the last chunk
             // we try to be careful as that point may not exist, and there may be a
