@@ -31,7 +31,9 @@ user's survey would come; the driver reads them (no in-process
 reference). `--memory-limit` gives each worker Dask's memory limit. With `--tiles
 OUT` the run is `distributed.detect_tiles` instead: no process reads the
 cloud whole, and the labelled tiles are written to OUT (the F1 read back
-from them).
+from them). `--one-file` concatenates the tiling's LAS files into one LAS
+file (their records in list order: the same cloud) and runs
+`detect_tiles` on that file alone, which tasks and driver read in pieces.
 
     .venv/bin/python scripts/bench_distributed.py --regions --workers 2 \
         --tiling ahn_2386_9702.ply 48 --per-file 8 --memory-limit 3GiB
@@ -95,6 +97,10 @@ def main() -> None:
     ap.add_argument("--per-file", type=int, default=8, help="copies per side in each LAS file of --tiling")
     ap.add_argument("--workdir", default="/tmp/aa_tiling", help="where --tiling writes its files")
     ap.add_argument("--memory-limit", default=None, help="each worker's Dask memory limit (e.g. 3GiB)")
+    ap.add_argument("--one-file", action="store_true",
+                    help="with --tiling and --tiles: the tiles concatenated into one LAS file, read in pieces")
+    ap.add_argument("--piece", type=int, default=None,
+                    help="with --tiles: detect_tiles' piece (default: the package's PIECE_POINTS)")
     ap.add_argument("--tiles", default=None, metavar="OUT",
                     help="with --tiling: distributed.detect_tiles, the labelled tiles written to OUT")
     args = ap.parse_args()
@@ -195,6 +201,40 @@ def tiling(scan: str, k: int, per_file: int, workdir: str) -> list:
     return paths
 
 
+def one_file(paths: list, workdir: str) -> str:
+    """The LAS tiles of a tiling (one header's scale and offset, no VLRs
+    between header and points) concatenated into one LAS file, their
+    records in list order (written once, kept); its path."""
+    import struct
+
+    out = os.path.join(workdir, os.path.basename(paths[0]).rsplit("_", 2)[0] + "_all.las")
+    if os.path.exists(out):
+        return out
+    heads = []
+    for p in paths:
+        with open(p, "rb") as f:
+            heads.append(f.read(227))
+    starts = [struct.unpack_from("<I", h, 96)[0] for h in heads]
+    counts = [struct.unpack_from("<I", h, 107)[0] for h in heads]
+    bounds = np.array([struct.unpack_from("<6d", h, 179) for h in heads])
+    if set(starts) != {227}:
+        raise ValueError("tiles with VLRs: not a tiling written by this script")
+    head = bytearray(heads[0])
+    struct.pack_into("<I", head, 107, sum(counts))
+    struct.pack_into("<5I", head, 111, sum(counts), 0, 0, 0, 0)
+    struct.pack_into("<6d", head, 179, bounds[:, 0].max(), bounds[:, 1].min(), bounds[:, 2].max(),
+                     bounds[:, 3].min(), bounds[:, 4].max(), bounds[:, 5].min())
+    with open(out + ".part", "wb") as w:
+        w.write(head)
+        for p, start in zip(paths, starts):
+            with open(p, "rb") as f:
+                f.seek(start)
+                while chunk := f.read(64 << 20):
+                    w.write(chunk)
+    os.replace(out + ".part", out)
+    return out
+
+
 def tiling_counts(truth: np.ndarray, pred: np.ndarray) -> np.ndarray:
     """True positives, false positives and false negatives of the plane
     points of copies of a tile (every copy is the tile's points in its
@@ -233,7 +273,17 @@ def tiles_f1(args: argparse.Namespace, outputs: list) -> float:
     import aniso_alpha as aa
 
     truth = tiling_truth(args.tiling[0])
-    counts = sum(tiling_counts(truth, aa.read(o).attributes["part"]) for o in outputs)
+    counts = np.zeros(3, dtype=np.int64)
+    step = 64 * len(truth)  # whole copies at a time
+    for o in outputs:
+        start = 0
+        while True:
+            try:
+                part = aa.read(o, start=start, count=step).attributes["part"]
+            except ValueError:  # past the end
+                break
+            counts += tiling_counts(truth, part)
+            start += len(part)
     return f1_of(counts)
 
 
@@ -257,6 +307,10 @@ def regions(args: argparse.Namespace) -> None:
             with ProcessPoolExecutor(1) as ex:
                 pts = ex.submit(tiling, args.tiling[0], int(args.tiling[1]), args.per_file, args.workdir).result()
             print(f"tiling: {len(pts)} LAS files in {args.workdir}", flush=True)
+            if args.one_file:
+                with ProcessPoolExecutor(1) as ex:
+                    pts = [ex.submit(one_file, pts, args.workdir).result()]
+                print(f"one file: {pts[0]} ({os.path.getsize(pts[0]) / 2**30:.2f} GiB)", flush=True)
         else:
             pts = town(int(size))
         ref = None
@@ -273,7 +327,8 @@ def regions(args: argparse.Namespace) -> None:
             try:
                 t0 = time.perf_counter()
                 if args.tiles:
-                    r = distributed.detect_tiles(pts, "planes", args.tiles, client=client)
+                    piece = args.piece or distributed.PIECE_POINTS
+                    r = distributed.detect_tiles(pts, "planes", args.tiles, client=client, piece=piece)
                 else:
                     r = distributed.detect_regions(pts, "planes", client=client)
                 t = time.perf_counter() - t0

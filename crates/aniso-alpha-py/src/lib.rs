@@ -11,6 +11,7 @@
 
 mod convert;
 mod errors;
+mod las_writer;
 mod options;
 mod progress;
 mod regions;
@@ -27,8 +28,8 @@ use aniso_alpha::aniso::Anisotropy;
 use aniso_alpha::delaunay::Triangulation;
 use aniso_alpha::detect::Detection;
 use aniso_alpha::io::{
-    read_points, write_labelled_cloud, Attribute, Format, Labelled, LasSource, PointCloud,
-    ReadOptions,
+    las_point_count, read_las_range, read_las_range_records, read_points, write_labelled_cloud,
+    Attribute, Format, Labelled, LasSource, PointCloud, ReadOptions,
 };
 use aniso_alpha::options::{run_warnings, Style};
 use aniso_alpha::report::{part_meshes, PartMeshes};
@@ -272,16 +273,34 @@ type ReadOut<'py> = (
 /// file has (as the CLI reads an input for `detect --output`); the
 /// normals are those `detect` uses: a PLY's `nx ny nz` or a PCD's
 /// `normal_x normal_y normal_z`.
+/// With `start` or `count`, the points `start..start + count` of a LAS/LAZ
+/// file alone ([`read_las_range`]).
 #[pyfunction]
-#[pyo3(signature = (path, attributes = true))]
-fn read(py: Python<'_>, path: PathBuf, attributes: bool) -> PyResult<ReadOut<'_>> {
+#[pyo3(signature = (path, attributes = true, start = None, count = None))]
+fn read(
+    py: Python<'_>,
+    path: PathBuf,
+    attributes: bool,
+    start: Option<u64>,
+    count: Option<u64>,
+) -> PyResult<ReadOut<'_>> {
     let (cloud, format) = detached(py, 1, |_| {
         let options = ReadOptions {
             attributes,
             ..ReadOptions::default()
         };
         let format = Format::resolve(&path, &options).map_err(io_error)?;
-        let cloud = read_points(&path, &options).map_err(io_error)?;
+        let cloud = match (start, count) {
+            (None, None) => read_points(&path, &options),
+            _ if format != Format::Las => {
+                return Err(PyValueError::new_err(format!(
+                    "{}: a range of points (start, count) is read from LAS/LAZ files only",
+                    path.display()
+                )))
+            }
+            (s, c) => read_las_range(&path, s.unwrap_or(0), c.unwrap_or(u64::MAX), &options),
+        }
+        .map_err(io_error)?;
         Ok((cloud, format))
     })?;
     let normals = match format {
@@ -364,6 +383,31 @@ fn write(
     })
 }
 
+/// The points `start..start + count` of a LAS/LAZ file and their records
+/// undecoded ([`read_las_range_records`]): what a labelled copy needs.
+#[pyfunction]
+fn read_las_records<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    start: u64,
+    count: u64,
+) -> PyResult<(Bound<'py, PyArray2<f64>>, PyLas)> {
+    let cloud = detached(py, 1, |_| {
+        read_las_range_records(&path, start, count).map_err(io_error)
+    })?;
+    let las = cloud
+        .las
+        .map(|l| PyLas { las: Arc::from(l) })
+        .ok_or_else(|| PyValueError::new_err("no LAS records read"))?;
+    Ok((rows_to_numpy(py, cloud.points), las))
+}
+
+/// The number of points a LAS/LAZ file declares ([`las_point_count`]).
+#[pyfunction]
+fn las_points(py: Python<'_>, path: PathBuf) -> PyResult<u64> {
+    detached(py, 1, |_| las_point_count(&path).map_err(io_error))
+}
+
 /// The address of the memory the library reads `points` from (tests check
 /// that a C-contiguous float64 array is used in place).
 #[pyfunction]
@@ -387,6 +431,8 @@ fn _panic(py: Python<'_>, on_worker: bool) -> PyResult<()> {
 #[pymodule(name = "_native")]
 mod native {
     #[pymodule_export]
+    use super::las_writer::PyLasLabelWriter;
+    #[pymodule_export]
     use super::regions::{detect_regions, region_plan, region_task, PyRegionJoin, PyRegionPlan};
     #[pymodule_export]
     use super::split::{plan, tile_step, PyPlan};
@@ -394,7 +440,8 @@ mod native {
     use super::tiles::{region_cells, region_grid, region_select, region_window, PyRegionJoined};
     #[pymodule_export]
     use super::{
-        _panic, _points_address, alpha_intervals, delaunay, detect, read, write, PyDetection, PyLas,
+        _panic, _points_address, alpha_intervals, delaunay, detect, las_points, read,
+        read_las_records, write, PyDetection, PyLas,
     };
 
     use pyo3::prelude::*;

@@ -304,11 +304,16 @@ pub struct PyRegionJoin {
 
 #[pymethods]
 impl PyRegionJoin {
+    /// A joining over `n` points; with `scratch` (a folder), their part
+    /// ids are kept in a file there rather than in memory.
     #[new]
-    fn new(n: usize) -> Self {
-        PyRegionJoin {
-            join: Some(RegionJoin::new(n)),
-        }
+    #[pyo3(signature = (n, scratch = None))]
+    fn new(n: usize, scratch: Option<std::path::PathBuf>) -> PyResult<Self> {
+        let join = match scratch {
+            None => RegionJoin::new(n),
+            Some(dir) => RegionJoin::with_scratch(n, &dir).map_err(value_error)?,
+        };
+        Ok(PyRegionJoin { join: Some(join) })
     }
 
     /// Counts a region whose margin was widened.

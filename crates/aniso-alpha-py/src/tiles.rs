@@ -177,7 +177,9 @@ impl PyRegionJoined {
     /// from input index `first` on.
     fn labels<'py>(&self, py: Python<'py>, first: usize, n: usize) -> PyResult<LabelsOut<'py>> {
         self.check(first, n)?;
-        let (parts, structures) = self.joined.labels(first, n);
+        let joined = &self.joined;
+        let (parts, structures) =
+            detached(py, 1, |_| joined.labels(first, n).map_err(value_error))?;
         Ok((structures.into_pyarray(py), parts.into_pyarray(py)))
     }
 
@@ -192,8 +194,7 @@ impl PyRegionJoined {
         }
         let (joined, refit) = (&self.joined, &mut self.refit);
         detached(py, 1, |_| {
-            refit.add_points(joined, first, pts);
-            Ok(())
+            refit.add_points(joined, first, pts).map_err(value_error)
         })
     }
 

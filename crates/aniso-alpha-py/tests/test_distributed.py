@@ -363,6 +363,41 @@ def test_tiles_equal_regions_on_the_stacked_points(client, tmp_path):
     assert_tiles_equal_regions(whole, ref_whole, len(stacked))
 
 
+def test_one_las_file_read_in_pieces_equals_regions(client, tmp_path):
+    """One LAS file (and the same points as LAZ) read in pieces of 700
+    points, fewer than any region holds: the labels and fits of the
+    stacked points, and the same labelled file, byte for byte, as a run
+    that reads it in one piece."""
+    pts, _ = ground_and_roof_scene()
+    las = str(tmp_path / "all.las")
+    write_las(las, pts)
+    laz = str(tmp_path / "all.laz")
+    aa.write(laz, aa.read(las), aa.detect_regions(aa.read(las).points, "planes"))
+    for path in (las, laz):
+        stacked = aa.read(path).points
+        ref = aa.detect_regions(stacked, "planes", side=30.0)
+        n = len(stacked)
+        assert len(distributed._pieces([path], 700)) == -(-n // 700) > 6
+        out = tmp_path / "pieces"
+        scratch = []
+        r = distributed.detect_tiles([path], "planes", out, side=30.0, client=client, piece=700, classify=6,
+                                     progress=lambda d, t: scratch.append(
+                                         [f.stat().st_size for f in out.glob(".*/.*part-ids*")]))
+        assert_tiles_equal_regions(r, ref, n)
+        # The part ids were in a scratch file inside the output folder,
+        # removed with its hidden folder.
+        assert scratch and all(sizes == [4 * n] for sizes in scratch)
+        assert os.path.basename(path) in [p.name for p in out.iterdir()]
+        assert not list(out.glob(".*"))
+        one = distributed.detect_tiles([path], "planes", tmp_path / "one", side=30.0, client=client,
+                                       classify=6)
+        assert_tiles_equal_regions(one, ref, n)
+        with open(r.outputs[0], "rb") as a, open(one.outputs[0], "rb") as b:
+            assert a.read() == b.read()
+    with pytest.raises(ValueError, match="piece must be"):
+        distributed.detect_tiles([las], "planes", tmp_path / "o", client=client, piece=0)
+
+
 def test_tiles_refuse_bad_input_before_any_work(client, tmp_path):
     pts, _ = ground_and_roof_scene()
     paths, _ = tiles_of(tmp_path, pts)
@@ -391,7 +426,7 @@ def test_tiles_refuse_bad_input_before_any_work(client, tmp_path):
 def test_a_tiled_run_that_fails_writes_no_labelled_tile(client, tmp_path):
     """A tile rewritten during the run (fewer points) is an error when the
     driver reads it back; the labelled tiles already written are not left
-    in the folder."""
+    in the folder, nor the scratch file of the part ids."""
     pts, _ = ground_and_roof_scene()
     paths, _ = tiles_of(tmp_path, pts)
     north = pts[pts[:, 1] >= 41.0]
@@ -401,6 +436,12 @@ def test_a_tiled_run_that_fails_writes_no_labelled_tile(client, tmp_path):
             write_las(paths[2], north[:-10])
 
     out = tmp_path / "out"
+    with pytest.raises(ValueError, match="north.las: .* when the run began"):
+        distributed.detect_tiles(paths, "planes", out, side=30.0, client=client, progress=shrink_north)
+    assert not out.exists(), "the folder the run made is removed with its scratch"
+    # A folder that was there stays, empty.
+    out.mkdir()
+    write_las(paths[2], north)
     with pytest.raises(ValueError, match="north.las: .* when the run began"):
         distributed.detect_tiles(paths, "planes", out, side=30.0, client=client, progress=shrink_north)
     assert list(out.iterdir()) == []

@@ -77,3 +77,26 @@ def test_read_formats(tmp_path):
         np.testing.assert_array_equal(got, pts)
     # str and os.PathLike both work.
     np.testing.assert_array_equal(aa.read(str(ply)).points, pts)
+
+
+def test_read_a_range_of_a_las_file(tmp_path):
+    """start/count read a LAS/LAZ file's rows alone (every attribute and
+    the records of those rows); other formats refuse them."""
+    las = FIXTURES / "las" / "simple.copc.laz"
+    whole = aa.read(las)
+    n = len(whole.points)
+    for start, count in ((0, n), (0, 1), (n - 1, 5), (517, 300), (1000, None)):
+        part = aa.read(las, start=start, count=count)
+        stop = n if count is None else min(n, start + count)
+        np.testing.assert_array_equal(part.points, whole.points[start:stop])
+        for name, values in whole.attributes.items():
+            np.testing.assert_array_equal(part.attributes[name], values[start:stop], err_msg=name)
+    np.testing.assert_array_equal(aa.read(las, count=3, attributes=False).points, whole.points[:3])
+    with pytest.raises(ValueError, match=f"the file has {n} points"):
+        aa.read(las, start=n)
+    with pytest.raises(ValueError, match="start must be a non-negative integer"):
+        aa.read(las, start=-1)
+    xyz = tmp_path / "p.xyz"
+    np.savetxt(xyz, whole.points[:10])
+    with pytest.raises(ValueError, match="read from LAS/LAZ files only"):
+        aa.read(xyz, start=2)

@@ -86,3 +86,17 @@ def test_a_bad_side_is_a_value_error(ground_and_roof, side):
     pts, _ = ground_and_roof
     with pytest.raises(ValueError, match="region side"):
         aa.detect_regions(pts, "planes", side=side)
+
+
+def test_a_region_run_is_written_with_its_labels(ground_and_roof, tmp_path):
+    """aa.write takes a RegionDetection as it takes a Detection (the parts
+    of a region run have no meshes: a PLY gets the points and ids)."""
+    pts, _ = ground_and_roof
+    r = aa.detect_regions(pts, "planes", side=30.0, threads=1)
+    for name in ("labelled.laz", "labelled.ply"):
+        out = tmp_path / name
+        aa.write(out, pts, r, classify=6)
+        back = aa.read(out)
+        np.testing.assert_array_equal(back.attributes["structure"], r.labels)
+        np.testing.assert_array_equal(back.attributes["part"], r.part_labels)
+        assert (back.attributes["classification"][r.labels >= 0] == 6).all()

@@ -15,7 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _native
-from ._results import Detection
+from ._results import Detection, RegionDetection
 
 __all__ = ["AnisoAlphaWarning", "Cloud", "labelled_array", "read", "write"]
 
@@ -86,7 +86,13 @@ class Cloud:
         )
 
 
-def read(path: PathLike, *, attributes: bool = True) -> Cloud:
+def read(
+    path: PathLike,
+    *,
+    attributes: bool = True,
+    start: Optional[int] = None,
+    count: Optional[int] = None,
+) -> Cloud:
     """Reads a point file: its points, normals and attributes, in file
     order, the format chosen by extension: ``.xyz`` ``.txt`` ``.csv``
     ``.pts`` (text: x y z in the first three columns), ``.ply`` (ascii and
@@ -96,6 +102,12 @@ def read(path: PathLike, *, attributes: bool = True) -> Cloud:
         path: the file.
         attributes: read every per-point attribute (default); ``False``
             reads the coordinates alone, faster (no normals then).
+        start, count: a LAS/LAZ file's points ``start`` to ``start +
+            count`` alone (``count`` cut at the end of the file; either
+            may be left out), read without the file's other points or
+            bytes: a file larger than memory is read a range at a time
+            (:func:`aniso_alpha.distributed.detect_tiles` does). Other
+            formats raise ``ValueError``.
 
     Returns:
         a :class:`Cloud`. What the reader guessed (a text file's first
@@ -122,12 +134,19 @@ def read(path: PathLike, *, attributes: bool = True) -> Cloud:
     True
     """
     p = os.fspath(path)
-    points, attrs, normals, messages, las, fmt = _native.read(p, attributes)
+    for name, v in (("start", start), ("count", count)):
+        if v is not None and not (isinstance(v, (int, np.integer)) and v >= 0):
+            raise ValueError(f"{name} must be a non-negative integer, got {v!r}")
+    points, attrs, normals, messages, las, fmt = _native.read(
+        p, attributes, None if start is None else int(start), None if count is None else int(count)
+    )
     _warn([f"{p}: {m}" for m in messages])
     return Cloud(points, normals, dict(attrs), p, fmt, las)
 
 
-def _labels_of(detection: Detection, n: int) -> Tuple[NDArray[np.int64], NDArray[np.int64]]:
+def _labels_of(
+    detection: Union[Detection, RegionDetection], n: int
+) -> Tuple[NDArray[np.int64], NDArray[np.int64]]:
     if len(detection.labels) != n:
         raise ValueError(f"the detection has {len(detection.labels)} labels for a cloud of {n} points")
     return detection.labels, detection.part_labels
@@ -136,7 +155,7 @@ def _labels_of(detection: Detection, n: int) -> Tuple[NDArray[np.int64], NDArray
 def write(
     path: PathLike,
     cloud: Union[Cloud, ArrayLike],
-    detection: Detection,
+    detection: Union[Detection, RegionDetection],
     *,
     classify: Optional[int] = None,
 ) -> None:
@@ -151,7 +170,9 @@ def write(
         path: the output, written atomically (complete or absent).
         cloud: a :class:`Cloud` (its attributes are written), or points
             (n, 3).
-        detection: the :class:`Detection` of these points.
+        detection: the :class:`Detection` of these points, or their
+            :class:`RegionDetection` (its parts have no meshes: a PLY
+            gets the points and ids alone).
         classify: a LAS classification (0-255) given to the structures'
             points (``--classify planes=6``).
 
@@ -177,7 +198,7 @@ def write(
         cloud._las,
         labels,
         parts,
-        detection._native,
+        detection._native if isinstance(detection, Detection) else None,
         None if classify is None else int(classify),
     )
 

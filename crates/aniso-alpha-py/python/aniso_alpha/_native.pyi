@@ -87,7 +87,7 @@ def region_task(
 class RegionJoin:
     """The joining of region steps on the driver."""
 
-    def __init__(self, n: int) -> None: ...
+    def __init__(self, n: int, scratch: Optional[str] = None) -> None: ...
     def widened(self) -> None: ...
     def add(
         self, ids: NDArray[np.uint32], core: NDArray[np.uint32], step: Optional[_StepArrays] = None
@@ -182,7 +182,7 @@ def tile_step(
     """(faces flat, offsets per job, points triangulated) of one tile."""
 
 def read(
-    path: str, attributes: bool = True
+    path: str, attributes: bool = True, start: Optional[int] = None, count: Optional[int] = None
 ) -> Tuple[
     NDArray[np.float64],
     List[Tuple[str, NDArray[Any]]],
@@ -192,6 +192,19 @@ def read(
     str,
 ]:
     """(points, attributes, normals, warnings, LAS source, format name)."""
+
+def read_las_records(path: str, start: int, count: int) -> Tuple[NDArray[np.float64], LasSource]:
+    """The points start..start + count of a LAS/LAZ file and their records."""
+
+def las_points(path: str) -> int:
+    """The number of points a LAS/LAZ file declares."""
+
+class LasLabelWriter:
+    """A labelled copy of a LAS/LAZ file written a range at a time."""
+
+    def __init__(self, path: str, las: LasSource, points: int, classify: Optional[int] = None) -> None: ...
+    def append(self, las: LasSource, labels: NDArray[np.int64], part_labels: NDArray[np.int64]) -> None: ...
+    def finish(self) -> None: ...
 
 def write(
     path: str,

@@ -33,6 +33,7 @@ labels of :func:`aniso_alpha.detect_regions`.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
@@ -49,7 +50,7 @@ from ._api import Structure, detect_input, detect_options
 from ._io import Cloud, PathLike, _warn, read
 from ._results import Detection, RegionDetection, TileDetection
 
-__all__ = ["RegionLost", "TileLost", "detect", "detect_regions", "detect_tiles", "load", "plan"]
+__all__ = ["PIECE_POINTS", "RegionLost", "TileLost", "detect", "detect_regions", "detect_tiles", "load", "plan"]
 
 Source = Union[PathLike, Sequence[PathLike], ArrayLike, Any]
 
@@ -619,19 +620,59 @@ def detect_regions(
     return _region_detection(run, plan.side, structure)
 
 
-def _tile_bounds(path: str) -> Tuple[int, NDArray[np.float64], NDArray[np.float64]]:
-    """A tile's task: its number of points and bounding box."""
-    pts = read(path, attributes=False).points
+# A piece of a tile: (path, first point, point count), or (path, 0, None)
+# for the whole file of a format read only whole.
+Piece = Tuple[str, int, Optional[int]]
+
+# The most points read from a LAS/LAZ file at once by a task or the
+# driver: 2^20, 25 MB of coordinates (and 35-70 MB of records of 34-67
+# bytes in the driver's pass over the labelled copies). A region's task
+# reads (and for LAZ decompresses) every piece whose bounding box meets
+# its window: smaller pieces have tighter boxes, so a file in acquisition
+# order costs less to read per region; each piece is one more small task
+# for its bounds and cells.
+PIECE_POINTS = 1 << 20
+
+
+def _is_las(path: str) -> bool:
+    return os.path.splitext(path)[1].lower() in (".las", ".laz")
+
+
+def _pieces(paths: Sequence[str], piece: int) -> List[Piece]:
+    """The pieces the tiles are read in, in input order: a LAS/LAZ tile in
+    ranges of at most ``piece`` points (its count from its header), any
+    other file whole."""
+    out: List[Piece] = []
+    for path in paths:
+        if not _is_las(path):
+            out.append((path, 0, None))
+            continue
+        n = int(_native.las_points(path))
+        out.extend((path, s, min(piece, n - s)) for s in range(0, max(n, 1), piece))
+    return out
+
+
+def _piece_points(piece: Piece) -> NDArray[np.float64]:
+    """A piece's points (coordinates only)."""
+    path, start, count = piece
+    if count is None:
+        return read(path, attributes=False).points
+    return read(path, attributes=False, start=start, count=count).points
+
+
+def _tile_bounds(piece: Piece) -> Tuple[int, NDArray[np.float64], NDArray[np.float64]]:
+    """A piece's task: its number of points and bounding box."""
+    pts = _piece_points(piece)
     return len(pts), pts.min(axis=0), pts.max(axis=0)
 
 
-def _tile_cells(path: str, origin: Tuple[float, float], side: float) -> NDArray[np.int64]:
-    """A tile's task: the region cells its points occupy."""
-    return _native.region_cells(read(path, attributes=False).points, origin, side)
+def _tile_cells(piece: Piece, origin: Tuple[float, float], side: float) -> NDArray[np.int64]:
+    """A piece's task: the region cells its points occupy."""
+    return _native.region_cells(_piece_points(piece), origin, side)
 
 
 def _tile_region(
-    tiles: Sequence[Tuple[str, int]],
+    pieces: Sequence[Tuple[Piece, int]],
     origin: Tuple[float, float],
     side: float,
     cell: Tuple[int, int],
@@ -641,13 +682,13 @@ def _tile_region(
     task_threads: int,
 ) -> Tuple[Any, ...]:
     """A region's task of :func:`detect_tiles`: its points cut from the
-    tiles that meet its window (each tile's path and the input index of
-    its first point), in input order, then :func:`_native.region_task`.
+    pieces that meet its window (each piece with the input index of its
+    first point), in input order, then :func:`_native.region_task`.
     Returns the task's ``(kind, margin, step)`` and, for a step, the
     region's input indices (uint32, ascending) and its core's."""
     points, ids, core = [], [], []
-    for path, first in tiles:
-        pts = read(path, attributes=False).points
+    for piece, first in pieces:
+        pts = _piece_points(piece)
         idx, is_core = _native.region_select(pts, origin, side, cell, margin)
         points.append(pts[idx])
         glob = (idx.astype(np.uint64) + np.uint64(first)).astype(np.uint32)
@@ -681,38 +722,51 @@ def _output_names(tiles: Sequence[str], out: str) -> List[str]:
 
 def _labels_and_fits(
     joined: Any,
-    paths: Sequence[str],
+    pieces: Sequence[Piece],
     firsts: Sequence[int],
     counts: Sequence[int],
     staging: Optional[str],
-    names: Sequence[str],
+    names: Dict[str, str],
+    totals: Dict[str, int],
     classify: Optional[int],
 ) -> None:
-    """The driver's three passes over the tiles in input order: the first
-    writes each tile's labelled copy into ``staging`` (when given) and
-    feeds the joined parts' refit, the two others finish the refit."""
+    """The driver's three passes over the pieces in input order: the first
+    writes each tile's labelled copy into ``staging`` (when given; a
+    LAS/LAZ tile a piece at a time) and feeds the joined parts' refit, the
+    two others finish it. ``totals``: each tile's points."""
+    cls = None if classify is None else int(classify)
     for k in range(3):
-        for i, (path, first, n) in enumerate(zip(paths, firsts, counts)):
-            cloud = read(path, attributes=k == 0 and staging is not None)
-            if len(cloud.points) != n:
-                raise ValueError(f"{path}: {len(cloud.points)} points, {n} when the run began")
-            joined.refit(first, cloud.points)
-            if k == 0 and staging is not None:
+        writer: Any = None
+        for (path, start, count), first, n in zip(pieces, firsts, counts):
+            label = k == 0 and staging is not None
+            las = None
+            if count is None:
+                cloud = read(path, attributes=label)
+                points = cloud.points
+            elif label:
+                points, las = _native.read_las_records(path, start, count)
+            else:
+                points = read(path, attributes=False, start=start, count=count).points
+            if len(points) != n:
+                raise ValueError(f"{path}: {len(points)} points, {n} when the run began")
+            joined.refit(first, points)
+            if label:
+                target = os.path.join(str(staging), os.path.basename(names[path]))
                 labels, part_labels = joined.labels(first, n)
-                # A LAS/LAZ tile written as LAS/LAZ keeps its records byte
-                # for byte: the writer has no use for the decoded attributes.
-                as_las = cloud._las is not None and names[i].lower().endswith((".las", ".laz"))
-                _native.write(
-                    os.path.join(staging, os.path.basename(names[i])),
-                    cloud.points,
-                    [] if as_las else list(cloud.attributes.items()),
-                    cloud._las,
-                    labels,
-                    part_labels,
-                    None,
-                    None if classify is None else int(classify),
-                )
-            del cloud
+                if las is None:
+                    _native.write(
+                        target, points, list(cloud.attributes.items()), cloud._las, labels, part_labels, None, cls
+                    )
+                else:
+                    # A LAS/LAZ tile's records are copied byte for byte, a
+                    # piece at a time, with the two ids added.
+                    if start == 0:
+                        writer = _native.LasLabelWriter(target, las, totals[path], cls)
+                    writer.append(las, labels, part_labels)
+                    if start + n == totals[path]:
+                        writer.finish()
+                        writer = None
+            del points, las
         joined.end_pass()
 
 
@@ -727,15 +781,22 @@ def detect_tiles(
     task_threads: int = 1,
     classify: Optional[int] = None,
     progress: Optional[Callable[[int, int], Optional[bool]]] = None,
+    piece: int = PIECE_POINTS,
     **options: Any,
 ) -> TileDetection:
     """:func:`detect_regions` over a cloud held as tiles (point files, such
-    as LAS/LAZ tiles), which no process reads whole: each point's labels
-    are written to a copy of its tile instead of returned.
+    as LAS/LAZ tiles, or one LAS/LAZ file larger than memory), which no
+    process reads whole: each point's labels are written to a copy of its
+    tile instead of returned.
 
     Args:
         tiles: the tiles' paths (any format :func:`aniso_alpha.read`
-            reads); the cloud is their points in list order.
+            reads); the cloud is their points in list order. A LAS/LAZ
+            tile is read in pieces of at most ``piece`` points (by
+            offset, without the rest of the file: see
+            :func:`aniso_alpha.read`'s ``start`` and ``count``), so one
+            LAS/LAZ file of any size can be the whole cloud; another
+            format is read whole by each task that needs it.
         structure: ``"lines"`` or ``"planes"``.
         out: a folder (made if missing) for the labelled tiles: each tile
             as :func:`aniso_alpha.write` writes it (a LAS/LAZ tile's header
@@ -751,19 +812,30 @@ def detect_tiles(
             own.
         classify: a LAS classification given to the structures' points in
             the outputs (as :func:`aniso_alpha.write`'s).
+        piece: the most points a task or the driver reads from a LAS/LAZ
+            tile at once (default :data:`PIECE_POINTS`, 2^20). A region's
+            task reads every piece whose bounding box meets its window:
+            a file in spatial order (tiles, COPC, or points sorted by
+            PDAL's ``filters.mortonorder``) is read least; one in
+            acquisition order (flight lines) may be read by many regions.
 
     Returns:
         a :class:`~aniso_alpha.TileDetection`: the parts, outputs and counts
         of :func:`detect_regions` on the tiles' points stacked in list
         order (the same labels, in the outputs).
 
-    What each process holds: a worker, one region (the tiles that meet
-    its window are read one at a time and cut); the driver, the tiles'
-    bounds, the regions' cells, one part id a point (4 bytes) and the
-    margin labels still waiting for their core region, and one tile at a
+    What each process holds: a worker, one region (the pieces that meet
+    its window are read one at a time and cut); the driver, the pieces'
+    bounds, the regions' cells, the margin labels still waiting for their
+    core region, and one piece at a
     time while it writes the labels and refits the joined parts (three
-    passes over the tiles in input order: the same fits as of the stacked
-    points).
+    passes over the pieces in input order: the same fits as of the stacked
+    points; a LAS/LAZ tile's labelled copy is written a piece at a time).
+    The part ids are kept in a scratch file, in a hidden folder inside
+    ``out`` (or the system's temporary folder without ``out``) with the
+    labelled tiles until they are complete, removed at the end: the
+    driver's memory does not grow with the cloud's points (the joined
+    parts and the pair counts grow with the parts).
     Tasks read their tiles from the paths, so a task whose worker dies is
     run again by Dask with the same result; the paths must be readable
     from every worker.
@@ -791,11 +863,50 @@ def detect_tiles(
         raise ValueError(f"region side {side}: must be positive and finite")
     if classify is not None and not (isinstance(classify, (int, np.integer)) and 0 <= int(classify) <= 255):
         raise ValueError(f"classify must be a LAS class between 0 and 255, got {classify!r}")
+    if not (isinstance(piece, (int, np.integer)) and piece >= 1):
+        raise ValueError(f"piece must be a positive number of points, got {piece!r}")
     names = _output_names(paths, os.fspath(out)) if out is not None else []
     opts = detect_options(**options)
+    pieces = _pieces(paths, int(piece))
+    made = out is not None and not os.path.isdir(os.fspath(out))
+    if out is not None:
+        os.makedirs(os.fspath(out), exist_ok=True)
+    # The part ids (4 bytes a point) and the labelled tiles until all are
+    # complete: a hidden folder inside `out`, removed at the end (and `out`
+    # with it when this run made it and failed).
+    scratch = tempfile.mkdtemp(prefix=".aniso-alpha-", dir=None if out is None else os.fspath(out))
+    done = False
+    try:
+        run = _tiles_run(pieces, paths, names, scratch, structure, side, client, n_workers, task_threads,
+                         classify, progress, opts)
+        done = True
+    finally:
+        shutil.rmtree(scratch, ignore_errors=True)
+        if made and not done:
+            with contextlib.suppress(OSError):
+                os.rmdir(os.fspath(out))
+    return run
+
+
+def _tiles_run(
+    pieces: List[Piece],
+    paths: List[str],
+    names: List[str],
+    scratch: str,
+    structure: Structure,
+    side: Optional[float],
+    client: Any,
+    n_workers: Optional[int],
+    task_threads: int,
+    classify: Optional[int],
+    progress: Optional[Callable[[int, int], Optional[bool]]],
+    opts: Dict[str, Any],
+) -> TileDetection:
+    """:func:`detect_tiles` once its input is checked: the regions, then
+    the labelled tiles written into ``scratch`` and moved to their names."""
     client, own = _client(client, n_workers)
     try:
-        bounds = client.gather(client.map(_tile_bounds, paths, pure=False))
+        bounds = client.gather(client.map(_tile_bounds, pieces, pure=False))
         counts = [int(b[0]) for b in bounds]
         firsts = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(int).tolist()
         lo = np.min([b[1] for b in bounds], axis=0)
@@ -803,16 +914,16 @@ def detect_tiles(
         origin, run_side, reported, first_margin = _native.region_grid(
             [float(v) for v in lo], [float(v) for v in hi], sum(counts), side
         )
-        tile_cells = client.gather(client.map(_tile_cells, paths, origin=origin, side=run_side, pure=False))
+        tile_cells = client.gather(client.map(_tile_cells, pieces, origin=origin, side=run_side, pure=False))
         cells = np.unique(np.concatenate(tile_cells), axis=0)
-        join = _native.RegionJoin(sum(counts))
+        join = _native.RegionJoin(sum(counts), scratch)
 
         def submit(r: int, margin: float) -> Any:
             cell = (int(cells[r][0]), int(cells[r][1]))
             x0, y0, x1, y1 = _native.region_window(origin, run_side, cell, margin)
             meets = [
                 (p, f)
-                for p, f, (_, tlo, thi) in zip(paths, firsts, bounds)
+                for p, f, (_, tlo, thi) in zip(pieces, firsts, bounds)
                 if tlo[0] <= x1 and thi[0] >= x0 and tlo[1] <= y1 and thi[1] >= y0
             ]
             return client.submit(
@@ -831,19 +942,17 @@ def detect_tiles(
     finally:
         _close(own)
     joined = join.resolve()
-    staging = None
-    if out is not None:
-        os.makedirs(os.fspath(out), exist_ok=True)
-        staging = tempfile.mkdtemp(prefix=".aniso-alpha-", dir=os.fspath(out))
-    try:
-        _labels_and_fits(joined, paths, firsts, counts, staging, names, classify)
-        # Every labelled tile is complete: they enter the folder together.
-        for name in names:
-            os.replace(os.path.join(str(staging), os.path.basename(name)), name)
-    finally:
-        if staging is not None:
-            shutil.rmtree(staging, ignore_errors=True)
+    del join
+    totals: Dict[str, int] = {}
+    for (path, _, _), n in zip(pieces, counts):
+        totals[path] = totals.get(path, 0) + n
+    staging = scratch if names else None
+    _labels_and_fits(joined, pieces, firsts, counts, staging, dict(zip(paths, names)), totals, classify)
+    # Every labelled tile is complete: they enter the folder together.
+    for name in names:
+        os.replace(os.path.join(scratch, os.path.basename(name)), name)
     _, _, rows, regions, widened, joins, skipped, messages = joined.finish()
+    del joined  # its scratch file closed before the folder is removed
     _warn(messages)
     from ._api import _region_parts
 

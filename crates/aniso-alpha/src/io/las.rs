@@ -49,7 +49,31 @@ pub(crate) fn read_las(
     labels_with: Option<ClassSet>,
     attributes: bool,
 ) -> Result<PointCloud, IoError> {
-    read_las_from(path, bytes, None, labels_with, attributes, &mut |_, _| {})
+    let keep = Keep::from_attributes(attributes);
+    read_las_from(path, bytes, None, labels_with, keep, &mut |_, _| {})
+}
+
+/// What a read keeps besides the points (and labels).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Keep {
+    /// Nothing.
+    Points,
+    /// The records, with the header, VLRs and trailing data
+    /// ([`PointCloud::las`]), for a copy of the file.
+    Records,
+    /// The records, decoded into [`PointCloud::attributes`] too.
+    Attributes,
+}
+
+impl Keep {
+    /// [`Keep::Attributes`] or [`Keep::Points`].
+    pub(crate) fn from_attributes(attributes: bool) -> Keep {
+        if attributes {
+            Keep::Attributes
+        } else {
+            Keep::Points
+        }
+    }
 }
 
 /// The number of points a LAS/LAZ file declares, checked as a read
@@ -65,8 +89,8 @@ pub(crate) fn las_points<B: LasBytes + ?Sized>(path: &Path, bytes: &B) -> Result
 /// end is cut at it), read from `bytes` without the rest of the point
 /// records: the records of an uncompressed file are read at their offset,
 /// a LAZ file's from the chunk that holds `start`. The checks of a hostile
-/// file are those of a whole read. With `attributes`, the range's records
-/// are kept, with the file's header, VLRs and trailing data.
+/// file are those of a whole read. `keep` says what is kept besides the
+/// points and labels.
 /// `progress(bytes, file_size)` is called after each batch of records
 /// (the bytes as the share of the range's points read).
 pub(crate) fn read_las_from<B: LasBytes + ?Sized>(
@@ -74,7 +98,7 @@ pub(crate) fn read_las_from<B: LasBytes + ?Sized>(
     bytes: &B,
     range: Option<(u64, u64)>,
     labels_with: Option<ClassSet>,
-    attributes: bool,
+    keep: Keep,
     progress: &mut dyn FnMut(u64, u64),
 ) -> Result<PointCloud, IoError> {
     let read_labels = labels_with.is_some();
@@ -106,8 +130,9 @@ pub(crate) fn read_las_from<B: LasBytes + ?Sized>(
     }
     let class_at = if layout.extended { 16 } else { 15 };
     let class_mask = if layout.extended { 0xFF } else { 0x1F };
+    let records = keep != Keep::Points;
     let mut kept: Vec<u8> = Vec::new();
-    if attributes {
+    if records {
         kept.reserve(
             cap.saturating_mul(layout.record_len).min(
                 usize::try_from(bytes.size())
@@ -116,11 +141,11 @@ pub(crate) fn read_las_from<B: LasBytes + ?Sized>(
             ),
         );
     }
-    let mut sink = |records: &[u8]| -> Result<(), IoError> {
-        if attributes {
-            kept.extend_from_slice(records);
+    let mut sink = |batch: &[u8]| -> Result<(), IoError> {
+        if records {
+            kept.extend_from_slice(batch);
         }
-        for rec in records.chunks_exact(layout.record_len) {
+        for rec in batch.chunks_exact(layout.record_len) {
             let p = [0usize, 1, 2].map(|k| {
                 let raw = i32::from_le_bytes([
                     rec[4 * k],
@@ -172,7 +197,7 @@ pub(crate) fn read_las_from<B: LasBytes + ?Sized>(
             }
         }
         Some(vlr) => {
-            let mut source = std::io::BufReader::new(ByteReader::new(bytes));
+            let mut source = std::io::BufReader::with_capacity(1 << 20, ByteReader::new(bytes));
             source
                 .seek(SeekFrom::Start(layout.data_start as u64))
                 .map_err(|e| bad(format!("LAZ: {e}")))?;
@@ -205,9 +230,11 @@ pub(crate) fn read_las_from<B: LasBytes + ?Sized>(
     if read_labels {
         cloud.labels = Some(labels);
     }
-    if attributes {
+    if records {
         let src = source(bytes, &layout, kept).map_err(bad)?;
-        cloud.attributes = record_attributes(&src);
+        if keep == Keep::Attributes {
+            cloud.attributes = record_attributes(&src);
+        }
         cloud.las = Some(Box::new(src));
     }
     non_empty(path, cloud)

@@ -362,7 +362,7 @@ pub fn read_points_with_progress(
             &bytes,
             None,
             options.read_labels.then_some(options.background_classes),
-            options.attributes,
+            las::Keep::from_attributes(options.attributes),
             progress,
         );
     }
@@ -452,21 +452,54 @@ pub fn read_las_range(
 ) -> Result<PointCloud, IoError> {
     #[cfg(feature = "las")]
     {
-        let (file, total) = open_file(path)?;
-        las::read_las_from(
-            path,
-            &las_bytes::FileBytes::new(file, total),
-            Some((start, count)),
-            options.read_labels.then_some(options.background_classes),
-            options.attributes,
-            &mut |_, _| {},
-        )
+        let keep = las::Keep::from_attributes(options.attributes);
+        read_range(path, start, count, options, keep)
     }
     #[cfg(not(feature = "las"))]
     {
         let _ = (start, count, options);
         Err(las_unsupported(path))
     }
+}
+
+/// [`read_las_range`] keeping the range's records in [`PointCloud::las`]
+/// without decoding them into attributes: what a labelled copy of the
+/// file needs (`LasLabelWriter::append`), at the records' size.
+pub fn read_las_range_records(path: &Path, start: u64, count: u64) -> Result<PointCloud, IoError> {
+    #[cfg(feature = "las")]
+    {
+        read_range(
+            path,
+            start,
+            count,
+            &ReadOptions::default(),
+            las::Keep::Records,
+        )
+    }
+    #[cfg(not(feature = "las"))]
+    {
+        let _ = (start, count);
+        Err(las_unsupported(path))
+    }
+}
+
+#[cfg(feature = "las")]
+fn read_range(
+    path: &Path,
+    start: u64,
+    count: u64,
+    options: &ReadOptions,
+    keep: las::Keep,
+) -> Result<PointCloud, IoError> {
+    let (file, total) = open_file(path)?;
+    las::read_las_from(
+        path,
+        &las_bytes::FileBytes::new(file, total),
+        Some((start, count)),
+        options.read_labels.then_some(options.background_classes),
+        keep,
+        &mut |_, _| {},
+    )
 }
 
 /// The number of points a LAS/LAZ file's header declares, after the

@@ -34,6 +34,9 @@ pub enum DetectError {
     Anisotropy(AnisotropyError),
     /// The run was cancelled by the progress callback.
     Cancelled,
+    /// A region run's scratch file (its part ids, kept on disk) could not
+    /// be made, written or read (the operating system's message).
+    Scratch(String),
     /// An internal invariant broke (a bug: please report it).
     Internal(String),
 }
@@ -61,6 +64,7 @@ impl fmt::Display for DetectError {
             DetectError::Orientations(e) => write!(f, "orientations: {e}"),
             DetectError::Anisotropy(e) => write!(f, "anisotropy: {e}"),
             DetectError::Cancelled => write!(f, "cancelled"),
+            DetectError::Scratch(m) => write!(f, "the region run's scratch file failed: {m}"),
             DetectError::Internal(m) => write!(f, "internal error (a bug, please report): {m}"),
         }
     }

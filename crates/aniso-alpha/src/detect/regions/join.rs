@@ -6,11 +6,14 @@
 //! a tile at a time ([`RegionJoined::labels`], [`PartsRefit`]), with the
 //! same result bit for bit.
 //!
-//! Memory: one part id a point (4 bytes), the regions' parts, the pair
-//! counts, and the margin labels whose core region was not added yet
-//! (those of regions added before are counted at once); structures are
-//! the parts' own.
+//! Memory: one part id a point (4 bytes, in memory or in a scratch file:
+//! [`RegionJoin::with_scratch`]), the regions' parts, the pair counts, and
+//! the margin labels whose core region was not added yet (those of regions
+//! added before are counted at once, the others as soon as their region
+//! is added: the waiting ones are swept whenever they have doubled);
+//! structures are the parts' own.
 
+use super::part_ids::{PartIds, UNSEEN};
 use super::{RegionPart, RegionRun, RegionStep, SAME_SHARE};
 use crate::detect::detection::Primitive;
 use crate::detect::fit::{Fitted, PassFit};
@@ -18,8 +21,6 @@ use crate::detect::DetectError;
 use crate::unionfind::UnionFind;
 use std::collections::HashMap;
 
-/// A point whose core region was not added yet.
-const UNSEEN: u32 = u32::MAX;
 /// A point its core region left as background.
 const NONE: u32 = u32::MAX - 1;
 
@@ -31,13 +32,18 @@ fn part_id(p: u32) -> Option<u32> {
 /// The joining of region steps: add each region's step (in the plan's
 /// order, or any fixed order), then [`Self::finish`] (a cloud in memory)
 /// or [`Self::resolve`] (a cloud streamed).
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct RegionJoin {
     /// Per point: the global region part its core region gave it,
     /// [`NONE`], or [`UNSEEN`].
-    part_of: Vec<u32>,
-    /// Per global region part: its region.
+    part_of: PartIds,
+    /// Per global region part: its region, and its core points.
     part_region: Vec<u32>,
+    held: Vec<usize>,
+    /// Margin labels waiting in `results`, and their number after the
+    /// last sweep.
+    waiting: usize,
+    swept: usize,
     /// Doubly labelled points per (part in a margin, part of the core
     /// owner), and per (part in a margin, owner's region).
     pairs: HashMap<(u32, u32), u32>,
@@ -61,12 +67,39 @@ struct RegionResult {
     margin: Vec<(u32, u32)>,
 }
 
+/// Waiting margin labels swept at the earliest when there are this many
+/// (a handful in tests, so that their joinings sweep).
+const FIRST_SWEEP: usize = if cfg!(test) { 16 } else { 1 << 16 };
+
+/// The error of a scratch file's read or write.
+fn scratch_error(e: std::io::Error) -> DetectError {
+    DetectError::Scratch(e.to_string())
+}
+
 impl RegionJoin {
     /// A joining over a cloud of `n` points.
     pub fn new(n: usize) -> Self {
+        Self::over(PartIds::in_memory(n))
+    }
+
+    /// A joining over a cloud of `n` points whose part ids (4 bytes a
+    /// point) are kept in a scratch file in folder `dir` (removed when the
+    /// joining and what it resolves to are dropped), for a cloud whose ids
+    /// should not take the joining process's memory. The same joins.
+    ///
+    /// # Errors
+    /// [`DetectError::Scratch`] when the file cannot be made.
+    pub fn with_scratch(n: usize, dir: &std::path::Path) -> Result<Self, DetectError> {
+        Ok(Self::over(PartIds::in_file(n, dir).map_err(scratch_error)?))
+    }
+
+    fn over(part_of: PartIds) -> Self {
         RegionJoin {
-            part_of: vec![UNSEEN; n],
+            part_of,
             part_region: Vec::new(),
+            held: Vec::new(),
+            waiting: 0,
+            swept: 0,
             pairs: HashMap::new(),
             over: HashMap::new(),
             results: Vec::new(),
@@ -122,7 +155,9 @@ impl RegionJoin {
         }
         let first_part = self.n_parts;
         let region = self.results.len() as u32;
-        let mut margin = Vec::new();
+        self.held.extend(std::iter::repeat_n(0, step.parts.len()));
+        let (mut core_ids, mut core_parts) = (Vec::with_capacity(core.len()), Vec::new());
+        let (mut margin_ids, mut margin_parts) = (Vec::new(), Vec::new());
         let mut c = 0usize;
         for (k, &i) in ids.iter().enumerate() {
             let is_core = c < core.len() && core[c] == i;
@@ -138,17 +173,28 @@ impl RegionJoin {
             }
             let part = (lp >= 0).then(|| first_part + lp as u32);
             match (is_core, part) {
-                (true, p) => self.part_of[i as usize] = p.unwrap_or(NONE),
-                (false, Some(pm)) => match self.part_of[i as usize] {
-                    UNSEEN => margin.push((i, pm)),
-                    owner => self.pair(pm, owner),
-                },
+                (true, p) => {
+                    core_ids.push(i);
+                    core_parts.push(p.unwrap_or(NONE));
+                    if let Some(p) = p {
+                        self.held[p as usize] += 1;
+                    }
+                }
+                (false, Some(pm)) => {
+                    margin_ids.push(i);
+                    margin_parts.push(pm);
+                }
                 (false, None) => {}
             }
         }
-        margin.shrink_to_fit();
         self.part_region
             .extend(std::iter::repeat_n(region, step.parts.len()));
+        self.part_of
+            .set(&core_ids, &core_parts)
+            .map_err(scratch_error)?;
+        drop((core_ids, core_parts));
+        let margin = self.pair_seen(margin_ids, margin_parts)?;
+        self.waiting += margin.len();
         let first_structure = self.n_structures;
         let parts = step
             .parts
@@ -161,6 +207,46 @@ impl RegionJoin {
         self.lines |= step.lines;
         self.normals_ignored += usize::from(step.normals_ignored);
         self.results.push(RegionResult { parts, margin });
+        if self.waiting >= FIRST_SWEEP.max(2 * self.swept) {
+            self.sweep()?;
+        }
+        Ok(())
+    }
+
+    /// Counts the margin labels (points `ids`, ascending, with parts
+    /// `parts`) whose core region was added; returns the others.
+    fn pair_seen(
+        &mut self,
+        ids: Vec<u32>,
+        parts: Vec<u32>,
+    ) -> Result<Vec<(u32, u32)>, DetectError> {
+        let mut owners = Vec::with_capacity(ids.len());
+        self.part_of.get(&ids, &mut owners).map_err(scratch_error)?;
+        let mut left = Vec::new();
+        for ((i, pm), owner) in ids.into_iter().zip(parts).zip(owners) {
+            match owner {
+                UNSEEN => left.push((i, pm)),
+                owner => self.pair(pm, owner),
+            }
+        }
+        left.shrink_to_fit();
+        Ok(left)
+    }
+
+    /// Counts every waiting margin label whose core region was added since.
+    fn sweep(&mut self) -> Result<(), DetectError> {
+        self.waiting = 0;
+        for r in 0..self.results.len() {
+            let margin = std::mem::take(&mut self.results[r].margin);
+            if margin.is_empty() {
+                continue;
+            }
+            let (ids, parts) = margin.into_iter().unzip();
+            let left = self.pair_seen(ids, parts)?;
+            self.waiting += left.len();
+            self.results[r].margin = left;
+        }
+        self.swept = self.waiting;
         Ok(())
     }
 
@@ -195,10 +281,10 @@ impl RegionJoin {
         joining: bool,
     ) -> Result<RegionRun, DetectError> {
         let joined = self.resolve_with(joining)?;
-        let (part_labels, labels) = joined.labels(0, points.len());
+        let (part_labels, labels) = joined.labels(0, points.len())?;
         let mut refit = joined.refit();
         for _ in 0..3 {
-            refit.add_points(&joined, 0, points);
+            refit.add_points(&joined, 0, points)?;
             refit.end_pass();
         }
         Ok(RegionRun {
@@ -221,12 +307,9 @@ impl RegionJoin {
         if self.skipped == self.results.len() {
             return Err(DetectError::NoSpacing);
         }
-        // The margin labels whose core region came later.
-        for r in 0..self.results.len() {
-            for (i, pm) in std::mem::take(&mut self.results[r].margin) {
-                self.pair(pm, self.part_of[i as usize]);
-            }
-        }
+        // The margin labels whose core region came later (every region is
+        // added now).
+        self.sweep()?;
         let (n_parts, n_structures) = (self.n_parts as usize, self.n_structures as usize);
         let (mut parts_uf, mut structures_uf, joins) = if joining {
             join(&self, n_parts, n_structures)
@@ -289,11 +372,11 @@ fn join(j: &RegionJoin, n_parts: usize, n_structures: usize) -> (UnionFind, Unio
 /// The joined and numbered parts of a region run (module doc, step 5):
 /// what gives each point its labels and each part its fit, over the cloud
 /// in memory or streamed in input order.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct RegionJoined {
     /// Per point: its global region part, [`NONE`], or [`UNSEEN`] (as in
     /// [`RegionJoin`]).
-    part_of: Vec<u32>,
+    part_of: PartIds,
     /// Per global region part: its final part and structure ids (MAX:
     /// a part no core point holds).
     final_of: Vec<(u32, u32)>,
@@ -337,13 +420,7 @@ impl RegionJoined {
     ) -> Self {
         let structure_of: Vec<u32> = join.parts().map(|(s, _)| s).collect();
         let n_parts = structure_of.len();
-        // Points per global region part, in one pass over the points.
-        let mut held = vec![0usize; n_parts];
-        for &p in &join.part_of {
-            if let Some(p) = part_id(p) {
-                held[p as usize] += 1;
-            }
-        }
+        let held = &join.held;
         let mut part_count = vec![0usize; n_parts];
         let mut structure_count = vec![0usize; join.n_structures as usize];
         for (p, &c) in held.iter().enumerate() {
@@ -386,7 +463,7 @@ impl RegionJoined {
 
     /// Whether the cloud has no points (never, for a joining of regions).
     pub fn is_empty(&self) -> bool {
-        self.part_of.is_empty()
+        self.part_of.len() == 0
     }
 
     /// The number of joined parts.
@@ -394,23 +471,43 @@ impl RegionJoined {
         self.summary.len()
     }
 
-    /// The final part of point `i`, or `None`.
-    fn final_part(&self, i: usize) -> Option<(u32, u32)> {
-        part_id(self.part_of[i]).map(|p| self.final_of[p as usize])
+    /// The final part and structure of each of the `n` points from input
+    /// index `first` on (`None`: none).
+    fn final_parts(
+        &self,
+        first: usize,
+        n: usize,
+    ) -> Result<impl Iterator<Item = Option<(u32, u32)>> + '_, DetectError> {
+        if first.checked_add(n).is_none_or(|end| end > self.len()) {
+            return Err(DetectError::BadParameter(format!(
+                "points {first}..{} past a cloud of {}",
+                first.saturating_add(n),
+                self.len()
+            )));
+        }
+        let mut ids = Vec::new();
+        self.part_of
+            .range(first, n, &mut ids)
+            .map_err(scratch_error)?;
+        Ok(ids
+            .into_iter()
+            .map(|p| part_id(p).map(|p| self.final_of[p as usize])))
     }
 
     /// The part and structure labels (−1: none) of the `n` points from
     /// input index `first` on.
     ///
-    /// # Panics
-    /// When `first + n` is past the cloud.
-    pub fn labels(&self, first: usize, n: usize) -> (Vec<i64>, Vec<i64>) {
-        (first..first + n)
-            .map(|i| match self.final_part(i) {
+    /// # Errors
+    /// Points past the cloud; [`DetectError::Scratch`] when the scratch
+    /// file cannot be read.
+    pub fn labels(&self, first: usize, n: usize) -> Result<(Vec<i64>, Vec<i64>), DetectError> {
+        Ok(self
+            .final_parts(first, n)?
+            .map(|f| match f {
                 Some((p, s)) => (i64::from(p), i64::from(s)),
                 None => (-1, -1),
             })
-            .unzip()
+            .unzip())
     }
 
     /// A refit of every joined part (its line or plane), to be fed the
@@ -479,11 +576,16 @@ impl PartsRefit {
     /// Adds the points `points`, input indices `first..`, to the pass under
     /// way, for the joining `joined`.
     ///
-    /// # Panics
-    /// When the points are past the cloud of `joined`.
-    pub fn add_points(&mut self, joined: &RegionJoined, first: usize, points: &[[f64; 3]]) {
-        for (k, &p) in points.iter().enumerate() {
-            let Some((id, _)) = joined.final_part(first + k) else {
+    /// # Errors
+    /// As [`RegionJoined::labels`].
+    pub fn add_points(
+        &mut self,
+        joined: &RegionJoined,
+        first: usize,
+        points: &[[f64; 3]],
+    ) -> Result<(), DetectError> {
+        for (f, &p) in joined.final_parts(first, points.len())?.zip(points) {
+            let Some((id, _)) = f else {
                 continue;
             };
             let fit = &mut self.fits[id as usize];
@@ -494,6 +596,7 @@ impl PartsRefit {
                 _ => {}
             }
         }
+        Ok(())
     }
 
     /// Ends the pass under way.

@@ -48,6 +48,7 @@
 //! order) only, and the joining takes the regions in the plan's order.
 
 mod join;
+mod part_ids;
 mod plan;
 
 pub use join::{PartsRefit, RegionJoin, RegionJoined};
@@ -547,13 +548,18 @@ mod tests {
         // of region parts follows it), wherever they ran.
         steps.sort_by_key(|s| s.0);
         let mut join = RegionJoin::new(pts.len());
+        // The same joining with its part ids in a scratch file (its
+        // waiting margin labels swept every few regions in tests).
+        let dir = std::env::temp_dir();
+        let mut streamed = RegionJoin::with_scratch(pts.len(), &dir).unwrap();
         for (r, ids, step, widened) in &steps {
             if *widened {
                 join.widened();
+                streamed.widened();
             }
             join.add(ids, plan.core(*r), Some(step)).unwrap();
+            streamed.add(ids, plan.core(*r), Some(step)).unwrap();
         }
-        let streamed = join.clone();
         assert_eq!(join.finish(&pts).unwrap(), want);
         // Streamed in uneven chunks (tiles in input order): labels chunk by
         // chunk and three refit passes give the same run, fits bit for bit.
@@ -564,11 +570,11 @@ mod tests {
         for pass in 0..3 {
             for w in chunks.windows(2) {
                 if pass == 0 {
-                    let (p, l) = joined.labels(w[0], w[1] - w[0]);
+                    let (p, l) = joined.labels(w[0], w[1] - w[0]).unwrap();
                     part_labels.extend(p);
                     labels.extend(l);
                 }
-                refit.add_points(&joined, w[0], &pts[w[0]..w[1]]);
+                refit.add_points(&joined, w[0], &pts[w[0]..w[1]]).unwrap();
             }
             refit.end_pass();
         }
@@ -578,6 +584,7 @@ mod tests {
             ..joined.run(&refit)
         };
         assert_eq!(run, want);
+        assert!(joined.labels(pts.len() - 1, 2).is_err());
         // A step of the wrong length, one naming points past the cloud, and
         // one that gives a point another structure than its part's are
         // refused.
