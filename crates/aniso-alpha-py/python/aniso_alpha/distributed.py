@@ -868,13 +868,14 @@ def detect_tiles(
     names = _output_names(paths, os.fspath(out)) if out is not None else []
     opts = detect_options(**options)
     pieces = _pieces(paths, int(piece))
-    made = out is not None and not os.path.isdir(os.fspath(out))
-    if out is not None:
-        os.makedirs(os.fspath(out), exist_ok=True)
+    folder = None if out is None else os.fspath(out)
+    made = folder is not None and not os.path.isdir(folder)
+    if folder is not None:
+        os.makedirs(folder, exist_ok=True)
     # The part ids (4 bytes a point) and the labelled tiles until all are
     # complete: a hidden folder inside `out`, removed at the end (and `out`
     # with it when this run made it and failed).
-    scratch = tempfile.mkdtemp(prefix=".aniso-alpha-", dir=None if out is None else os.fspath(out))
+    scratch = tempfile.mkdtemp(prefix=".aniso-alpha-", dir=folder)
     done = False
     try:
         run = _tiles_run(pieces, paths, names, scratch, structure, side, client, n_workers, task_threads,
@@ -882,9 +883,9 @@ def detect_tiles(
         done = True
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
-        if made and not done:
+        if made and not done and folder is not None:
             with contextlib.suppress(OSError):
-                os.rmdir(os.fspath(out))
+                os.rmdir(folder)
     return run
 
 
