@@ -79,7 +79,7 @@ impl Keep {
 /// The number of points a LAS/LAZ file declares, checked as a read
 /// checks it (a LAZ file's chunk table must hold them).
 pub(crate) fn las_points<B: LasBytes + ?Sized>(path: &Path, bytes: &B) -> Result<u64, IoError> {
-    let bad = |m: String| IoError::format(path, format!("invalid LAS/LAZ file: {m}"));
+    let bad = |m: String| invalid(path, m);
     precheck(bytes).map_err(bad)?;
     let (layout, _) = contain(path, || header_layout(bytes))?.map_err(bad)?;
     Ok(layout.points)
@@ -103,7 +103,7 @@ pub(crate) fn read_las_from<B: LasBytes + ?Sized>(
 ) -> Result<PointCloud, IoError> {
     let read_labels = labels_with.is_some();
     let background = labels_with.unwrap_or(ClassSet::EMPTY);
-    let bad = |m: String| IoError::format(path, format!("invalid LAS/LAZ file: {m}"));
+    let bad = |m: String| invalid(path, m);
     precheck(bytes).map_err(bad)?;
     let (layout, laz) = contain(path, || header_layout(bytes))?.map_err(bad)?;
     let (start, count) = match range {
@@ -168,6 +168,41 @@ pub(crate) fn read_las_from<B: LasBytes + ?Sized>(
         }
         Ok(())
     };
+    for_each_batch(
+        path,
+        bytes,
+        &layout,
+        laz,
+        (start, count),
+        &mut sink,
+        progress,
+    )?;
+    if read_labels {
+        cloud.labels = Some(labels);
+    }
+    if records {
+        let src = source(bytes, &layout, kept).map_err(bad)?;
+        if keep == Keep::Attributes {
+            cloud.attributes = record_attributes(&src);
+        }
+        cloud.las = Some(Box::new(src));
+    }
+    non_empty(path, cloud)
+}
+
+/// Feeds `sink` the records `range` (start, count) of a checked file, a
+/// batch at a time ([`batch_size`]), calling `progress` after each.
+fn for_each_batch<B: LasBytes + ?Sized>(
+    path: &Path,
+    bytes: &B,
+    layout: &Layout,
+    laz: Option<laz::LazVlr>,
+    range: (u64, u64),
+    sink: &mut dyn FnMut(&[u8]) -> Result<(), IoError>,
+    progress: &mut dyn FnMut(u64, u64),
+) -> Result<(), IoError> {
+    let (start, count) = range;
+    let bad = |m: String| invalid(path, m);
     let len = layout.record_len as u64;
     let batch = batch_size(layout.record_len, bytes.size());
     match laz {
@@ -227,17 +262,7 @@ pub(crate) fn read_las_from<B: LasBytes + ?Sized>(
             }
         }
     }
-    if read_labels {
-        cloud.labels = Some(labels);
-    }
-    if records {
-        let src = source(bytes, &layout, kept).map_err(bad)?;
-        if keep == Keep::Attributes {
-            cloud.attributes = record_attributes(&src);
-        }
-        cloud.las = Some(Box::new(src));
-    }
-    non_empty(path, cloud)
+    Ok(())
 }
 
 /// The header, VLRs and data after the points of a LAS file, with its
@@ -298,6 +323,11 @@ fn source<B: LasBytes + ?Sized>(
         tail_start,
         tail,
     })
+}
+
+/// A LAS/LAZ file that fails a check.
+fn invalid(path: &Path, message: String) -> IoError {
+    IoError::format(path, format!("invalid LAS/LAZ file: {message}"))
 }
 
 /// Runs `f`, turning a panic inside it (from the `las` or `laz` crates on

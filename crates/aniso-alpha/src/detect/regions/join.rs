@@ -37,8 +37,9 @@ pub struct RegionJoin {
     /// Per point: the global region part its core region gave it,
     /// [`NONE`], or [`UNSEEN`].
     part_of: PartIds,
-    /// Per global region part: its region, and its core points.
+    /// Per global region part: its region.
     part_region: Vec<u32>,
+    /// Per global region part: its core points.
     held: Vec<usize>,
     /// Margin labels waiting in `results`, and their number after the
     /// last sweep.
@@ -155,7 +156,7 @@ impl RegionJoin {
         }
         let first_part = self.n_parts;
         let region = self.results.len() as u32;
-        self.held.extend(std::iter::repeat_n(0, step.parts.len()));
+        let mut held = vec![0usize; step.parts.len()];
         let (mut core_ids, mut core_parts) = (Vec::with_capacity(core.len()), Vec::new());
         let (mut margin_ids, mut margin_parts) = (Vec::new(), Vec::new());
         let mut c = 0usize;
@@ -176,8 +177,8 @@ impl RegionJoin {
                 (true, p) => {
                     core_ids.push(i);
                     core_parts.push(p.unwrap_or(NONE));
-                    if let Some(p) = p {
-                        self.held[p as usize] += 1;
+                    if lp >= 0 {
+                        held[lp as usize] += 1;
                     }
                 }
                 (false, Some(pm)) => {
@@ -189,6 +190,7 @@ impl RegionJoin {
         }
         self.part_region
             .extend(std::iter::repeat_n(region, step.parts.len()));
+        self.held.extend(held);
         self.part_of
             .set(&core_ids, &core_parts)
             .map_err(scratch_error)?;
