@@ -4,7 +4,8 @@
 //! library MODULE::` runs one file's tests. The files that need a cargo
 //! feature are test binaries of their own with `required-features`
 //! (`io_e57`, `io_fuzz_regressions`), so that without the feature they
-//! are not built rather than built empty.
+//! are not built rather than built empty; `las_range` is a module here
+//! only with the `las` feature (the workspace's tests have it).
 
 mod alpha_common;
 mod common;
@@ -37,6 +38,7 @@ mod io_attributes;
 mod io_formats;
 #[path = "io_never_panics.rs"]
 mod io_never_panics;
+#[cfg(feature = "las")]
 #[path = "las_range.rs"]
 mod las_range;
 #[path = "lines_pipeline_bruteforce.rs"]
