@@ -28,17 +28,29 @@ pub(super) enum PartIds {
     File(Scratch),
 }
 
-/// A scratch file of ids, removed when dropped.
+/// A scratch file of ids, closed and removed when dropped.
 #[derive(Debug)]
 pub(super) struct Scratch {
-    file: File,
+    /// `None` only while dropped (closed before it is removed, which some
+    /// systems require).
+    file: Option<File>,
     path: PathBuf,
     len: usize,
 }
 
 impl Drop for Scratch {
     fn drop(&mut self) {
+        drop(self.file.take());
         let _ = std::fs::remove_file(&self.path);
+    }
+}
+
+impl Scratch {
+    /// The open file.
+    fn file(&self) -> std::io::Result<&File> {
+        self.file
+            .as_ref()
+            .ok_or_else(|| std::io::Error::other("the scratch file is closed"))
     }
 }
 
@@ -76,8 +88,12 @@ impl PartIds {
             .write(true)
             .create_new(true)
             .open(&path)?;
-        let scratch = Scratch { file, path, len: n };
-        scratch.file.set_len(n as u64 * 4)?;
+        let scratch = Scratch {
+            file: Some(file),
+            path,
+            len: n,
+        };
+        scratch.file()?.set_len(n as u64 * 4)?;
         Ok(PartIds::File(scratch))
     }
 
@@ -101,11 +117,12 @@ impl PartIds {
             }
             PartIds::File(s) => {
                 let mut buf = Vec::new();
+                let mut file = s.file()?;
                 for r in runs(ids, 0) {
                     buf.clear();
                     buf.extend(values[r.clone()].iter().flat_map(|&p| (!p).to_le_bytes()));
-                    s.file.seek(SeekFrom::Start(u64::from(ids[r.start]) * 4))?;
-                    s.file.write_all(&buf)?;
+                    file.seek(SeekFrom::Start(u64::from(ids[r.start]) * 4))?;
+                    file.write_all(&buf)?;
                 }
                 Ok(())
             }
@@ -150,7 +167,7 @@ impl Scratch {
     /// The ids of points `first..first + n` into `out` (replacing it).
     fn read_range(&self, first: usize, n: usize, out: &mut Vec<u32>) -> std::io::Result<()> {
         let mut bytes = vec![0u8; n * 4];
-        let mut file = &self.file;
+        let mut file = self.file()?;
         file.seek(SeekFrom::Start(first as u64 * 4))?;
         file.read_exact(&mut bytes)?;
         out.clear();
