@@ -100,3 +100,16 @@ def test_a_region_run_is_written_with_its_labels(ground_and_roof, tmp_path):
         np.testing.assert_array_equal(back.attributes["structure"], r.labels)
         np.testing.assert_array_equal(back.attributes["part"], r.part_labels)
         assert (back.attributes["classification"][r.labels >= 0] == 6).all()
+
+
+def test_a_region_run_gives_pdal_dimensions(ground_and_roof):
+    pts, _ = ground_and_roof
+    r = aa.detect_regions(pts, "planes", side=30.0, threads=1)
+    assert r.kind == "planes"
+    arr = np.zeros(len(pts), dtype=[("X", "<f8"), ("Y", "<f8"), ("Z", "<f8")])
+    out = aa.labelled_array(arr, r, classify=6)
+    np.testing.assert_array_equal(out["StructureId"], r.labels)
+    np.testing.assert_array_equal(out["PlaneId"], r.part_labels)
+    assert (out["Classification"][r.labels >= 0] == 6).all()
+    lines = aa.detect_regions(pts[:500], "lines", threads=1)
+    assert lines.kind == "lines" and set(lines.dimensions()) == {"StructureId", "LineId"}

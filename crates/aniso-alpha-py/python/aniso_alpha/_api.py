@@ -412,7 +412,8 @@ def _region_detection(run: Tuple[Any, ...], side: Optional[float], structure: st
     labels, part_labels, rows, regions, widened, joins, skipped, messages = run
     _warn(messages, stacklevel=4)
     return RegionDetection(
-        labels, part_labels, _region_parts(rows, structure), side, regions, widened, joins, skipped, messages
+        labels, part_labels, _region_parts(rows, structure), side, regions, widened, joins, skipped, messages,
+        structure,
     )
 
 

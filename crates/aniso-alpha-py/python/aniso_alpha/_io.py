@@ -204,10 +204,11 @@ def write(
 
 
 def labelled_array(
-    array: NDArray[Any], detection: Detection, *, classify: Optional[int] = None
+    array: NDArray[Any], detection: Union[Detection, RegionDetection], *, classify: Optional[int] = None
 ) -> NDArray[Any]:
     """A PDAL point array (a numpy structured array, as
-    ``pdal.Pipeline.arrays`` gives it) with the detection's ids added as
+    ``pdal.Pipeline.arrays`` gives it) with the ids of ``detection`` (a
+    :class:`Detection` or a :class:`RegionDetection`) added as
     dimensions: ``StructureId`` and ``PlaneId`` (planes) or ``LineId``
     (lines), int32, -1 off the structures (:meth:`Detection.dimensions`);
     with ``classify``, ``Classification`` (uint8, added if missing) set to

@@ -184,11 +184,7 @@ class Detection:
         PDAL's ``filters.python``: ``outs.update(det.dimensions())``, with
         ``add_dimension`` declaring them.
         """
-        part = "PlaneId" if self.kind == "planes" else "LineId"
-        return {
-            "StructureId": self.labels.astype(np.int32),
-            part: self.part_labels.astype(np.int32),
-        }
+        return _dimensions(self.kind, self.labels, self.part_labels)
 
     def __repr__(self) -> str:
         background = int(np.count_nonzero(self.labels < 0))
@@ -246,6 +242,7 @@ class RegionDetection:
         warnings: what the CLI prints as warnings (also raised as
             :class:`AnisoAlphaWarning`): regions that did not use the
             normals given with the points.
+        kind: ``"planes"`` or ``"lines"``.
     """
 
     labels: NDArray[np.int64]
@@ -257,6 +254,12 @@ class RegionDetection:
     joins: int = 0
     skipped: int = 0
     warnings: List[str] = field(default_factory=list)
+    kind: str = "planes"
+
+    def dimensions(self) -> Dict[str, NDArray[np.int32]]:
+        """The per-point ids as PDAL dimensions, as
+        :meth:`Detection.dimensions` gives them."""
+        return _dimensions(self.kind, self.labels, self.part_labels)
 
 
 @dataclass(frozen=True, eq=False)
@@ -285,3 +288,11 @@ class TileDetection:
     joins: int = 0
     skipped: int = 0
     warnings: List[str] = field(default_factory=list)
+
+
+def _dimensions(
+    kind: str, labels: NDArray[np.int64], part_labels: NDArray[np.int64]
+) -> Dict[str, NDArray[np.int32]]:
+    """``StructureId`` and ``PlaneId`` (planes) or ``LineId`` (lines), int32."""
+    part = "PlaneId" if kind == "planes" else "LineId"
+    return {"StructureId": labels.astype(np.int32), part: part_labels.astype(np.int32)}
