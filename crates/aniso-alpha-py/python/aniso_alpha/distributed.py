@@ -737,16 +737,17 @@ def _labels_and_fits(
     cls = None if classify is None else int(classify)
     for k in range(3):
         writer: Any = None
-        for (path, start, count), first, n in zip(pieces, firsts, counts):
+        for piece, first, n in zip(pieces, firsts, counts):
+            path, start, count = piece
             label = k == 0 and staging is not None
             las = None
-            if count is None:
-                cloud = read(path, attributes=label)
+            if not label:
+                points = _piece_points(piece)
+            elif count is None:
+                cloud = read(path, attributes=True)
                 points = cloud.points
-            elif label:
-                points, las = _native.read_las_records(path, start, count)
             else:
-                points = read(path, attributes=False, start=start, count=count).points
+                points, las = _native.read_las_records(path, start, count)
             if len(points) != n:
                 raise ValueError(f"{path}: {len(points)} points, {n} when the run began")
             joined.refit(first, points)

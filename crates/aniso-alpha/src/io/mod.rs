@@ -355,16 +355,8 @@ pub fn read_points_with_progress(
     #[cfg(feature = "las")]
     if format == Format::Las && !is_stdin(path) {
         // Read at offsets: the file's bytes are never all in memory.
-        let (file, total) = open_file(path)?;
-        let bytes = las_bytes::FileBytes::new(file, total);
-        return las::read_las_from(
-            path,
-            &bytes,
-            None,
-            options.read_labels.then_some(options.background_classes),
-            las::Keep::from_attributes(options.attributes),
-            progress,
-        );
+        let keep = las::Keep::from_attributes(options.attributes);
+        return read_las_file(path, None, options, keep, progress);
     }
     let bytes = if is_stdin(path) {
         let mut bytes = Vec::new();
@@ -453,7 +445,7 @@ pub fn read_las_range(
     #[cfg(feature = "las")]
     {
         let keep = las::Keep::from_attributes(options.attributes);
-        read_range(path, start, count, options, keep)
+        read_las_file(path, Some((start, count)), options, keep, &mut |_, _| {})
     }
     #[cfg(not(feature = "las"))]
     {
@@ -468,12 +460,13 @@ pub fn read_las_range(
 pub fn read_las_range_records(path: &Path, start: u64, count: u64) -> Result<PointCloud, IoError> {
     #[cfg(feature = "las")]
     {
-        read_range(
+        let options = ReadOptions::default();
+        read_las_file(
             path,
-            start,
-            count,
-            &ReadOptions::default(),
+            Some((start, count)),
+            &options,
             las::Keep::Records,
+            &mut |_, _| {},
         )
     }
     #[cfg(not(feature = "las"))]
@@ -483,22 +476,30 @@ pub fn read_las_range_records(path: &Path, start: u64, count: u64) -> Result<Poi
     }
 }
 
+/// A LAS/LAZ file on disk, read at offsets.
 #[cfg(feature = "las")]
-fn read_range(
+fn las_file(path: &Path) -> Result<las_bytes::FileBytes, IoError> {
+    let (file, total) = open_file(path)?;
+    Ok(las_bytes::FileBytes::new(file, total))
+}
+
+/// The points `range` (start, count; `None`: all) of a LAS/LAZ file on
+/// disk, keeping `keep`.
+#[cfg(feature = "las")]
+fn read_las_file(
     path: &Path,
-    start: u64,
-    count: u64,
+    range: Option<(u64, u64)>,
     options: &ReadOptions,
     keep: las::Keep,
+    progress: &mut dyn FnMut(u64, u64),
 ) -> Result<PointCloud, IoError> {
-    let (file, total) = open_file(path)?;
     las::read_las_from(
         path,
-        &las_bytes::FileBytes::new(file, total),
-        Some((start, count)),
+        &las_file(path)?,
+        range,
         options.read_labels.then_some(options.background_classes),
         keep,
-        &mut |_, _| {},
+        progress,
     )
 }
 
@@ -508,8 +509,7 @@ fn read_range(
 pub fn las_point_count(path: &Path) -> Result<u64, IoError> {
     #[cfg(feature = "las")]
     {
-        let (file, total) = open_file(path)?;
-        las::las_points(path, &las_bytes::FileBytes::new(file, total))
+        las::las_points(path, &las_file(path)?)
     }
     #[cfg(not(feature = "las"))]
     {
