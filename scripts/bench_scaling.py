@@ -1,63 +1,94 @@
 #!/usr/bin/env python3
 """Growth of `detect` (automatic mode) with the number of points at
-constant density (issue: real scans, tiles): copies of a scan laid out on
-a grid, from 1 copy to many. By default the CGAL ball scan (the fixture,
-31,374 points), each copy 1.5 object sizes from the next; `--scan` takes
-any binary PLY (e.g. an airborne tile of the corpus, scripts/corpus/) and
-`--spacing 1` lays its copies edge to edge, as the tiles of one survey:
-the ground of every copy is then one plane across the tiles, and every
-roof has a coplanar twin in each copy (the case where merging coplanar
-parts was quadratic). Prints wall time, peak RSS, microseconds per point,
-planes found per copy, the CLI's phases (`--timings`) and, when the scan
-has a truth column `plane` (scripts/corpus/), the per-point plane F1 of
-the copies. `--regions` passes detect's `--regions` (default: the CLI's,
-`auto`: region by region above 1,000,000 points; `off`: one whole run).
-With `--peer`
-(scripts/peers/cgal_shapes.cpp), CGAL's Efficient RANSAC runs on the same
-cloud in the same loop (`--peer-args`, e.g. the scan's best preset of
-scripts/bench_corpus.py), and the table gets its wall time, peak RSS and
-our ratios to them.
+constant density, and with the number of threads (issue 27): copies of a
+scan laid out on a grid, from 1 copy to many. By default the CGAL ball
+scan (the fixture, 31,374 points), each copy 1.5 object sizes from the
+next; `--scan` takes any binary PLY (e.g. an airborne tile of the corpus,
+scripts/corpus/) and `--spacing 1` lays its copies edge to edge, as the
+tiles of one survey: the ground of every copy is then one plane across the
+tiles, and every roof has a coplanar twin in each copy (the case where
+merging coplanar parts was quadratic).
+
+Each row is one run: copies × `--regions` × `--threads` (each a comma
+list; `--threads 1,16` gives the speed-up, and the `labels` column, the
+first digits of the part labels' SHA-256, shows that every thread count
+gave the same labels). Prints wall time, peak RSS, microseconds per
+point, planes found per copy, the CLI's phases (`--timings`) and, when the
+scan has a truth column `plane` (scripts/corpus/), the per-point plane F1
+of the copies. `--regions` passes detect's `--regions` (`auto`: region by
+region above 1,000,000 points, the CLI's default; `off`: one whole run).
+With `--peer` (scripts/peers/cgal_shapes.cpp), CGAL's Efficient RANSAC
+(one thread) runs on the same cloud in the same loop (`--peer-args`, e.g.
+the scan's best preset of scripts/bench_corpus.py; `--peer-copies` limits
+the sizes it runs on), and its rows get its wall time, peak RSS and our
+ratios to them (each thread count's). `--deadline S` skips the runs that
+would start after S seconds and caps each run's timeout at what is left
+(the device machine's one prepared script); `--json FILE` appends every
+row as one JSON object as soon as it is measured.
 
     python3 scripts/bench_scaling.py [--bin target/release/aniso-alpha] [--copies 1,4,16,32]
-        [--scan FILE.ply --spacing 1] [--timeout S] [--threads N] [--regions auto|off|SIDE]
+        [--scan FILE.ply --spacing 1] [--timeout S] [--threads 1,2] [--regions auto,off]
         [--peer cgal_shapes --peer-args "--epsilon 0.15 --cluster-epsilon 0.49 --min-points 100"]
+        [--peer-copies 16] [--deadline S] [--json FILE]
 
-Needs numpy and GNU time (/usr/bin/time) for the peak RSS.
+Needs numpy. Peak RSS is the child's own (`os.wait4`), so no GNU time.
 """
 import argparse
+import hashlib
 import json
 import os
 import signal
 import subprocess
+import sys
 import tempfile
 import time
 
 import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys_path = os.path.join(ROOT, "scripts")
-import sys  # noqa: E402
-
-sys.path.insert(0, sys_path)
+sys.path.insert(0, os.path.join(ROOT, "scripts"))
 from bench_real import read_ply, score  # noqa: E402
 
-sys.path.insert(0, os.path.join(sys_path, "corpus"))
+sys.path.insert(0, os.path.join(ROOT, "scripts", "corpus"))
 from common import read_ply as read_any_ply  # noqa: E402
+
+
+class Clock:
+    """The script's time budget (`--deadline`): what is left of it."""
+
+    def __init__(self, deadline):
+        self.start = time.perf_counter()
+        self.deadline = deadline
+
+    def left(self):
+        if self.deadline is None:
+            return None
+        return self.deadline - (time.perf_counter() - self.start)
+
+    def timeout(self, per_run):
+        """A run's timeout: `per_run` capped at what is left (None: none)."""
+        left = self.left()
+        if left is None:
+            return per_run
+        return left if per_run is None else min(per_run, left)
 
 
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--bin", default=os.path.join(ROOT, "target/release/aniso-alpha"))
     ap.add_argument("--copies", default="1,4,16,32")
-    ap.add_argument("--threads", default=None)
+    ap.add_argument("--threads", default=None, help="thread counts, a comma list (default: the CLI's, all cores)")
     ap.add_argument("--scan", default=None, help="a binary PLY to copy (default: CGAL's ball)")
     ap.add_argument("--spacing", type=float, default=1.5,
                     help="copy pitch in units of the scan's extent (1: edge to edge)")
     ap.add_argument("--timeout", type=float, default=None, help="seconds per run, ours and the peer's (then: > timeout)")
+    ap.add_argument("--deadline", type=float, default=None, help="seconds for the whole script")
     ap.add_argument("--peer", default=None, help="CGAL peer binary (scripts/peers/cgal_shapes.cpp)")
     ap.add_argument("--peer-args", default="", help="its options, one string")
+    ap.add_argument("--peer-copies", default=None, help="the copies the peer runs on (default: all)")
     ap.add_argument("--regions", default=None,
-                    help="detect's --regions (SIDE, auto or off; default: the CLI's, auto)")
+                    help="detect's --regions, a comma list (SIDE, auto or off; default: the CLI's, auto)")
+    ap.add_argument("--json", default=None, help="append each row to this file as one JSON object")
     a = ap.parse_args()
     truth = None
     if a.scan:
@@ -69,82 +100,150 @@ def main():
         pts, _ = read_ply(os.path.join(ROOT, "crates/aniso-alpha/tests/fixtures/real/ball.ply"))
     lo, hi = pts.min(0), pts.max(0)
     pitch = a.spacing * (hi - lo)
+    threads = a.threads.split(",") if a.threads else [None]
+    regions = a.regions.split(",") if a.regions else [None]
+    peer_copies = None if a.peer_copies is None else set(map(int, a.peer_copies.split(",")))
+    clock = Clock(a.deadline)
     peer_cols = " RANSAC wall s | RANSAC RSS MiB | wall / RANSAC | RSS / RANSAC |" if a.peer else ""
     f1_col = " plane F1 |" if truth is not None else ""
-    print("| copies | points | wall s | peak RSS MiB | µs / point | parts | parts / copy | phases (s) |" + f1_col
-          + peer_cols)
-    print("|---:|---:|---:|---:|---:|---:|---:|---|" + ("---:|" if truth is not None else "")
+    print("| copies | points | regions | threads | wall s | peak RSS MiB | µs / point | parts | parts / copy"
+          " | labels | phases (s) |" + f1_col + peer_cols)
+    print("|---:|---:|---|---:|---:|---:|---:|---:|---:|---|---|" + ("---:|" if truth is not None else "")
           + ("---:|" * 4 if a.peer else ""))
     with tempfile.TemporaryDirectory() as tmp:
         for c in map(int, a.copies.split(",")):
             side = int(np.ceil(np.sqrt(c)))
             cloud = np.concatenate([pts + np.array([pitch[0] * (k % side), pitch[1] * (k // side), 0.0])
                                     for k in range(c)])
-            f = os.path.join(tmp, "copies.xyz")
-            np.savetxt(f, cloud, fmt="%.5f")
-            rep = os.path.join(tmp, "r.json")
-            lab = os.path.join(tmp, "parts.txt")
-            args = ["/usr/bin/time", "-f", "%M", a.bin, "detect", f, "--structure", "planes", "--report", rep,
-                    "--part-labels", lab, "--quiet", "--timings"]
-            if a.threads:
-                args += ["--threads", a.threads]
-            if a.regions:
-                args += ["--regions", a.regions]
-            t = time.perf_counter()
-            try:
-                r = run_group(args, a.timeout)
-            except subprocess.TimeoutExpired:
-                print(f"| {c} | {len(cloud)} | > {a.timeout:.0f} | | | | | |", flush=True)
-                continue
-            wall = time.perf_counter() - t
-            lines = r.stderr.strip().splitlines()
-            rss = int(lines[-1]) / 1024
-            phases = next((json.loads(x) for x in lines if x.startswith("{")), {})
-            ph = ", ".join(f"{k} {v:.1f}" for k, v in phases.items()
-                           if k != "total" and isinstance(v, (int, float)))
-            report = json.load(open(rep))
-            # A whole run reports structures and their parts; a region run
-            # its joined parts.
-            parts = (len(report["parts"]) if "regions" in report
-                     else sum(len(s.get("parts", [])) for s in report["structures"]))
-            f1 = ""
-            if truth is not None:
-                pred = np.loadtxt(lab, dtype=np.int64)
-                f1 = f" {score(np.tile(truth, c), pred)['f1']:.3f} |"
-            del report
-            peer = ""
-            if a.peer:
-                try:
-                    pw, prss = run_peer(a, f, os.path.join(tmp, "peer.txt"))
-                    peer = f" {pw:.2f} | {prss:.0f} | {wall / pw:.2f} | {rss / prss:.2f} |"
-                except subprocess.TimeoutExpired:
-                    peer = f" > {a.timeout:.0f} | | < {wall / a.timeout:.2f} | |"
-            print(f"| {c} | {len(cloud)} | {wall:.2f} | {rss:.0f} | {1e6 * wall / len(cloud):.1f} | {parts} | {parts / c:.1f} | {ph} |"
-                  + f1 + peer, flush=True)
+            f = os.path.join(tmp, "copies.ply")
+            write_xyz_ply(f, cloud)
+            peer = None
+            if a.peer and (peer_copies is None or c in peer_copies):
+                peer = measure_peer(a, clock, cloud, tmp)
+            for reg in regions:
+                for th in threads:
+                    row = measure_ours(a, clock, f, c, len(cloud), reg, th, truth, tmp)
+                    print_row(a, row, peer, truth is not None)
+            del cloud
 
 
-def run_group(args, timeout):
-    """`args` to completion (stdout and stderr captured), or killed with
-    every process it started after `timeout` seconds (GNU time's child
-    too), raising subprocess.TimeoutExpired."""
-    p = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+def write_xyz_ply(path, xyz):
+    """`xyz` as a binary PLY of double x y z (what `detect` reads fastest)."""
+    head = f"ply\nformat binary_little_endian 1.0\nelement vertex {len(xyz)}\n"
+    head += "property double x\nproperty double y\nproperty double z\nend_header\n"
+    with open(path, "wb") as f:
+        f.write(head.encode())
+        f.write(np.ascontiguousarray(xyz, dtype="<f8").tobytes())
+
+
+def measure_ours(a, clock, f, c, n, reg, th, truth, tmp):
+    """One run of `detect` on `f`: a row's fields (wall None when it did
+    not finish in time, or was not started for lack of it)."""
+    row = dict(copies=c, points=n, regions=reg or "auto", threads=th or "all", wall=None)
+    timeout = clock.timeout(a.timeout)
+    if timeout is not None and timeout <= 1:
+        row["skipped"] = True
+        return row
+    rep = os.path.join(tmp, "r.json")
+    lab = os.path.join(tmp, "parts.txt")
+    args = [a.bin, "detect", f, "--structure", "planes", "--report", rep,
+            "--part-labels", lab, "--quiet", "--timings"]
+    if th:
+        args += ["--threads", th]
+    if reg:
+        args += ["--regions", reg]
     try:
-        out, err = p.communicate(timeout=timeout)
+        wall, rss, _, err = run_measured(args, timeout)
     except subprocess.TimeoutExpired:
-        os.killpg(p.pid, signal.SIGKILL)
-        p.communicate()
-        raise
+        row["timeout"] = timeout
+        return row
+    phases = next((json.loads(x) for x in err.splitlines() if x.startswith("{")), {})
+    report = json.load(open(rep))
+    # A whole run reports structures and their parts; a region run its
+    # joined parts.
+    parts = (len(report["parts"]) if "regions" in report
+             else sum(len(s.get("parts", [])) for s in report["structures"]))
+    del report
+    with open(lab, "rb") as g:
+        raw = g.read()
+    row.update(wall=wall, rss=rss, parts=parts, labels=hashlib.sha256(raw).hexdigest()[:12], phases=phases)
+    if truth is not None:
+        pred = np.array(raw.split(), dtype=np.int64)
+        row["f1"] = score(np.tile(truth, c), pred)["f1"]
+    return row
+
+
+def measure_peer(a, clock, cloud, tmp):
+    """CGAL's Efficient RANSAC on the cloud: {wall, rss} (wall None when
+    it did not finish in time)."""
+    timeout = clock.timeout(a.timeout)
+    if timeout is not None and timeout <= 1:
+        return dict(wall=None, timeout=0)
+    xyz = os.path.join(tmp, "copies.xyz")
+    np.savetxt(xyz, cloud, fmt="%.5f")
+    args = [a.peer, "ransac", xyz, os.path.join(tmp, "peer.txt"), *a.peer_args.split()]
+    try:
+        wall, rss, _, _ = run_measured(args, timeout)
+    except subprocess.TimeoutExpired:
+        return dict(wall=None, timeout=timeout)
+    return dict(wall=wall, rss=rss)
+
+
+def print_row(a, row, peer, has_truth):
+    """One markdown row (and one JSON line with `--json`)."""
+    head = f"| {row['copies']} | {row['points']} | {row['regions']} | {row['threads']} |"
+    if row["wall"] is None:
+        why = "skipped" if row.get("skipped") else f"> {row['timeout']:.0f}"
+        print(head + f" {why} | | | | | | |" + (" |" if has_truth else "") + (" | | | |" if a.peer else ""),
+              flush=True)
+    else:
+        ph = ", ".join(f"{k} {v:.1f}" for k, v in row["phases"].items()
+                       if k != "total" and isinstance(v, (int, float)))
+        line = (head + f" {row['wall']:.2f} | {row['rss']:.0f} | {1e6 * row['wall'] / row['points']:.1f} |"
+                f" {row['parts']} | {row['parts'] / row['copies']:.1f} | {row['labels']} | {ph} |")
+        if has_truth:
+            line += f" {row['f1']:.3f} |"
+        if a.peer:
+            if peer is None:
+                line += " | | | |"
+            elif peer["wall"] is None:
+                line += f" > {peer['timeout']:.0f} | | | |"
+            else:
+                line += (f" {peer['wall']:.2f} | {peer['rss']:.0f} | {row['wall'] / peer['wall']:.2f} |"
+                         f" {row['rss'] / peer['rss']:.2f} |")
+        print(line, flush=True)
+    if a.json:
+        with open(a.json, "a") as g:
+            g.write(json.dumps(dict(row, peer=peer)) + "\n")
+
+
+def run_measured(args, timeout):
+    """`args` to completion: (wall s, peak RSS MiB, stdout, stderr), or
+    killed with every process it started after `timeout` seconds, raising
+    subprocess.TimeoutExpired. The peak RSS is the child's own, from
+    `os.wait4` (ru_maxrss, KiB on Linux); its output goes through files so
+    that nothing but `wait4` reaps it."""
+    with tempfile.TemporaryFile("w+") as out, tempfile.TemporaryFile("w+") as err:
+        t = time.perf_counter()
+        p = subprocess.Popen(args, stdout=out, stderr=err, text=True, start_new_session=True)
+        while True:
+            pid, status, usage = os.wait4(p.pid, os.WNOHANG)
+            if pid == p.pid:
+                break
+            if timeout is not None and time.perf_counter() - t > timeout:
+                os.killpg(p.pid, signal.SIGKILL)
+                os.wait4(p.pid, 0)
+                p.returncode = -9
+                raise subprocess.TimeoutExpired(args, timeout)
+            time.sleep(0.02)
+        wall = time.perf_counter() - t
+        p.returncode = os.waitstatus_to_exitcode(status)
+        out.seek(0)
+        err.seek(0)
+        o, e = out.read(), err.read()
     if p.returncode != 0:
-        raise subprocess.CalledProcessError(p.returncode, args, out, err)
-    return subprocess.CompletedProcess(args, p.returncode, out, err)
-
-
-def run_peer(a, xyz, labels):
-    """Wall time and peak RSS (MiB) of CGAL's Efficient RANSAC on `xyz`."""
-    args = ["/usr/bin/time", "-f", "%M", a.peer, "ransac", xyz, labels, *a.peer_args.split()]
-    t = time.perf_counter()
-    r = run_group(args, a.timeout)
-    return time.perf_counter() - t, int(r.stderr.strip().splitlines()[-1]) / 1024
+        raise subprocess.CalledProcessError(p.returncode, args, o, e)
+    return wall, usage.ru_maxrss / 1024, o, e
 
 
 if __name__ == "__main__":

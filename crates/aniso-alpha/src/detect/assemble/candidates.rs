@@ -109,22 +109,18 @@ fn extract<S: Face>(
         return out;
     }
     let mut cands = piece_fits(points, local, &verts, angle);
-    let inliers = |fit: &Primitive| -> Vec<u32> {
-        verts
-            .iter()
-            .copied()
-            .filter(|&v| fit.distance(&points[v as usize]) <= tol)
-            .collect()
-    };
+    let inside = |c: &Primitive, v: u32| c.distance(&points[v as usize]) <= tol;
+    let inliers = |fit: &Primitive| -> Vec<u32> { filter_chunks(&verts, |v| inside(fit, v)) };
+    // Each candidate's count of uncovered vertices within `tol`, counted
+    // once and then lowered by the vertices each extraction covers: the
+    // counts a recount over the uncovered vertices would give, at the
+    // cost of one pass over the vertices per candidate in all.
+    let mut new_count: Vec<usize> = count_each(&cands, &verts, &inside);
     let mut covered = vec![false; verts.len()];
     loop {
+        // The first candidate with the most new inliers.
         let mut best: Option<(usize, usize)> = None; // (new inliers, candidate)
-        for (ci, c) in cands.iter().enumerate() {
-            let new = verts
-                .iter()
-                .zip(&covered)
-                .filter(|(&v, &cov)| !cov && c.distance(&points[v as usize]) <= tol)
-                .count();
+        for (ci, &new) in new_count.iter().enumerate() {
             if best.is_none_or(|b| new > b.0) {
                 best = Some((new, ci));
             }
@@ -133,6 +129,7 @@ fn extract<S: Face>(
         if new < min_vertices {
             break;
         }
+        new_count.swap_remove(ci);
         let mut fit = cands.swap_remove(ci);
         for _ in 0..2 {
             let refit = S::fit(points, &inliers(&fit));
@@ -142,19 +139,70 @@ fn extract<S: Face>(
             fit = refit;
         }
         let inl = inliers(&fit);
-        let mut gained = 0;
+        // `inl` is a sorted subset of the sorted `verts`: one walk.
+        let mut gained: Vec<u32> = Vec::new();
+        let mut next = inl.iter().peekable();
         for (k, &v) in verts.iter().enumerate() {
-            if !covered[k] && inl.binary_search(&v).is_ok() {
+            if next.next_if_eq(&&v).is_some() && !covered[k] {
                 covered[k] = true;
-                gained += 1;
+                gained.push(v);
             }
         }
+        for (count, lost) in new_count
+            .iter_mut()
+            .zip(count_each(&cands, &gained, &inside))
+        {
+            *count -= lost;
+        }
+        let gained = gained.len();
         if gained < min_vertices || inl.len() < min_vertices {
             break;
         }
         out.push((inl, fit));
     }
     out
+}
+
+/// Vertices from which one component's passes over its vertices are cut
+/// into chunks for the threads: 2^15. A scan's ground is one component of
+/// hundreds of thousands of vertices, extracted alone while the small
+/// components are done; below this a pass is a few microseconds' work.
+const CHUNKED_VERTICES: usize = 1 << 15;
+
+/// The vertices of the sorted `verts` for which `keep` holds, in order; in
+/// chunks on the pool's threads from [`CHUNKED_VERTICES`] vertices.
+fn filter_chunks(verts: &[u32], keep: impl Fn(u32) -> bool + Sync) -> Vec<u32> {
+    if verts.len() < CHUNKED_VERTICES {
+        return verts.iter().copied().filter(|&v| keep(v)).collect();
+    }
+    let chunk = CHUNKED_VERTICES / 4;
+    map_ranges(
+        verts.len().div_ceil(chunk),
+        || (),
+        |_, k| {
+            verts[k * chunk..((k + 1) * chunk).min(verts.len())]
+                .iter()
+                .copied()
+                .filter(|&v| keep(v))
+                .collect::<Vec<u32>>()
+        },
+    )
+    .concat()
+}
+
+/// For each candidate, how many of `verts` lie within its tolerance
+/// (`inside`); the candidates on the pool's threads when there are
+/// [`CHUNKED_VERTICES`] vertices or more.
+fn count_each(
+    cands: &[Primitive],
+    verts: &[u32],
+    inside: &(impl Fn(&Primitive, u32) -> bool + Sync),
+) -> Vec<usize> {
+    let count = |c: &Primitive| verts.iter().filter(|&&v| inside(c, v)).count();
+    if verts.len() < CHUNKED_VERTICES {
+        return cands.iter().map(count).collect();
+    }
+    map_ranges(cands.len(), || (), |_, ci| count(&cands[ci]))
 }
 
 /// The candidate primitives of a component with the vertices `verts`: the

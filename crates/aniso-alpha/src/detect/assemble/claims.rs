@@ -16,7 +16,7 @@
 
 use super::super::cloud::Cloud;
 use super::super::detection::Primitive;
-use super::footprint::{for_near, Stamps};
+use super::footprint::{for_near_in, Stamps};
 use super::same::absorbed;
 use super::{Candidate, Draft, Footprint, Shape};
 use crate::par::map_ranges;
@@ -40,6 +40,13 @@ use std::collections::HashSet;
 /// rule (docs/method.md §4).
 pub(crate) const NORMAL_AGREEMENT_COS: f64 = 0.8;
 
+/// Footprint blocks in one slice of a candidate's claims ([`Claims::of`]):
+/// 64. A plane's blocks are about two claim radii wide, so a slice covers
+/// a few hundred cells' worth of points: enough work to be worth a task,
+/// while a scan's ground (thousands of blocks) is cut into tens of
+/// slices for the threads.
+const CLAIM_BLOCKS: usize = 64;
+
 /// A claim: (point, candidate, distance to the candidate's primitive).
 type Claim = (u32, u32, f64);
 
@@ -49,35 +56,65 @@ pub(super) struct Claims(Vec<Claim>);
 
 impl Claims {
     /// The claims of `cands` on the points of `cloud`, gated by the given
-    /// `normals` (unit, zero where missing) for planes. Candidates in
-    /// parallel, each range of them with its own stamps.
+    /// `normals` (unit, zero where missing) for planes. In parallel over
+    /// slices of the candidates' footprint blocks ([`CLAIM_BLOCKS`] at
+    /// most a slice, so that one large candidate, a scan's ground, is
+    /// shared between threads), each range of slices with its own stamps;
+    /// a candidate's slices are joined and a point claimed by two of them
+    /// kept once. The claims do not depend on the slicing.
     pub(super) fn of(cands: &[Candidate], cloud: &Cloud<'_>, normals: Option<&[[f32; 3]]>) -> Self {
         let points = cloud.points();
-        let per_cand = map_ranges(
-            cands.len(),
+        let blocks: Vec<Vec<([f64; 3], f64)>> =
+            cands.iter().map(|c| c.foot.near_blocks(c.tau)).collect();
+        // (candidate, first block, end block) of each slice, in order.
+        let slices: Vec<(usize, usize, usize)> = blocks
+            .iter()
+            .enumerate()
+            .flat_map(|(ci, b)| {
+                (0..b.len().max(1))
+                    .step_by(CLAIM_BLOCKS)
+                    .map(move |s| (ci, s, (s + CLAIM_BLOCKS).min(b.len())))
+            })
+            .collect();
+        let per_slice = map_ranges(
+            slices.len(),
             || Stamps::new(points.len()),
-            |stamp, ci| {
+            |stamp, k| {
+                let (ci, from, to) = slices[k];
                 let c = &cands[ci];
                 let agrees = normal_agreement(&c.fit, normals);
                 let mut claims = Vec::new();
-                for_near(
+                for_near_in(
                     &c.fit,
                     &c.foot,
                     c.tau,
                     points,
                     cloud.index(),
                     stamp,
+                    &blocks[ci][from..to],
                     &mut |i, d| {
                         if agrees(i) {
                             claims.push((i, ci as u32, d));
                         }
                     },
                 );
-                // Held until every candidate is done: no growth slack.
-                claims.shrink_to_fit();
                 claims
             },
         );
+        drop(blocks);
+        let mut per_cand: Vec<Vec<Claim>> = vec![Vec::new(); cands.len()];
+        let mut sliced = vec![false; cands.len()];
+        for ((ci, from, _), claims) in slices.iter().zip(per_slice) {
+            sliced[*ci] |= *from > 0;
+            per_cand[*ci].extend(claims);
+        }
+        for (claims, _) in per_cand.iter_mut().zip(&sliced).filter(|(_, &s)| s) {
+            // A candidate claimed slice by slice: each point once.
+            claims.sort_unstable_by_key(|c| c.0);
+            claims.dedup_by_key(|c| c.0);
+        }
+        // Held until every candidate is done: no growth slack.
+        per_cand.iter_mut().for_each(Vec::shrink_to_fit);
         Claims(by_point_then_candidate(points.len(), per_cand))
     }
 
@@ -494,6 +531,63 @@ mod tests {
         assert_eq!(cands[0].tau, 0.1);
         assert_eq!(cands[1].tau, 1.0);
         assert!(tilted.iter().all(|v| cands[1].seeds.contains(v)));
+    }
+
+    #[test]
+    fn a_large_candidate_claimed_in_slices_claims_each_point_once() {
+        // A plane of 120 × 120 points, every third 0.3 off it (outside τ
+        // 0.1), and a second, small candidate on a corner of it: the large
+        // one's footprint has far more than CLAIM_BLOCKS blocks.
+        let pts: Vec<[f64; 3]> = (0..120)
+            .flat_map(|i| (0..120).map(move |j| (i, j)))
+            .map(|(i, j)| {
+                let z = if (i * 7 + j) % 3 == 0 {
+                    0.3
+                } else {
+                    0.01 * ((i + j) % 5) as f64
+                };
+                [i as f64, j as f64, z]
+            })
+            .collect();
+        let copies = Copies::none(pts.len());
+        let cloud = Cloud::new(&pts, &copies);
+        let cand = |seeds: Vec<u32>| {
+            let fit = Primitive::Plane(fit_plane_indices(&pts, &seeds).unwrap());
+            let foot = Footprint::new(&fit, &pts, &seeds, 1.0).unwrap();
+            Candidate {
+                fit,
+                tau: 0.1,
+                cell: 1.0,
+                seeds,
+                foot,
+            }
+        };
+        let on: Vec<u32> = (0..pts.len() as u32)
+            .filter(|&i| pts[i as usize][2] < 0.1)
+            .collect();
+        let corner: Vec<u32> = on
+            .iter()
+            .copied()
+            .filter(|&i| i < 10 * 120 && i % 120 < 10)
+            .collect();
+        let cands = vec![cand(on.clone()), cand(corner.clone())];
+        assert!(cands[0].foot.near_blocks(0.1).len() > 10 * CLAIM_BLOCKS);
+        let got = Claims::of(&cands, &cloud, None).0;
+        // Each point within τ of a candidate's plane and over its footprint,
+        // by point, then candidate.
+        let mut want: Vec<Claim> = Vec::new();
+        for i in 0..pts.len() as u32 {
+            for (ci, c) in cands.iter().enumerate() {
+                let d = c.fit.distance(&pts[i as usize]);
+                if d <= c.tau && c.foot.contains(&pts[i as usize]) {
+                    want.push((i, ci as u32, d));
+                }
+            }
+        }
+        assert_eq!(got.len(), want.len());
+        assert!(got == want);
+        assert_eq!(got.iter().filter(|c| c.1 == 0).count(), on.len());
+        assert!(got.iter().filter(|c| c.1 == 1).count() >= corner.len());
     }
 
     #[test]

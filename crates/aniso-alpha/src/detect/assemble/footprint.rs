@@ -204,13 +204,41 @@ pub(super) fn for_near(
     stamps: &mut Stamps,
     f: &mut dyn FnMut(u32, f64),
 ) {
+    let blocks = foot.near_blocks(radius);
+    for_near_in(fit, foot, radius, points, index, stamps, &blocks, f);
+}
+
+impl Footprint {
+    /// The balls [`for_near`] queries for `radius`: one per block of cells
+    /// about 2·radius wide (one cell while the radius is under half a
+    /// cell; with a radius many cells wide, a ball per cell would visit
+    /// each point once per cell within its reach), as the blocks' centres
+    /// and half-diagonals.
+    pub(super) fn near_blocks(&self, radius: f64) -> Vec<([f64; 3], f64)> {
+        let b = ((2.0 * radius / self.cell).ceil() as usize).max(1);
+        self.blocks(b).collect()
+    }
+}
+
+/// [`for_near`] over some of the footprint's [`Footprint::near_blocks`]:
+/// each point of those blocks' balls within `radius` and over the
+/// footprint, once. A point near two slices of the blocks is reported by
+/// both (the claims of a large candidate are gathered slice by slice, in
+/// parallel, and deduplicated).
+#[allow(clippy::too_many_arguments)]
+pub(super) fn for_near_in(
+    fit: &Primitive,
+    foot: &Footprint,
+    radius: f64,
+    points: &[[f64; 3]],
+    index: &KdTree,
+    stamps: &mut Stamps,
+    blocks: &[([f64; 3], f64)],
+    f: &mut dyn FnMut(u32, f64),
+) {
     let mark = stamps.next();
     let stamp = &mut stamps.v;
-    // One ball per block of cells about 2·radius wide (one cell while the
-    // radius is under half a cell): with a radius many cells wide, a ball
-    // per cell would visit each point once per cell within its reach.
-    let b = ((2.0 * radius / foot.cell).ceil() as usize).max(1);
-    for (centre, half) in foot.blocks(b) {
+    for &(centre, half) in blocks {
         let r = (half * half + radius * radius).sqrt();
         index.within(&centre, r, |i| {
             if stamp[i as usize] == mark {

@@ -312,8 +312,14 @@ fn raw_faces_at<S: Face>(
     let Some(side) = tile.filter(|&s| s.is_finite() && s > 0.0) else {
         let (map, q) = pruned(points, ids, a, radius, pruning);
         let n = map.len();
-        let mut faces = faces_at::<S>(q, &map, alphas, &|_| true)?;
-        faces.iter_mut().for_each(|f| f.sort_unstable());
+        let faces = match parallel_side(points, &map, job) {
+            Some(side) => faces_in_tiles::<S>(points, &map, &q, alphas, side, halo_width(job))?,
+            None => {
+                let mut faces = faces_at::<S>(q, &map, alphas, &|_| true)?;
+                faces.iter_mut().for_each(|f| f.sort_unstable());
+                faces
+            }
+        };
         return Ok((faces, n));
     };
     // Tiles: integer cells of side `side`; halo `h` around each.
@@ -359,6 +365,107 @@ fn raw_faces_at<S: Face>(
         f.dedup();
     }
     Ok((faces, triangulated))
+}
+
+/// Points per tile of a large job cut for the threads ([`parallel_side`]):
+/// 2^15, enough tiles for 16 threads on the ground of an airborne region
+/// (500,000 points), each still a triangulation of tens of milliseconds
+/// beside which a tile's own costs (its points from the kd-tree, its first
+/// tetrahedron) are small. On the AHN tiles the halo is about 1 m against
+/// tiles of 50–70 m: 3–4% of a tile's points are triangulated twice.
+#[cfg(not(test))]
+const PARALLEL_TILE_POINTS: usize = 1 << 15;
+/// A few hundred points in the tests, so that small clouds take the path.
+#[cfg(test)]
+const PARALLEL_TILE_POINTS: usize = 1 << 8;
+
+/// Threads from which a large job is cut into tiles run at once: 4. On
+/// two threads the scan's other jobs already share them, and cutting
+/// gained nothing (the 697k-point AHN tiling on 2 cores: scan stage 1.82 s
+/// cut, 1.80 s whole, medians of 3); on 16 threads it ran 3.4× faster
+/// than on one (BENCHMARKS.md, "Threads").
+const PARALLEL_TILE_THREADS: usize = 4;
+
+/// The tile side at which a large job's kept points `map` are cut so that
+/// its tiles run on the pool's threads at once, or `None` for one
+/// triangulation: with fewer than [`PARALLEL_TILE_THREADS`] threads, fewer
+/// than two tiles' worth of points, or where the halo (2α·λ_max) leaves
+/// tiles less than eight halos wide. The result does not depend on it
+/// (module doc: the tiles' union is the job's `F_{k,α,Q}` exactly), so the
+/// choice may follow the thread count; the points triangulated are counted
+/// once, as untiled.
+fn parallel_side(points: &[[f64; 3]], map: &[u32], job: &Job<'_>) -> Option<f64> {
+    let threads = crate::par::threads();
+    if threads < PARALLEL_TILE_THREADS || map.len() < 2 * PARALLEL_TILE_POINTS {
+        return None;
+    }
+    let tiles = (map.len() / PARALLEL_TILE_POINTS).min(4 * threads);
+    let (lo, hi) =
+        crate::geometry::bounding_box(&map.iter().map(|&i| points[i as usize]).collect::<Vec<_>>());
+    let mut ext = [0, 1, 2].map(|k| hi[k] - lo[k]);
+    ext.sort_unstable_by(f64::total_cmp);
+    // Cubes over the two largest extents: a surface's points (a scan's
+    // ground, a facade) spread over two of them.
+    let side = (ext[1] * ext[2] / tiles as f64).sqrt();
+    let h = halo_width(job);
+    (side.is_finite() && side >= 8.0 * h && ext[2] >= 2.0 * side).then_some(side)
+}
+
+/// `F_{k,α,Q}` at each α of `alphas` of the kept points `map` (transforms
+/// `q`, input indices ascending) cut into tiles of side `side` with halos
+/// `h`, the tiles triangulated at once on the pool's threads; each tile
+/// keeps the simplices whose smallest vertex it owns, so the union, sorted,
+/// is the untiled result (module doc).
+fn faces_in_tiles<S: Face>(
+    points: &[[f64; 3]],
+    map: &[u32],
+    q: &[[f64; 3]],
+    alphas: &[f64],
+    side: f64,
+    h: f64,
+) -> Result<Vec<Vec<S>>, ScanError> {
+    let cell = |p: &[f64; 3]| -> [i64; 3] { tile_cell(p, side) };
+    let mut tiles: Vec<[i64; 3]> = map.iter().map(|&i| cell(&points[i as usize])).collect();
+    tiles.sort_unstable();
+    tiles.dedup();
+    let index = crate::geometry::kdtree::KdTree::new(points, Some(map.to_vec()));
+    let per_tile = crate::par::map_ranges(
+        tiles.len(),
+        || (),
+        |_, k| {
+            let t = tiles[k];
+            let lo = t.map(|c| c as f64 * side);
+            let hi = t.map(|c| (c + 1) as f64 * side);
+            let centre = [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]));
+            let r = (3.0f64).sqrt() * (0.5 * side + h);
+            let mut sub: Vec<u32> = Vec::new();
+            index.within(&centre, r, |i| {
+                let p = &points[i as usize];
+                if (0..3).all(|k| p[k] >= lo[k] - h && p[k] <= hi[k] + h) {
+                    sub.push(i);
+                }
+            });
+            sub.sort_unstable();
+            // `map` is ascending: a kept point's transform is at its rank.
+            let sub_q: Vec<[f64; 3]> = sub
+                .iter()
+                .map(|i| q[map.binary_search(i).expect("a kept point")])
+                .collect();
+            let owned = |v: u32| cell(&points[v as usize]) == t;
+            faces_at::<S>(sub_q, &sub, alphas, &owned)
+        },
+    );
+    let mut faces: Vec<Vec<S>> = vec![Vec::new(); alphas.len()];
+    for tile in per_tile {
+        for (all, f) in faces.iter_mut().zip(tile?) {
+            all.extend(f);
+        }
+    }
+    for f in &mut faces {
+        f.sort_unstable();
+        f.dedup();
+    }
+    Ok(faces)
 }
 
 /// One job: raw faces, then the path filter.
@@ -414,4 +521,77 @@ pub(crate) fn union<S: Face>(per_job: Vec<(u32, Vec<S>)>) -> (Vec<S>, Vec<u32>) 
     all.sort_unstable();
     all.dedup_by(|b, a| a.0 == b.0);
     all.into_iter().unzip()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::SplitMix64;
+
+    /// A noisy ground with a roof step, 6,000 points over 100 × 60.
+    fn ground() -> Vec<[f64; 3]> {
+        let mut rng = SplitMix64::new(27);
+        (0..6000)
+            .map(|_| {
+                let x = 100.0 * rng.uniform();
+                let y = 60.0 * rng.uniform();
+                let z = if x > 40.0 && x < 55.0 { 6.0 } else { 0.0 } + 0.05 * rng.uniform();
+                [x, y, z]
+            })
+            .collect()
+    }
+
+    /// A large job cut into tiles for the threads gives the faces of one
+    /// triangulation, edges and triangles, at several α; and it was cut.
+    #[cfg(feature = "parallel")]
+    #[test]
+    fn a_job_cut_for_the_threads_has_the_untiled_faces() {
+        let pts = ground();
+        let anisotropy = Anisotropy::plane([0.0, 0.0, 1.0], [1.0, 0.0, 0.0], 2.0, 2.0).unwrap();
+        let job = Job {
+            anisotropy,
+            alpha: 0.5,
+            ids: None,
+            group: 0,
+        };
+        let alphas = [0.3, 0.4, 0.5];
+        let on = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                let (map, _) = pruned(
+                    &pts,
+                    &(0..6000).collect::<Vec<u32>>(),
+                    &job.anisotropy,
+                    prune_radius(&job),
+                    &Pruning::Grid,
+                );
+                let side = parallel_side(&pts, &map, &job);
+                let e =
+                    raw_faces_at::<[u32; 2]>(&pts, &job, &alphas, &Pruning::Grid, None).unwrap();
+                let t =
+                    raw_faces_at::<[u32; 3]>(&pts, &job, &alphas, &Pruning::Grid, None).unwrap();
+                (side, e, t)
+            })
+        };
+        let (side1, e1, t1) = on(1);
+        let (side4, e4, t4) = on(4);
+        assert_eq!(side1, None);
+        let side = side4.expect("cut into tiles on 4 threads");
+        assert!(side < 50.0, "{side}");
+        let sizes = |f: &[Vec<[u32; 2]>]| f.iter().map(Vec::len).collect::<Vec<_>>();
+        assert!(
+            e1 == e4,
+            "edges {:?} against {:?}",
+            sizes(&e1.0),
+            sizes(&e4.0)
+        );
+        assert!(t1.0 == t4.0, "triangles differ");
+        assert!(e1.0.iter().all(|f| !f.is_empty()) && t1.0[2].len() > 1000);
+        // The faces grow with α, and the tiles count each point once.
+        assert!(t1.0[0].len() < t1.0[2].len());
+        assert_eq!(t1.1, t4.1);
+    }
 }
