@@ -40,11 +40,12 @@ use std::collections::HashSet;
 /// rule (docs/method.md §4).
 pub(crate) const NORMAL_AGREEMENT_COS: f64 = 0.8;
 
-/// Footprint blocks in one slice of a candidate's claims ([`Claims::of`]):
-/// 64. A plane's blocks are about two claim radii wide, so a slice covers
-/// a few hundred cells' worth of points: enough work to be worth a task,
-/// while a scan's ground (thousands of blocks) is cut into tens of
-/// slices for the threads.
+/// The fewest footprint blocks in one slice of a candidate's claims
+/// ([`Claims::of`]): 64. A plane's blocks are about two claim radii wide,
+/// so a slice covers a few hundred cells' worth of points: enough work to
+/// be worth a task. Slices are longer where the candidates' blocks are
+/// many for the threads (about four slices a thread in all): a scan's
+/// ground (thousands of blocks) is cut into a few slices a thread.
 const CLAIM_BLOCKS: usize = 64;
 
 /// A claim: (point, candidate, distance to the candidate's primitive).
@@ -60,20 +61,25 @@ impl Claims {
     /// slices of the candidates' footprint blocks ([`CLAIM_BLOCKS`] at
     /// most a slice, so that one large candidate, a scan's ground, is
     /// shared between threads), each range of slices with its own stamps;
-    /// a candidate's slices are joined and a point claimed by two of them
-    /// kept once. The claims do not depend on the slicing.
+    /// a point claimed by two slices of one candidate is kept once. The
+    /// claims do not depend on the slicing.
     pub(super) fn of(cands: &[Candidate], cloud: &Cloud<'_>, normals: Option<&[[f32; 3]]>) -> Self {
         let points = cloud.points();
         let blocks: Vec<Vec<([f64; 3], f64)>> =
             cands.iter().map(|c| c.foot.near_blocks(c.tau)).collect();
-        // (candidate, first block, end block) of each slice, in order.
+        // (candidate, first block, end block) of each slice, in order. A
+        // slice's balls reach into the next slice's blocks, whose points
+        // both report: slices as long as the threads allow, so that few
+        // points are reported twice.
+        let total: usize = blocks.iter().map(Vec::len).sum();
+        let size = CLAIM_BLOCKS.max(total.div_ceil(4 * crate::par::threads()));
         let slices: Vec<(usize, usize, usize)> = blocks
             .iter()
             .enumerate()
             .flat_map(|(ci, b)| {
                 (0..b.len().max(1))
-                    .step_by(CLAIM_BLOCKS)
-                    .map(move |s| (ci, s, (s + CLAIM_BLOCKS).min(b.len())))
+                    .step_by(size)
+                    .map(move |s| (ci, s, (s + size).min(b.len())))
             })
             .collect();
         let per_slice = map_ranges(
@@ -98,24 +104,18 @@ impl Claims {
                         }
                     },
                 );
+                // Held until every slice is done: no growth slack.
+                claims.shrink_to_fit();
                 claims
             },
         );
         drop(blocks);
-        let mut per_cand: Vec<Vec<Claim>> = vec![Vec::new(); cands.len()];
-        let mut sliced = vec![false; cands.len()];
-        for ((ci, from, _), claims) in slices.iter().zip(per_slice) {
-            sliced[*ci] |= *from > 0;
-            per_cand[*ci].extend(claims);
-        }
-        for (claims, _) in per_cand.iter_mut().zip(&sliced).filter(|(_, &s)| s) {
-            // A candidate claimed slice by slice: each point once.
-            claims.sort_unstable_by_key(|c| c.0);
-            claims.dedup_by_key(|c| c.0);
-        }
-        // Held until every candidate is done: no growth slack.
-        per_cand.iter_mut().for_each(Vec::shrink_to_fit);
-        Claims(by_point_then_candidate(points.len(), per_cand))
+        // A slice's claims are ordered by candidate, so the counting sort
+        // puts a point claimed by two slices of one candidate twice in a
+        // row: kept once.
+        let mut claims = by_point_then_candidate(points.len(), per_slice);
+        claims.dedup_by_key(|c| (c.0, c.1));
+        Claims(claims)
     }
 
     /// Claims already sorted by point, then candidate.
@@ -195,10 +195,10 @@ impl Claims {
     }
 }
 
-/// The claims of each candidate in turn (`per_cand[c]`: candidate c's,
-/// each point at most once) on `n` points, ordered by point, then
-/// candidate: a counting sort by point, which keeps the candidates' order
-/// within each point.
+/// Lists of claims in candidate order (a candidate's, or one slice of a
+/// candidate's, each point at most once a list) on `n` points, ordered by
+/// point, then candidate: a counting sort by point, which keeps the lists'
+/// order within each point. Each list is freed once placed.
 fn by_point_then_candidate(n: usize, per_cand: Vec<Vec<Claim>>) -> Vec<Claim> {
     let mut start = vec![0usize; n + 1];
     for c in &per_cand {
