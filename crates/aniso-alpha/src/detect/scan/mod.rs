@@ -336,20 +336,7 @@ fn raw_faces_at<S: Face>(
     let mut faces: Vec<Vec<S>> = vec![Vec::new(); alphas.len()];
     let mut triangulated = 0usize;
     for t in tiles {
-        let lo = t.map(|c| c as f64 * side);
-        let hi = t.map(|c| (c + 1) as f64 * side);
-        // Points of the tile's cube grown by h: the kd-tree gives those
-        // within the circumscribed sphere; keep those in the grown box.
-        let centre = [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]));
-        let r = (3.0f64).sqrt() * (0.5 * side + h);
-        let mut sub: Vec<u32> = Vec::new();
-        index.within(&centre, r, |i| {
-            let p = &points[i as usize];
-            if (0..3).all(|k| p[k] >= lo[k] - h && p[k] <= hi[k] + h) {
-                sub.push(i);
-            }
-        });
-        sub.sort_unstable();
+        let sub = tile_points(points, &index, t, side, h);
         let (map, q) = pruned(points, &sub, a, radius, &Pruning::Grid);
         triangulated += map.len();
         let owned = |v: u32| cell(&points[v as usize]) == t;
@@ -434,18 +421,7 @@ fn faces_in_tiles<S: Face>(
         || (),
         |_, k| {
             let t = tiles[k];
-            let lo = t.map(|c| c as f64 * side);
-            let hi = t.map(|c| (c + 1) as f64 * side);
-            let centre = [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]));
-            let r = (3.0f64).sqrt() * (0.5 * side + h);
-            let mut sub: Vec<u32> = Vec::new();
-            index.within(&centre, r, |i| {
-                let p = &points[i as usize];
-                if (0..3).all(|k| p[k] >= lo[k] - h && p[k] <= hi[k] + h) {
-                    sub.push(i);
-                }
-            });
-            sub.sort_unstable();
+            let sub = tile_points(points, &index, t, side, h);
             // `map` is ascending: a kept point's transform is at its rank.
             let sub_q: Vec<[f64; 3]> = sub
                 .iter()
@@ -466,6 +442,31 @@ fn faces_in_tiles<S: Face>(
         f.dedup();
     }
     Ok(faces)
+}
+
+/// The points of `index` in tile `t`'s cube (side `side`) grown by `h`,
+/// ascending: the kd-tree gives those within the circumscribed sphere,
+/// and those in the grown box are kept.
+fn tile_points(
+    points: &[[f64; 3]],
+    index: &crate::geometry::kdtree::KdTree,
+    t: [i64; 3],
+    side: f64,
+    h: f64,
+) -> Vec<u32> {
+    let lo = t.map(|c| c as f64 * side);
+    let hi = t.map(|c| (c + 1) as f64 * side);
+    let centre = [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]));
+    let r = (3.0f64).sqrt() * (0.5 * side + h);
+    let mut sub: Vec<u32> = Vec::new();
+    index.within(&centre, r, |i| {
+        let p = &points[i as usize];
+        if (0..3).all(|k| p[k] >= lo[k] - h && p[k] <= hi[k] + h) {
+            sub.push(i);
+        }
+    });
+    sub.sort_unstable();
+    sub
 }
 
 /// One job: raw faces, then the path filter.
