@@ -58,9 +58,10 @@ pub(super) struct Claims(Vec<Claim>);
 impl Claims {
     /// The claims of `cands` on the points of `cloud`, gated by the given
     /// `normals` (unit, zero where missing) for planes. In parallel over
-    /// slices of the candidates' footprint blocks ([`CLAIM_BLOCKS`] at
-    /// most a slice, so that one large candidate, a scan's ground, is
-    /// shared between threads), each range of slices with its own stamps;
+    /// slices of the candidates' footprint blocks (at least
+    /// [`CLAIM_BLOCKS`] a slice, so that one large candidate, a scan's
+    /// ground, is shared between threads), each range of slices with its
+    /// own stamps;
     /// a point claimed by two slices of one candidate is kept once. The
     /// claims do not depend on the slicing.
     pub(super) fn of(cands: &[Candidate], cloud: &Cloud<'_>, normals: Option<&[[f32; 3]]>) -> Self {

@@ -21,7 +21,9 @@
 //! whose smallest input index lies in its cube: the union is exactly the
 //! job's `F_{k,α,Q}` (tested against the untiled result). Tiles bound the
 //! memory of one triangulation and are independent tasks (in parallel here,
-//! or spread over machines).
+//! or spread over machines). On 4 threads or more, a job of many points
+//! is cut into tiles for the threads alone ([`parallel_side`]): the same
+//! faces, its triangulations at once.
 //!
 //! The path filter is not local (a path can cross tiles): it runs on the
 //! job's gathered simplices. The union is a set, sorted; each simplex keeps
