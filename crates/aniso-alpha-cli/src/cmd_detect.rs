@@ -114,7 +114,7 @@ pub struct DetectArgs {
     /// margin for its ellipsoids' reach, parts joined across borders;
     /// memory bounded by one region's run. 'auto' (the default unless an
     /// output needs a whole run: --html, --png, --union, .obj): regions of
-    /// about 500,000 points, a whole run up to 1,000,000 points. 'off': one
+    /// about 250,000 points, a whole run up to 1,000,000 points. 'off': one
     /// whole run
     #[arg(long, value_name = "SIDE|auto|off", value_parser = crate::cmd_regions::parse_regions, requires = "input")]
     pub regions: Option<crate::cmd_regions::Regions>,

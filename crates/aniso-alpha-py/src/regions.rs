@@ -55,8 +55,8 @@ pub fn run_out(py: Python<'_>, run: RegionRun) -> RunOut<'_> {
 }
 
 /// The detection region by region (docs/method.md §8 "Regions"): regions of
-/// side `side` (input units), or of about 500,000 points when `side` is
-/// `None`; a cloud of about one region runs whole. `options`, `normals`,
+/// side `side` (input units), or of about 250,000 points when `side` is
+/// `None`; a cloud of at most 1,000,000 points runs whole. `options`, `normals`,
 /// `threads` and `progress` (called after each region; `False` cancels)
 /// as for `detect`. Returns the run ([`RunOut`]) and the region side
 /// (`None`: one whole run, the cloud being about one region).
@@ -132,8 +132,8 @@ pub struct PyRegionPlan {
     whole: bool,
 }
 
-/// The regions of `points` of side `side` (`None`: about 500,000 points a
-/// region; a cloud of about one region is one region).
+/// The regions of `points` of side `side` (`None`: about 250,000 points a
+/// region; a cloud of at most 1,000,000 points is one region).
 #[pyfunction]
 #[pyo3(signature = (points, side = None))]
 pub fn region_plan(points: &Bound<'_, PyAny>, side: Option<f64>) -> PyResult<PyRegionPlan> {

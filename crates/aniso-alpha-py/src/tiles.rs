@@ -22,8 +22,8 @@ use crate::run::detached;
 
 /// The side to run a cloud of `n` points with bounding box `lo`–`hi` and
 /// the side to report: `side` when given (checked by the grid), else
-/// about 500,000 points a region; a cloud of about one region runs as one
-/// region holding it all, reported as `None`.
+/// about 250,000 points a region; a cloud of at most 1,000,000 points runs
+/// as one region holding it all, reported as `None`.
 pub fn region_side_extent(
     lo: [f64; 3],
     hi: [f64; 3],

@@ -364,7 +364,7 @@ def detect_regions(
         points: as for :func:`detect`.
         structure: ``"lines"`` or ``"planes"``.
         side: the region side (input units); default: regions of about
-            500,000 points, and one whole run for a cloud of up to
+            250,000 points, and one whole run for a cloud of up to
             1,000,000 points (``--regions``).
         alpha, lambda2, lambda3, min_size, sampler, m1, m2, step, epsilon,
             normals, ignore_normals, threads: as for :func:`detect`, for

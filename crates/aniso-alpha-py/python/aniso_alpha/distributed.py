@@ -549,7 +549,7 @@ def detect_regions(
         source: as for :func:`detect`.
         structure: ``"lines"`` or ``"planes"``.
         side: the region side (input units); default: regions of about
-            500,000 points (one region for a cloud of up to 1,000,000).
+            250,000 points (one region for a cloud of up to 1,000,000).
         client: a ``dask.distributed.Client``; ``None`` starts a
             ``LocalCluster`` of ``n_workers`` processes, one thread each.
         n_workers: the workers of that LocalCluster (default: one per core).

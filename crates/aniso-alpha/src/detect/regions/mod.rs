@@ -70,11 +70,25 @@ pub const SAME_SHARE: f64 = 0.5;
 /// estimate on the wider margin may reach a little farther).
 pub const MARGIN_SLACK: f64 = 1.25;
 
-/// Points a region holds with [`side_for`]: a run of this size keeps its
-/// per-point time within 1.2× that of a 40k-point tile and its peak at a
-/// few hundred MiB (BENCHMARKS.md, growth over AHN tiles: 24.5 µs a point
-/// and 284 MiB at 697k points against 21.0 µs at 43k).
-pub const REGION_POINTS: usize = 500_000;
+/// Points a region holds with [`side_for`]: 250,000. A region's run keeps
+/// its per-point time near a single tile's and its peak at a few hundred
+/// MiB (BENCHMARKS.md, growth over AHN tiles: 24.5 µs a point and 284 MiB
+/// at 697k points against 21.0 µs at 43k), and a cloud of a few million
+/// points gives enough regions to run at once on many threads (a region
+/// is a task; its own stages are parallel only in part). Measured on the
+/// AHN **train** tile copied 8 × 8 (2.79M points, 2 cores) against
+/// 500,000: plane F1 0.900 against 0.903 (0.909 with the side rounded to
+/// a millimetre: region borders move the score by about 0.01), one thread
+/// 35.6 s against 38.4 s, peak RSS on two threads 352 MiB against 516 MiB;
+/// the held-out tile copied so: F1 0.860 against 0.851 (BENCHMARKS.md,
+/// "Region size").
+pub const REGION_POINTS: usize = 250_000;
+
+/// Points above which a cloud is detected region by region (the CLI's
+/// `--regions auto`): 1,000,000. A whole run of that size peaks at about
+/// 400 MiB (BENCHMARKS.md, "Growth over tiles": 285 MiB at 697k points);
+/// above it the whole run's memory grows with the cloud (3.5 GiB at 11M).
+pub const REGIONS_ABOVE: usize = 1_000_000;
 
 /// One joined part of a region run.
 #[derive(Debug, Clone, PartialEq)]
@@ -746,9 +760,11 @@ mod tests {
             .map(|i| [f64::from(i % 2000), f64::from(i / 2000), 0.0])
             .collect();
         let side = side_for(&pts).unwrap();
-        // 2000 x 1500 at one point per unit: 500k points in a square of
-        // side about 707.
-        assert!((side - 707.1).abs() < 1.0, "{side}");
+        // 2000 x 1500 at one point per unit: 250k points in a square of
+        // side 500.
+        assert!((side - 500.0).abs() < 1.0, "{side}");
+        // Regions only above REGIONS_ABOVE points.
         assert!(side_for(&pts[..1_000_000]).is_none());
+        assert!(side_for(&pts[..1_000_001]).is_some());
     }
 }

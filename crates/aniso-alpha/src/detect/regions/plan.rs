@@ -6,7 +6,7 @@
 //! and each region's points from the tiles with the same window test
 //! ([`RegionWindow::contains`]).
 
-use super::REGION_POINTS;
+use super::{REGIONS_ABOVE, REGION_POINTS};
 use crate::detect::DetectError;
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -15,10 +15,10 @@ use std::collections::{BTreeMap, BTreeSet};
 pub const FIRST_MARGIN: f64 = 1.0 / 16.0;
 
 /// The side of square regions holding about [`REGION_POINTS`] points each
-/// at the cloud's mean density over its x–y extent; `None` when the whole
-/// cloud is about one region (or flat in x or y).
+/// at the cloud's mean density over its x–y extent; `None` for a cloud of
+/// at most [`REGIONS_ABOVE`] points (one whole run), or flat in x or y.
 pub fn side_for(points: &[[f64; 3]]) -> Option<f64> {
-    if points.len() <= 2 * REGION_POINTS {
+    if points.len() <= REGIONS_ABOVE {
         return None;
     }
     let (lo, hi) = crate::geometry::bounding_box(points);
@@ -27,7 +27,7 @@ pub fn side_for(points: &[[f64; 3]]) -> Option<f64> {
 
 /// [`side_for`] of a cloud of `n` points with bounding box `lo`–`hi`.
 pub fn side_for_extent(lo: [f64; 3], hi: [f64; 3], n: usize) -> Option<f64> {
-    if n <= 2 * REGION_POINTS {
+    if n <= REGIONS_ABOVE {
         return None;
     }
     let (w, h) = (hi[0] - lo[0], hi[1] - lo[1]);

@@ -358,7 +358,7 @@ fn raw_faces_at<S: Face>(
 
 /// Points per tile of a large job cut for the threads ([`parallel_side`]):
 /// 2^15, enough tiles for 16 threads on the ground of an airborne region
-/// (500,000 points), each still a triangulation of tens of milliseconds
+/// of 500,000 points, each still a triangulation of tens of milliseconds
 /// beside which a tile's own costs (its points from the kd-tree, its first
 /// tetrahedron) are small. On the AHN tiles the halo is about 1 m against
 /// tiles of 50–70 m: 3–4% of a tile's points are triangulated twice.
