@@ -37,3 +37,18 @@ pub fn bounding_box(points: &[Point3]) -> (Point3, Point3) {
     }
     (lo, hi)
 }
+
+/// [`bounding_box`] of the points `ids` of `points`, without gathering
+/// them.
+pub(crate) fn bounding_box_of(points: &[Point3], ids: &[u32]) -> (Point3, Point3) {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for &i in ids {
+        let p = points[i as usize];
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    (lo, hi)
+}

@@ -35,7 +35,7 @@ use super::super::detection::Primitive;
 use super::super::fit::{symmetric_eigen, PlaneFit};
 use super::same::SAME_SHARE;
 use super::{Candidate, Draft, Shape};
-use crate::geometry::{cross, dot, sub};
+use crate::geometry::{bounding_box_of, cross, dot, sub};
 use crate::unionfind::UnionFind;
 
 /// The most points of the larger group that the joint plane's test reads
@@ -67,19 +67,6 @@ pub(super) fn planes_apart<S: Shape>(
 
 /// A bounding box.
 type Box3 = ([f64; 3], [f64; 3]);
-
-/// The bounding box of `members`.
-fn bounding_box(members: &[u32], points: &[[f64; 3]]) -> Box3 {
-    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for &v in members {
-        let q = points[v as usize];
-        for k in 0..3 {
-            lo[k] = lo[k].min(q[k]);
-            hi[k] = hi[k].max(q[k]);
-        }
-    }
-    (lo, hi)
-}
 
 /// The distance between two boxes (0 when they meet).
 fn gap(a: &Box3, b: &Box3) -> f64 {
@@ -130,7 +117,7 @@ fn pairs(
 ) -> Vec<(usize, usize)> {
     let boxes: Vec<Box3> = parts
         .iter()
-        .map(|p| bounding_box(&p.members, points))
+        .map(|p| bounding_box_of(points, &p.members))
         .collect();
     let sizes: Vec<f64> = parts.iter().map(|p| size(&p.fit)).collect();
     let tau = |a: usize| cands[parts[a].cand].tau;

@@ -389,8 +389,7 @@ fn parallel_side(points: &[[f64; 3]], map: &[u32], job: &Job<'_>) -> Option<f64>
         return None;
     }
     let tiles = (map.len() / PARALLEL_TILE_POINTS).min(4 * threads);
-    let (lo, hi) =
-        crate::geometry::bounding_box(&map.iter().map(|&i| points[i as usize]).collect::<Vec<_>>());
+    let (lo, hi) = crate::geometry::bounding_box_of(points, map);
     let mut ext = [0, 1, 2].map(|k| hi[k] - lo[k]);
     ext.sort_unstable_by(f64::total_cmp);
     // Cubes over the two largest extents: a surface's points (a scan's
