@@ -5,6 +5,7 @@ range, outliers), with per-point ground truth.
 
     python3 scripts/simulate_scan.py room   --seed 1 --output room.xyz
     python3 scripts/simulate_scan.py house  --seed 1 --output house.xyz
+    python3 scripts/simulate_scan.py halls  --seed 1 --output halls.xyz
     python3 scripts/simulate_scan.py street --seed 1 --output street.xyz
 
 Writes `x y z label` per line (label -1 = clutter/outlier, otherwise the
@@ -27,6 +28,15 @@ Scenes (dimensions in metres):
           lines 0.8-1.4 m apart with 0.3-0.5 m between points along a
           line (the anisotropic pattern of airborne tiles); range noise
           3 cm.
+  halls   a 120 x 120 m industrial block seen from the air, as
+          `airborne` but denser (scan lines 0.4-0.6 m apart, 0.2-0.3 m
+          along a line): four halls 30-50 m a side at random azimuths
+          with shallow roofs of two faces each (a gable, a butterfly roof
+          whose faces fall to a valley, an asymmetric gable with faces of
+          different widths and pitches, a two-bay sawtooth), every face
+          pitched 3-12 degrees, so that the faces of one roof are within
+          a few degrees of each other and of the ground; each roof face
+          and wall a plane; trees as clutter; range noise 3 cm.
   street  a street with 5 poles (cylinders, radius 8-15 cm, 6-8 m tall,
           each with a crossbar), cables sagging between their tops, a
           facade and the ground, scanned from two stations; labels are the
@@ -289,6 +299,72 @@ def airborne(rng, strips=1):
     return np.vstack([pts[keep], trees]), np.concatenate([labels[keep], -np.ones(len(trees), np.int64)])
 
 
+def _hall(s, rng, c, th, lx, ly, h, kind, lab):
+    """A hall lx x ly at c, turned by th, eaves at h, with a shallow roof
+    of `kind` (faces across the local y axis); returns the next label."""
+    R = np.array([[np.cos(th), -np.sin(th)], [np.sin(th), np.cos(th)]])
+    pitch = lambda: np.tan(np.radians(rng.uniform(3.0, 12.0)))
+    lab = _rotated_box_walls(s, c, R, lx, ly, h, lab)
+    at = lambda x, y, z: np.r_[c + R @ [x, y], z]
+    along = np.r_[R @ [lx, 0], 0]
+    if kind == "gable" or kind == "asymmetric":
+        # The ridge at y = split, faces falling to the eaves on both sides.
+        # (The far eave lies where the second pitch takes it.)
+        split = ly * (0.5 if kind == "gable" else rng.uniform(0.25, 0.4))
+        t1, t2 = pitch(), pitch()
+        top = h + split * t1
+        fall = (ly - split) * t2
+        s.quad(at(-lx / 2, -ly / 2, h), along, np.r_[R @ [0, split], top - h], lab); lab += 1
+        s.quad(at(-lx / 2, -ly / 2 + split, top), along, np.r_[R @ [0, ly - split], -fall], lab); lab += 1
+    elif kind == "butterfly":
+        # Two faces falling from the eaves to a valley at mid-width.
+        t = pitch()
+        drop = ly / 2 * t
+        s.quad(at(-lx / 2, -ly / 2, h + drop), along, np.r_[R @ [0, ly / 2], -drop], lab); lab += 1
+        s.quad(at(-lx / 2, 0.0, h), along, np.r_[R @ [0, ly / 2], drop], lab); lab += 1
+    else:
+        # Sawtooth: two bays, each a shallow face rising to a vertical step.
+        t = pitch()
+        for k in range(2):
+            y = -ly / 2 + k * ly / 2
+            rise = ly / 2 * t
+            s.quad(at(-lx / 2, y, h), along, np.r_[R @ [0, ly / 2], rise], lab); lab += 1
+            s.quad(at(-lx / 2, y + ly / 2, h), along, [0, 0, rise], lab); lab += 1
+    return lab
+
+
+def halls(rng, strips=1):
+    s = Scene()
+    lab = 0
+    size = 120.0
+    s.quad([-10, -10, 0], [size + 20, 0, 0], [0, size + 20, 0], lab); lab += 1   # ground
+    sites = [[32, 32], [88, 32], [32, 88], [88, 88]]
+    kinds = list(rng.permutation(["gable", "butterfly", "asymmetric", "sawtooth"]))
+    for site, kind in zip(sites, kinds):
+        lx, ly, h = rng.uniform(30, 45), rng.uniform(25, 40), rng.uniform(6, 12)
+        c = np.asarray(site, float) + rng.uniform(-3, 3, 2)
+        lab = _hall(s, rng, c, rng.uniform(0, np.pi), lx, ly, h, kind, lab)
+    along = rng.uniform(0.4, 0.6)
+    across = rng.uniform(0.2, 0.3)
+    import open3d as o3d
+
+    v, t, labs = s.arrays()
+    rs = o3d.t.geometry.RaycastingScene()
+    rs.add_triangles(o3d.core.Tensor(v.astype(np.float32)), o3d.core.Tensor(t.astype(np.uint32)))
+    parts = [_strip(rng, rs, labs, size, along, across, 0.0, 1.0)]
+    for _ in range(1, strips):
+        parts.append(_strip(rng, rs, labs, size, along, across, rng.uniform(0, along), -1.0))
+    pts = np.vstack([p for p, _ in parts])
+    labels = np.concatenate([l for _, l in parts])
+    trees = []
+    for cx, cy in rng.uniform(5, size - 5, (6, 2)):
+        k = int(rng.integers(300, 800))
+        trees.append(np.array([cx, cy, rng.uniform(5, 9)]) + rng.normal(0, 1.0, (k, 3)) * [2.0, 2.0, 1.5])
+    trees = np.vstack(trees)
+    keep = np.all((pts[:, :2] >= 0) & (pts[:, :2] <= size), axis=1)
+    return np.vstack([pts[keep], trees]), np.concatenate([labels[keep], -np.ones(len(trees), np.int64)])
+
+
 def street(rng):
     s = Scene()
     lab = 0
@@ -319,13 +395,14 @@ def street(rng):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("scene", choices=["room", "house", "airborne", "street"])
+    ap.add_argument("scene", choices=["room", "house", "airborne", "halls", "street"])
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--output", required=True)
     ap.add_argument("--strips", type=int, default=1, help="airborne: overlapping flight strips (default 1)")
     a = ap.parse_args()
     rng = np.random.default_rng(a.seed)
-    scenes = {"room": room, "house": house, "airborne": lambda r: airborne(r, a.strips), "street": street}
+    scenes = {"room": room, "house": house, "airborne": lambda r: airborne(r, a.strips),
+              "halls": lambda r: halls(r, a.strips), "street": street}
     pts, labels = scenes[a.scene](rng)
     # Shuffle (scanner order would make every neighbour query trivial).
     perm = rng.permutation(len(pts))

@@ -6,7 +6,10 @@
 //! footprint claims it; with normals given, a point claims a plane only if
 //! its normal agrees with the plane's ([`NORMAL_AGREEMENT_COS`]).
 //! Candidates that are one primitive ([`Shape::same`]) and share claimed
-//! points merge, until none do; then each point goes to the candidate it
+//! points merge, until none do; two groups merged so far are tested by
+//! their largest candidates, so that a small piece lying where two planes
+//! meet (a shallow roof's ridge, within the part angle of both faces)
+//! joins one of them and does not chain the two into one; then each point goes to the candidate it
 //! is nearest to (parts are disjoint), the candidates are refitted on
 //! their members, and claim again. A merged candidate claims with the
 //! widest radius of its pieces, except the radius of a piece it absorbed
@@ -272,7 +275,11 @@ struct Groups {
 
 /// The groups of candidates that are one primitive and share claimed
 /// points, or `None` when no two are. An absorbed candidate ([`absorbed`])
-/// joins the one that absorbs it and no other.
+/// joins the one that absorbs it and no other. Two candidates already in
+/// groups are tested by their groups' largest candidates (most seeds, the
+/// smaller index on a tie): the pairwise test alone chains two faces of a
+/// shallow roof, 14° apart, through a four-point piece on their ridge
+/// whose plane is within the part angle of both.
 fn duplicates<S: Shape>(
     cands: &[Candidate],
     claims: &Claims,
@@ -281,17 +288,39 @@ fn duplicates<S: Shape>(
 ) -> Option<Groups> {
     let mut uf = UnionFind::new(cands.len());
     let mut was_absorbed = vec![false; cands.len()];
+    // At each group's root: its largest candidate.
+    let mut largest: Vec<u32> = (0..cands.len() as u32).collect();
     let mut merged = false;
     for (a, b) in claims.shared(Some) {
-        if was_absorbed[a as usize] || was_absorbed[b as usize] || uf.find(a) == uf.find(b) {
+        let (ra, rb) = (uf.find(a), uf.find(b));
+        if was_absorbed[a as usize] || was_absorbed[b as usize] || ra == rb {
             continue;
         }
+        let (la, lb) = (largest[ra as usize], largest[rb as usize]);
         let (pa, pb) = (cands[a as usize].piece(), cands[b as usize].piece());
-        if S::same(pa, pb, angle_deg, points) {
+        let same = if (la, lb) == (a, b) {
+            S::same(pa, pb, angle_deg, points)
+        } else {
+            S::same(pa, pb, angle_deg, points)
+                && S::same(
+                    cands[la as usize].piece(),
+                    cands[lb as usize].piece(),
+                    angle_deg,
+                    points,
+                )
+        };
+        if same {
             if let Some(a_is) = absorbed(pa, pb, points) {
                 was_absorbed[if a_is { a } else { b } as usize] = true;
             }
             uf.union_min_root(a, b);
+            let seeds = |c: u32| cands[c as usize].seeds.len();
+            let keep = if (seeds(lb), lb) > (seeds(la), la) {
+                lb
+            } else {
+                la
+            };
+            largest[uf.find(a) as usize] = keep;
             merged = true;
         }
     }
@@ -393,6 +422,7 @@ pub(super) fn parts<S: Shape>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::detect::assemble::same::same_primitive;
     use crate::detect::cloud::Copies;
     use crate::detect::fit::{fit_line_indices, fit_plane_indices};
 
@@ -485,6 +515,70 @@ mod tests {
         assert_eq!(found[1].members, (21..28).collect::<Vec<u32>>());
         // Too few members: no part.
         assert_eq!(parts::<[u32; 2]>(&claims, cands.len(), &pts, 8).len(), 1);
+    }
+
+    #[test]
+    fn a_piece_on_a_ridge_does_not_chain_the_two_faces() {
+        // A shallow gable: face A (x in 0..=20) and face B (x in -12..=0)
+        // falling 7° from the ridge x = 0 (14° apart, τ 0.1), and a
+        // four-point piece lying flat across the ridge at x = ±0.25: its
+        // plane is 7° from each face and its points within τ of both, so
+        // that it is one primitive with each face; the faces are not one.
+        let t = 7f64.to_radians().tan();
+        let mut pts: Vec<[f64; 3]> = Vec::new();
+        let mut face = |xs: std::ops::RangeInclusive<i32>| -> Vec<u32> {
+            xs.flat_map(|i| (0..=10).map(move |j| (i, j)))
+                .map(|(i, j)| {
+                    pts.push([f64::from(i), f64::from(j), -f64::from(i).abs() * t]);
+                    (pts.len() - 1) as u32
+                })
+                .collect()
+        };
+        let a = face(0..=20);
+        let b = face(-12..=0);
+        let ridge: Vec<u32> = [(-0.25, 4.0), (0.25, 4.0), (-0.25, 5.0), (0.25, 5.0)]
+            .iter()
+            .map(|&(x, y)| {
+                pts.push([x, y, -0.25 * t]);
+                (pts.len() - 1) as u32
+            })
+            .collect();
+        let copies = Copies::none(pts.len());
+        let cloud = Cloud::new(&pts, &copies);
+        let cand = |seeds: Vec<u32>| {
+            let fit = Primitive::Plane(fit_plane_indices(&pts, &seeds).unwrap());
+            let foot = Footprint::new(&fit, &pts, &seeds, 2.0).unwrap();
+            Candidate {
+                fit,
+                tau: 0.1,
+                cell: 2.0,
+                seeds,
+                foot,
+            }
+        };
+        let (pa, pb, pr) = (cand(a.clone()), cand(b.clone()), cand(ridge.clone()));
+        // The pairwise tests that would chain them.
+        assert!(same_primitive(pa.piece(), pr.piece(), 10.0, &pts));
+        assert!(same_primitive(pb.piece(), pr.piece(), 10.0, &pts));
+        assert!(!same_primitive(pa.piece(), pb.piece(), 10.0, &pts));
+        let (cands, _) = settle::<[u32; 3]>(vec![pa, pb, pr], &cloud, None, 10.0);
+        assert_eq!(cands.len(), 2);
+        let normals: Vec<[f64; 3]> = cands
+            .iter()
+            .map(|c| match &c.fit {
+                Primitive::Plane(f) => f.normal,
+                _ => unreachable!(),
+            })
+            .collect();
+        let cos = normals[0]
+            .iter()
+            .zip(&normals[1])
+            .map(|(x, y)| x * y)
+            .sum::<f64>();
+        assert!(cos.abs() < 14f64.to_radians().cos() + 1e-3, "{normals:?}");
+        // Each face's points stay with the candidate of that face.
+        assert!(a.iter().all(|v| cands[0].seeds.contains(v)));
+        assert!(b.iter().all(|v| cands[1].seeds.contains(v)));
     }
 
     #[test]
