@@ -6,7 +6,9 @@
 //! footprint claims it; with normals given, a point claims a plane only if
 //! its normal agrees with the plane's ([`NORMAL_AGREEMENT_COS`]).
 //! Candidates that are one primitive ([`Shape::same`]) and share claimed
-//! points merge, until none do; two groups merged so far are tested by
+//! points merge, until none do (these rounds ask only which candidates
+//! claim each point: [`Sharing`], without the distances); two groups
+//! merged so far are tested by
 //! their largest candidates, so that a small piece lying where two planes
 //! meet (a shallow roof's ridge, within the part angle of both faces)
 //! joins one of them and does not chain the two into one; then each point goes to the candidate it
@@ -60,64 +62,18 @@ pub(super) struct Claims(Vec<Claim>);
 
 impl Claims {
     /// The claims of `cands` on the points of `cloud`, gated by the given
-    /// `normals` (unit, zero where missing) for planes. In parallel over
-    /// slices of the candidates' footprint blocks (at least
-    /// [`CLAIM_BLOCKS`] a slice, so that one large candidate, a scan's
-    /// ground, is shared between threads), each range of slices with its
-    /// own stamps;
+    /// `normals` (unit, zero where missing) for planes ([`claim_slices`]);
     /// a point claimed by two slices of one candidate is kept once. The
     /// claims do not depend on the slicing.
     pub(super) fn of(cands: &[Candidate], cloud: &Cloud<'_>, normals: Option<&[[f32; 3]]>) -> Self {
-        let points = cloud.points();
-        let blocks: Vec<Vec<([f64; 3], f64)>> =
-            cands.iter().map(|c| c.foot.near_blocks(c.tau)).collect();
-        // (candidate, first block, end block) of each slice, in order. A
-        // slice's balls reach into the next slice's blocks, whose points
-        // both report: slices as long as the threads allow, so that few
-        // points are reported twice.
-        let total: usize = blocks.iter().map(Vec::len).sum();
-        let size = CLAIM_BLOCKS.max(total.div_ceil(4 * crate::par::threads()));
-        let slices: Vec<(usize, usize, usize)> = blocks
-            .iter()
-            .enumerate()
-            .flat_map(|(ci, b)| {
-                (0..b.len().max(1))
-                    .step_by(size)
-                    .map(move |s| (ci, s, (s + size).min(b.len())))
-            })
+        let per_slice: Vec<Vec<Claim>> = claim_slices(cands, cloud, normals, |i, c, d| (i, c, d))
+            .into_iter()
+            .map(|(_, v)| v)
             .collect();
-        let per_slice = map_ranges(
-            slices.len(),
-            || Stamps::new(points.len()),
-            |stamp, k| {
-                let (ci, from, to) = slices[k];
-                let c = &cands[ci];
-                let agrees = normal_agreement(&c.fit, normals);
-                let mut claims = Vec::new();
-                for_near_in(
-                    &c.fit,
-                    &c.foot,
-                    c.tau,
-                    points,
-                    cloud.index(),
-                    stamp,
-                    &blocks[ci][from..to],
-                    &mut |i, d| {
-                        if agrees(i) {
-                            claims.push((i, ci as u32, d));
-                        }
-                    },
-                );
-                // Held until every slice is done: no growth slack.
-                claims.shrink_to_fit();
-                claims
-            },
-        );
-        drop(blocks);
         // A slice's claims are ordered by candidate, so the counting sort
         // puts a point claimed by two slices of one candidate twice in a
         // row: kept once.
-        let mut claims = by_point_then_candidate(points.len(), per_slice);
+        let mut claims = by_point_then_candidate(cloud.points().len(), per_slice, |c| c.0);
         claims.dedup_by_key(|c| (c.0, c.1));
         Claims(claims)
     }
@@ -146,42 +102,10 @@ impl Claims {
     }
 
     /// The distinct pairs (a < b) of what `of` maps two candidates claimed
-    /// by one point to, sorted; `None` and equal images are left out.
-    /// Every point of a large plane repeats the same few candidates (11
-    /// claims a point on a depth frame, before the merge), so each distinct
-    /// set of images gives its pairs once, and the list is deduplicated
-    /// whenever it has doubled: its memory follows the distinct pairs, not
-    /// the claims.
+    /// by one point to, sorted; `None` and equal images are left out
+    /// ([`shared_pairs`]).
     pub(super) fn shared(&self, of: impl Fn(u32) -> Option<u32>) -> Vec<(u32, u32)> {
-        const FIRST_DEDUP: usize = 1 << 12;
-        let mut pairs: Vec<(u32, u32)> = Vec::new();
-        let mut dedup_at = FIRST_DEDUP;
-        let mut seen: HashSet<Box<[u32]>> = HashSet::new();
-        let mut set: Vec<u32> = Vec::new();
-        for here in self.by_point() {
-            if here.len() < 2 {
-                continue;
-            }
-            set.clear();
-            set.extend(here.iter().filter_map(|c| of(c.1)));
-            set.sort_unstable();
-            set.dedup();
-            if set.len() < 2 || seen.contains(set.as_slice()) {
-                continue;
-            }
-            seen.insert(set.as_slice().into());
-            for (k, &x) in set.iter().enumerate() {
-                pairs.extend(set[k + 1..].iter().map(|&y| (x, y)));
-            }
-            if pairs.len() >= dedup_at {
-                pairs.sort_unstable();
-                pairs.dedup();
-                dedup_at = (2 * pairs.len()).max(FIRST_DEDUP);
-            }
-        }
-        pairs.sort_unstable();
-        pairs.dedup();
-        pairs
+        shared_pairs(self.by_point().map(|h| h.iter().map(|c| c.1)), of)
     }
 
     /// The members of each of `n` candidates: every claimed point goes to
@@ -199,29 +123,189 @@ impl Claims {
     }
 }
 
+/// Which candidates claim each point, without the distances: what the
+/// merging rounds of [`settle`] ask (which candidates share a point), in
+/// half the memory of [`Claims`] (8 bytes a claim, and 4 while the slices
+/// are sorted). Sorted by point, then candidate.
+struct Sharing(Vec<(u32, u32)>);
+
+impl Sharing {
+    /// The (point, candidate) pairs of [`Claims::of`].
+    fn of(cands: &[Candidate], cloud: &Cloud<'_>, normals: Option<&[[f32; 3]]>) -> Self {
+        let per_slice = claim_slices(cands, cloud, normals, |i, _, _| i);
+        let mut pairs = sort_sharing(cloud.points().len(), per_slice);
+        pairs.dedup();
+        Sharing(pairs)
+    }
+
+    /// [`Claims::shared`] of the same candidates.
+    fn shared(&self, of: impl Fn(u32) -> Option<u32>) -> Vec<(u32, u32)> {
+        shared_pairs(
+            self.0
+                .chunk_by(|a, b| a.0 == b.0)
+                .map(|h| h.iter().map(|c| c.1)),
+            of,
+        )
+    }
+}
+
+/// The (candidate, first block, end block) of each slice of the
+/// candidates' footprint blocks, in order: at least [`CLAIM_BLOCKS`] blocks
+/// a slice, longer where the blocks are many for the threads (about four
+/// slices a thread in all).
+fn slices_of(blocks: &[Vec<([f64; 3], f64)>]) -> Vec<(usize, usize, usize)> {
+    let total: usize = blocks.iter().map(Vec::len).sum();
+    let size = CLAIM_BLOCKS.max(total.div_ceil(4 * crate::par::threads()));
+    blocks
+        .iter()
+        .enumerate()
+        .flat_map(|(ci, b)| {
+            (0..b.len().max(1))
+                .step_by(size)
+                .map(move |s| (ci, s, (s + size).min(b.len())))
+        })
+        .collect()
+}
+
+/// The claims of `cands` slice by slice ([`slices_of`] of their footprint
+/// blocks), each claim made by `make(point, candidate, distance)`, with
+/// the candidate of each slice: in parallel over the slices (so
+/// that one large candidate, a scan's ground, is shared between threads),
+/// each range of slices with its own stamps. A slice's balls reach into
+/// the next slice's blocks, whose points both report: slices are as long
+/// as the threads allow, so that few points are reported twice.
+fn claim_slices<T: Send>(
+    cands: &[Candidate],
+    cloud: &Cloud<'_>,
+    normals: Option<&[[f32; 3]]>,
+    make: impl Fn(u32, u32, f64) -> T + Sync,
+) -> Vec<(u32, Vec<T>)> {
+    let points = cloud.points();
+    let blocks: Vec<Vec<([f64; 3], f64)>> =
+        cands.iter().map(|c| c.foot.near_blocks(c.tau)).collect();
+    let slices = slices_of(&blocks);
+    map_ranges(
+        slices.len(),
+        || Stamps::new(points.len()),
+        |stamp, k| {
+            let (ci, from, to) = slices[k];
+            let c = &cands[ci];
+            let agrees = normal_agreement(&c.fit, normals);
+            let mut claims = Vec::new();
+            for_near_in(
+                &c.fit,
+                &c.foot,
+                c.tau,
+                points,
+                cloud.index(),
+                stamp,
+                &blocks[ci][from..to],
+                &mut |i, d| {
+                    if agrees(i) {
+                        claims.push(make(i, ci as u32, d));
+                    }
+                },
+            );
+            // Held until every slice is done: no growth slack.
+            claims.shrink_to_fit();
+            (ci as u32, claims)
+        },
+    )
+}
+
+/// The distinct pairs (a < b) of what `of` maps two candidates of one
+/// point's set (`sets`: the candidates claiming each point, point after
+/// point) to, sorted; `None` and equal images are left out. Every point
+/// of a large plane repeats the same few candidates (11 claims a point on
+/// a depth frame, before the merge), so each distinct set of images gives
+/// its pairs once, and the list is deduplicated whenever it has doubled:
+/// its memory follows the distinct pairs, not the claims.
+fn shared_pairs<I: Iterator<Item = u32>>(
+    sets: impl Iterator<Item = I>,
+    of: impl Fn(u32) -> Option<u32>,
+) -> Vec<(u32, u32)> {
+    const FIRST_DEDUP: usize = 1 << 12;
+    let mut pairs: Vec<(u32, u32)> = Vec::new();
+    let mut dedup_at = FIRST_DEDUP;
+    let mut seen: HashSet<Box<[u32]>> = HashSet::new();
+    let mut set: Vec<u32> = Vec::new();
+    for here in sets {
+        set.clear();
+        set.extend(here.filter_map(&of));
+        if set.len() < 2 {
+            continue;
+        }
+        set.sort_unstable();
+        set.dedup();
+        if set.len() < 2 || seen.contains(set.as_slice()) {
+            continue;
+        }
+        seen.insert(set.as_slice().into());
+        for (k, &x) in set.iter().enumerate() {
+            pairs.extend(set[k + 1..].iter().map(|&y| (x, y)));
+        }
+        if pairs.len() >= dedup_at {
+            pairs.sort_unstable();
+            pairs.dedup();
+            dedup_at = (2 * pairs.len()).max(FIRST_DEDUP);
+        }
+    }
+    pairs.sort_unstable();
+    pairs.dedup();
+    pairs
+}
+
 /// Lists of claims in candidate order (a candidate's, or one slice of a
 /// candidate's, each point at most once a list) on `n` points, ordered by
-/// point, then candidate: a counting sort by point, which keeps the lists'
-/// order within each point. Each list is freed once placed.
-fn by_point_then_candidate(n: usize, per_cand: Vec<Vec<Claim>>) -> Vec<Claim> {
+/// point (`point_of`), then candidate: a counting sort by point, which
+/// keeps the lists' order within each point. Each list is freed once
+/// placed.
+fn by_point_then_candidate<T: Copy + Default>(
+    n: usize,
+    per_cand: Vec<Vec<T>>,
+    point_of: impl Fn(&T) -> u32,
+) -> Vec<T> {
     let mut start = vec![0usize; n + 1];
     for c in &per_cand {
-        for &(p, _, _) in c {
+        for x in c {
+            start[point_of(x) as usize + 1] += 1;
+        }
+    }
+    for i in 0..n {
+        start[i + 1] += start[i];
+    }
+    let mut sorted: Vec<T> = vec![T::default(); start[n]];
+    for c in per_cand {
+        for x in c {
+            let at = &mut start[point_of(&x) as usize];
+            sorted[*at] = x;
+            *at += 1;
+        }
+    }
+    sorted
+}
+
+/// [`by_point_then_candidate`] of slices that hold their points alone,
+/// each numbered by its candidate: (point, candidate) pairs.
+fn sort_sharing(n: usize, per_slice: Vec<(u32, Vec<u32>)>) -> Vec<(u32, u32)> {
+    let mut start = vec![0usize; n + 1];
+    for (_, ps) in &per_slice {
+        for &p in ps {
             start[p as usize + 1] += 1;
         }
     }
     for i in 0..n {
         start[i + 1] += start[i];
     }
-    let mut claims: Vec<Claim> = vec![(0, 0, 0.0); start[n]];
-    for c in per_cand {
-        for claim in c {
-            let at = &mut start[claim.0 as usize];
-            claims[*at] = claim;
+    let mut sorted: Vec<(u32, u32)> = vec![(0, 0); start[n]];
+    for (c, ps) in per_slice {
+        for p in ps {
+            let at = &mut start[p as usize];
+            sorted[*at] = (p, c);
             *at += 1;
         }
     }
-    claims
+    sorted
 }
 
 /// Whether point i's given normal lets it join `fit`: true without
@@ -255,11 +339,14 @@ pub(super) fn settle<S: Shape>(
     angle_deg: f64,
 ) -> (Vec<Candidate>, Claims) {
     let points = cloud.points();
-    let mut claims = Claims::of(&cands, cloud, normals);
-    while let Some(groups) = duplicates::<S>(&cands, &claims, angle_deg, points) {
+    // The merging rounds ask only which candidates share points.
+    let mut sharing = Sharing::of(&cands, cloud, normals);
+    while let Some(groups) = duplicates::<S>(&cands, &sharing, angle_deg, points) {
         cands = merged::<S>(cands, &groups, points);
-        claims = Claims::of(&cands, cloud, normals);
+        sharing = Sharing::of(&cands, cloud, normals);
     }
+    drop(sharing);
+    let claims = Claims::of(&cands, cloud, normals);
     let members = claims.resolve(cands.len());
     refit::<S>(&mut cands, &members, points);
     let claims = Claims::of(&cands, cloud, normals);
@@ -282,7 +369,7 @@ struct Groups {
 /// whose plane is within the part angle of both.
 fn duplicates<S: Shape>(
     cands: &[Candidate],
-    claims: &Claims,
+    sharing: &Sharing,
     angle_deg: f64,
     points: &[[f64; 3]],
 ) -> Option<Groups> {
@@ -291,7 +378,7 @@ fn duplicates<S: Shape>(
     // At each group's root: its largest candidate.
     let mut largest: Vec<u32> = (0..cands.len() as u32).collect();
     let mut merged = false;
-    for (a, b) in claims.shared(Some) {
+    for (a, b) in sharing.shared(Some) {
         let (ra, rb) = (uf.find(a), uf.find(b));
         if was_absorbed[a as usize] || was_absorbed[b as usize] || ra == rb {
             continue;
@@ -460,7 +547,7 @@ mod tests {
         }
         let mut want: Vec<Claim> = per_cand.iter().flatten().copied().collect();
         want.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.cmp(&b.1)));
-        assert_eq!(by_point_then_candidate(200, per_cand), want);
+        assert_eq!(by_point_then_candidate(200, per_cand, |c| c.0), want);
     }
 
     #[test]
@@ -579,6 +666,56 @@ mod tests {
         // Each face's points stay with the candidate of that face.
         assert!(a.iter().all(|v| cands[0].seeds.contains(v)));
         assert!(b.iter().all(|v| cands[1].seeds.contains(v)));
+    }
+
+    #[test]
+    fn the_merging_rounds_see_the_claims_without_their_distances() {
+        // Three overlapping planes over a 30 × 30 grid (two tilted), with
+        // normals that keep some points out of the tilted ones: Sharing
+        // holds the (point, candidate) pairs of the claims, in their order,
+        // and gives the same shared pairs.
+        let pts: Vec<[f64; 3]> = (0..900)
+            .map(|k| {
+                let (i, j) = (f64::from(k % 30), f64::from(k / 30));
+                [i, j, 0.02 * ((i * 7.0 + j * 3.0) % 5.0)]
+            })
+            .collect();
+        let normals: Vec<[f32; 3]> = (0..900)
+            .map(|k| {
+                if k % 7 == 0 {
+                    [1.0, 0.0, 0.0]
+                } else {
+                    [0.0, 0.0, 1.0]
+                }
+            })
+            .collect();
+        let copies = Copies::none(pts.len());
+        let cloud = Cloud::new(&pts, &copies);
+        let cand = |seeds: Vec<u32>, tau: f64| {
+            let fit = Primitive::Plane(fit_plane_indices(&pts, &seeds).unwrap());
+            let foot = Footprint::new(&fit, &pts, &seeds, 2.0).unwrap();
+            Candidate {
+                fit,
+                tau,
+                cell: 2.0,
+                seeds,
+                foot,
+            }
+        };
+        let cands = vec![
+            cand((0..600).collect(), 0.1),
+            cand((300..900).collect(), 0.05),
+            cand((0..900).filter(|k| k % 30 < 12).collect(), 0.2),
+        ];
+        for normals in [None, Some(normals.as_slice())] {
+            let claims = Claims::of(&cands, &cloud, normals);
+            let sharing = Sharing::of(&cands, &cloud, normals);
+            let pairs: Vec<(u32, u32)> = claims.0.iter().map(|c| (c.0, c.1)).collect();
+            assert!(pairs.len() > 900, "{}", pairs.len());
+            assert_eq!(sharing.0, pairs);
+            assert_eq!(sharing.shared(Some), claims.shared(Some));
+            assert_eq!(sharing.shared(Some), [(0, 1), (0, 2), (1, 2)]);
+        }
     }
 
     #[test]
