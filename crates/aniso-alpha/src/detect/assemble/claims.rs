@@ -7,12 +7,13 @@
 //! its normal agrees with the plane's ([`NORMAL_AGREEMENT_COS`]).
 //! Candidates that are one primitive ([`Shape::same`]) and share claimed
 //! points merge, until none do (these rounds ask only which candidates
-//! claim each point: [`Sharing`], without the distances); two groups
-//! merged so far are tested by
-//! their largest candidates, so that a small piece lying where two planes
-//! meet (a shallow roof's ridge, within the part angle of both faces)
-//! joins one of them and does not chain the two into one; then each point goes to the candidate it
-//! is nearest to (parts are disjoint), the candidates are refitted on
+//! claim each point: [`Sharing`], without the distances); a candidate
+//! that joins a group merged so far must be one primitive with the group
+//! too (the fit of its candidates' seeds, [`SoFar`]), so that a small
+//! piece lying where two planes meet (a shallow roof's ridge, within the
+//! part angle of both faces) joins one of them and does not chain the two
+//! into one; then each point goes to the candidate it is nearest to
+//! (parts are disjoint), the candidates are refitted on
 //! their members, and claim again. A merged candidate claims with the
 //! widest radius of its pieces, except the radius of a piece it absorbed
 //! ([`absorbed`]: a coarser piece on its own points), which also links it
@@ -22,7 +23,8 @@
 use super::super::cloud::Cloud;
 use super::super::detection::Primitive;
 use super::footprint::{for_near_in, Stamps};
-use super::same::absorbed;
+use super::moments::Moments;
+use super::same::{absorbed, Piece};
 use super::{Candidate, Draft, Footprint, Shape};
 use crate::par::map_ranges;
 use crate::unionfind::UnionFind;
@@ -362,11 +364,11 @@ struct Groups {
 
 /// The groups of candidates that are one primitive and share claimed
 /// points, or `None` when no two are. An absorbed candidate ([`absorbed`])
-/// joins the one that absorbs it and no other. Two candidates already in
-/// groups are tested by their groups' largest candidates (most seeds, the
-/// smaller index on a tie): the pairwise test alone chains two faces of a
-/// shallow roof, 14° apart, through a four-point piece on their ridge
-/// whose plane is within the part angle of both.
+/// joins the one that absorbs it and no other. Two candidates of which
+/// one is in a group already join only if their groups are one primitive
+/// too ([`SoFar`]): the pairwise test alone chains two faces of a shallow
+/// roof, 14° apart, through a four-point piece on their ridge whose plane
+/// is within the part angle of both.
 fn duplicates<S: Shape>(
     cands: &[Candidate],
     sharing: &Sharing,
@@ -375,39 +377,28 @@ fn duplicates<S: Shape>(
 ) -> Option<Groups> {
     let mut uf = UnionFind::new(cands.len());
     let mut was_absorbed = vec![false; cands.len()];
-    // At each group's root: its largest candidate.
-    let mut largest: Vec<u32> = (0..cands.len() as u32).collect();
+    let mut so_far = SoFar::new(cands.len());
     let mut merged = false;
     for (a, b) in sharing.shared(Some) {
         let (ra, rb) = (uf.find(a), uf.find(b));
         if was_absorbed[a as usize] || was_absorbed[b as usize] || ra == rb {
             continue;
         }
-        let (la, lb) = (largest[ra as usize], largest[rb as usize]);
         let (pa, pb) = (cands[a as usize].piece(), cands[b as usize].piece());
-        let same = if (la, lb) == (a, b) {
-            S::same(pa, pb, angle_deg, points)
-        } else {
-            S::same(pa, pb, angle_deg, points)
-                && S::same(
-                    cands[la as usize].piece(),
-                    cands[lb as usize].piece(),
+        let same = S::same(pa, pb, angle_deg, points)
+            && (so_far.alone(ra, rb)
+                || S::same(
+                    so_far.piece(ra, cands),
+                    so_far.piece(rb, cands),
                     angle_deg,
                     points,
-                )
-        };
+                ));
         if same {
             if let Some(a_is) = absorbed(pa, pb, points) {
                 was_absorbed[if a_is { a } else { b } as usize] = true;
             }
             uf.union_min_root(a, b);
-            let seeds = |c: u32| cands[c as usize].seeds.len();
-            let keep = if (seeds(lb), lb) > (seeds(la), la) {
-                lb
-            } else {
-                la
-            };
-            largest[uf.find(a) as usize] = keep;
+            so_far.join::<S>(ra, rb, uf.find(a), cands, &was_absorbed, points);
             merged = true;
         }
     }
@@ -415,6 +406,101 @@ fn duplicates<S: Shape>(
         sets: uf.sets(),
         absorbed: was_absorbed,
     })
+}
+
+/// The groups of two candidates or more merged so far by [`duplicates`],
+/// at their roots, each as one piece: its candidates' seeds (a point in
+/// two of them twice), the fit of those seeds (from their moments, so
+/// that a group grows in O(1) besides its seeds), and the widest claim
+/// radius of its candidates not absorbed: the primitive the group would be
+/// if merged now, as stage 5 tests its groups of parts.
+struct SoFar {
+    groups: Vec<Option<Group>>,
+}
+
+/// One group of [`SoFar`].
+struct Group {
+    members: Vec<u32>,
+    seeds: Vec<u32>,
+    moments: Moments,
+    fit: Primitive,
+    tau: f64,
+}
+
+impl SoFar {
+    /// Every candidate alone.
+    fn new(n: usize) -> Self {
+        SoFar {
+            groups: (0..n).map(|_| None).collect(),
+        }
+    }
+
+    /// Whether the roots `a` and `b` are candidates alone.
+    fn alone(&self, a: u32, b: u32) -> bool {
+        self.groups[a as usize].is_none() && self.groups[b as usize].is_none()
+    }
+
+    /// The group at root `r` as a piece (a candidate alone: itself).
+    fn piece<'a>(&'a self, r: u32, cands: &'a [Candidate]) -> Piece<'a> {
+        match &self.groups[r as usize] {
+            Some(g) => Piece {
+                fit: &g.fit,
+                tau: g.tau,
+                seeds: &g.seeds,
+            },
+            None => cands[r as usize].piece(),
+        }
+    }
+
+    /// The group at root `r` taken out (a candidate alone made a group).
+    fn take(&mut self, r: u32, cands: &[Candidate], points: &[[f64; 3]]) -> Group {
+        self.groups[r as usize].take().unwrap_or_else(|| {
+            let c = &cands[r as usize];
+            Group {
+                members: vec![r],
+                seeds: c.seeds.clone(),
+                moments: Moments::of(&c.seeds, points),
+                fit: c.fit.clone(),
+                tau: c.tau,
+            }
+        })
+    }
+
+    /// The groups at roots `a` and `b` joined at `root`.
+    fn join<S: Shape>(
+        &mut self,
+        a: u32,
+        b: u32,
+        root: u32,
+        cands: &[Candidate],
+        absorbed: &[bool],
+        points: &[[f64; 3]],
+    ) {
+        let (ga, gb) = (self.take(a, cands, points), self.take(b, cands, points));
+        let (mut big, small) = if ga.seeds.len() >= gb.seeds.len() {
+            (ga, gb)
+        } else {
+            (gb, ga)
+        };
+        big.members.extend(small.members);
+        big.seeds.extend(small.seeds);
+        big.moments = big.moments.join(&small.moments);
+        let joint = if S::K == 1 {
+            big.moments.line()
+        } else {
+            big.moments.plane()
+        };
+        if !matches!(joint, Primitive::None) {
+            big.fit = joint;
+        }
+        big.tau = big
+            .members
+            .iter()
+            .filter(|&&c| !absorbed[c as usize])
+            .map(|&c| cands[c as usize].tau)
+            .fold(0.0, f64::max);
+        self.groups[root as usize] = Some(big);
+    }
 }
 
 /// One candidate per group: a group of one keeps its candidate; a larger

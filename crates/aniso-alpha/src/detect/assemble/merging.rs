@@ -32,10 +32,10 @@
 //! most [`JOINT_SAMPLE`] of the larger one's.
 
 use super::super::detection::Primitive;
-use super::super::fit::{symmetric_eigen, PlaneFit};
+use super::moments::Moments;
 use super::same::SAME_SHARE;
 use super::{Candidate, Draft, Shape};
-use crate::geometry::{bounding_box_of, cross, dot, sub};
+use crate::geometry::{bounding_box_of, dot, sub};
 use crate::unionfind::UnionFind;
 
 /// The most points of the larger group that the joint plane's test reads
@@ -156,84 +156,6 @@ fn parallel_planes(a: &Primitive, b: &Primitive, cos: f64) -> bool {
     match (a, b) {
         (Primitive::Plane(fa), Primitive::Plane(fb)) => dot(fa.normal, fb.normal).abs() >= cos,
         _ => false,
-    }
-}
-
-/// The moments of a set of points: their number, centroid and scatter
-/// matrix Σ (p − c)(p − c)ᵀ.
-#[derive(Debug, Clone, Copy)]
-struct Moments {
-    n: f64,
-    centroid: [f64; 3],
-    scatter: [[f64; 3]; 3],
-}
-
-impl Moments {
-    /// The moments of `members`.
-    fn of(members: &[u32], points: &[[f64; 3]]) -> Self {
-        let n = members.len() as f64;
-        let mut c = [0.0; 3];
-        for &v in members {
-            let p = points[v as usize];
-            (0..3).for_each(|k| c[k] += p[k]);
-        }
-        c = c.map(|x| x / n);
-        let mut s = [[0.0; 3]; 3];
-        for &v in members {
-            let d = sub(points[v as usize], c);
-            for r in 0..3 {
-                for q in 0..3 {
-                    s[r][q] += d[r] * d[q];
-                }
-            }
-        }
-        Moments {
-            n,
-            centroid: c,
-            scatter: s,
-        }
-    }
-
-    /// The moments of the union of two disjoint sets (the parallel-axis
-    /// rule: no cancellation, whatever the coordinates' magnitude).
-    fn join(&self, o: &Moments) -> Moments {
-        let n = self.n + o.n;
-        let d = sub(o.centroid, self.centroid);
-        let w = self.n * o.n / n;
-        let mut s = [[0.0; 3]; 3];
-        for r in 0..3 {
-            for q in 0..3 {
-                s[r][q] = self.scatter[r][q] + o.scatter[r][q] + w * d[r] * d[q];
-            }
-        }
-        Moments {
-            n,
-            centroid: [0, 1, 2].map(|k| self.centroid[k] + d[k] * o.n / n),
-            scatter: s,
-        }
-    }
-
-    /// The least-squares plane of the points (its extent left at zero:
-    /// only the plane itself is asked for while merging).
-    fn plane(&self) -> Primitive {
-        let cov = self.scatter.map(|row| row.map(|x| x / self.n));
-        let (vals, vecs) = symmetric_eigen(cov);
-        if !(vals[0] > 0.0 && vals[1] > 64.0 * f64::EPSILON * vals[0]) {
-            return Primitive::None;
-        }
-        let unit = |u: [f64; 3]| {
-            let l = dot(u, u).sqrt();
-            u.map(|x| x / l)
-        };
-        let normal = unit(vecs[2]);
-        let a0 = unit(vecs[0]);
-        Primitive::Plane(PlaneFit {
-            centroid: self.centroid,
-            normal,
-            axes: [a0, cross(normal, a0)],
-            rms_residual: vals[2].max(0.0).sqrt(),
-            extent: [0.0; 2],
-        })
     }
 }
 

@@ -43,6 +43,7 @@ mod claims;
 mod embedded;
 mod footprint;
 mod merging;
+mod moments;
 mod proportions;
 mod same;
 mod select;
