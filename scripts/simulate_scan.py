@@ -279,6 +279,14 @@ def airborne(rng, strips=1):
     # strips, where points of the two come in near pairs).
     along = rng.uniform(0.8, 1.4)
     across = rng.uniform(0.3, 0.5)
+    return _fly(rng, s, size, along, across, strips, trees=8, tree_points=(150, 400))
+
+
+def _fly(rng, s, size, along, across, strips, trees, tree_points):
+    """The scene `s` over a `size` x `size` block seen by `strips` flight
+    strips (scan lines `along` apart, `across` between points on a line),
+    with `trees` blobs of foliage of `tree_points` (low, high) points as
+    clutter: the points inside the block and their labels."""
     import open3d as o3d
 
     v, t, labs = s.arrays()
@@ -290,13 +298,13 @@ def airborne(rng, strips=1):
     pts = np.vstack([p for p, _ in parts])
     labels = np.concatenate([l for _, l in parts])
     # Trees: blobs of foliage points above the ground.
-    trees = []
-    for cx, cy in rng.uniform(5, size - 5, (8, 2)):
-        k = int(rng.integers(150, 400))
-        trees.append(np.array([cx, cy, rng.uniform(5, 9)]) + rng.normal(0, 1.0, (k, 3)) * [2.0, 2.0, 1.5])
-    trees = np.vstack(trees)
+    blobs = []
+    for cx, cy in rng.uniform(5, size - 5, (trees, 2)):
+        k = int(rng.integers(*tree_points))
+        blobs.append(np.array([cx, cy, rng.uniform(5, 9)]) + rng.normal(0, 1.0, (k, 3)) * [2.0, 2.0, 1.5])
+    blobs = np.vstack(blobs)
     keep = np.all((pts[:, :2] >= 0) & (pts[:, :2] <= size), axis=1)
-    return np.vstack([pts[keep], trees]), np.concatenate([labels[keep], -np.ones(len(trees), np.int64)])
+    return np.vstack([pts[keep], blobs]), np.concatenate([labels[keep], -np.ones(len(blobs), np.int64)])
 
 
 def _hall(s, rng, c, th, lx, ly, h, kind, lab):
@@ -346,23 +354,7 @@ def halls(rng, strips=1):
         lab = _hall(s, rng, c, rng.uniform(0, np.pi), lx, ly, h, kind, lab)
     along = rng.uniform(0.4, 0.6)
     across = rng.uniform(0.2, 0.3)
-    import open3d as o3d
-
-    v, t, labs = s.arrays()
-    rs = o3d.t.geometry.RaycastingScene()
-    rs.add_triangles(o3d.core.Tensor(v.astype(np.float32)), o3d.core.Tensor(t.astype(np.uint32)))
-    parts = [_strip(rng, rs, labs, size, along, across, 0.0, 1.0)]
-    for _ in range(1, strips):
-        parts.append(_strip(rng, rs, labs, size, along, across, rng.uniform(0, along), -1.0))
-    pts = np.vstack([p for p, _ in parts])
-    labels = np.concatenate([l for _, l in parts])
-    trees = []
-    for cx, cy in rng.uniform(5, size - 5, (6, 2)):
-        k = int(rng.integers(300, 800))
-        trees.append(np.array([cx, cy, rng.uniform(5, 9)]) + rng.normal(0, 1.0, (k, 3)) * [2.0, 2.0, 1.5])
-    trees = np.vstack(trees)
-    keep = np.all((pts[:, :2] >= 0) & (pts[:, :2] <= size), axis=1)
-    return np.vstack([pts[keep], trees]), np.concatenate([labels[keep], -np.ones(len(trees), np.int64)])
+    return _fly(rng, s, size, along, across, strips, trees=6, tree_points=(300, 800))
 
 
 def street(rng):

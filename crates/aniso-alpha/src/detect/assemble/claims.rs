@@ -599,6 +599,20 @@ mod tests {
     use crate::detect::cloud::Copies;
     use crate::detect::fit::{fit_line_indices, fit_plane_indices};
 
+    /// A plane candidate fitted to `seeds`, with the claim radius `tau`
+    /// and footprint cells of side 2.
+    fn plane_candidate(pts: &[[f64; 3]], seeds: Vec<u32>, tau: f64) -> Candidate {
+        let fit = Primitive::Plane(fit_plane_indices(pts, &seeds).unwrap());
+        let foot = Footprint::new(&fit, pts, &seeds, 2.0).unwrap();
+        Candidate {
+            fit,
+            tau,
+            cell: 2.0,
+            seeds,
+            foot,
+        }
+    }
+
     /// Claims of three candidates on five points.
     fn claims() -> Claims {
         Claims(vec![
@@ -718,17 +732,7 @@ mod tests {
             .collect();
         let copies = Copies::none(pts.len());
         let cloud = Cloud::new(&pts, &copies);
-        let cand = |seeds: Vec<u32>| {
-            let fit = Primitive::Plane(fit_plane_indices(&pts, &seeds).unwrap());
-            let foot = Footprint::new(&fit, &pts, &seeds, 2.0).unwrap();
-            Candidate {
-                fit,
-                tau: 0.1,
-                cell: 2.0,
-                seeds,
-                foot,
-            }
-        };
+        let cand = |seeds: Vec<u32>| plane_candidate(&pts, seeds, 0.1);
         let (pa, pb, pr) = (cand(a.clone()), cand(b.clone()), cand(ridge.clone()));
         // The pairwise tests that would chain them.
         assert!(same_primitive(pa.piece(), pr.piece(), 10.0, &pts));
@@ -777,17 +781,7 @@ mod tests {
             .collect();
         let copies = Copies::none(pts.len());
         let cloud = Cloud::new(&pts, &copies);
-        let cand = |seeds: Vec<u32>, tau: f64| {
-            let fit = Primitive::Plane(fit_plane_indices(&pts, &seeds).unwrap());
-            let foot = Footprint::new(&fit, &pts, &seeds, 2.0).unwrap();
-            Candidate {
-                fit,
-                tau,
-                cell: 2.0,
-                seeds,
-                foot,
-            }
-        };
+        let cand = |seeds: Vec<u32>, tau: f64| plane_candidate(&pts, seeds, tau);
         let cands = vec![
             cand((0..600).collect(), 0.1),
             cand((300..900).collect(), 0.05),
@@ -823,17 +817,7 @@ mod tests {
             .collect();
         let copies = Copies::none(pts.len());
         let cloud = Cloud::new(&pts, &copies);
-        let cand = |seeds: Vec<u32>, tau: f64| {
-            let fit = Primitive::Plane(fit_plane_indices(&pts, &seeds).unwrap());
-            let foot = Footprint::new(&fit, &pts, &seeds, 2.0).unwrap();
-            Candidate {
-                fit,
-                tau,
-                cell: 2.0,
-                seeds,
-                foot,
-            }
-        };
+        let cand = |seeds: Vec<u32>, tau: f64| plane_candidate(&pts, seeds, tau);
         let coarse: Vec<u32> = (8..12)
             .flat_map(|i| (8..12).map(move |j| i * 21 + j))
             .collect();
