@@ -68,14 +68,12 @@ impl Claims {
     /// a point claimed by two slices of one candidate is kept once. The
     /// claims do not depend on the slicing.
     pub(super) fn of(cands: &[Candidate], cloud: &Cloud<'_>, normals: Option<&[[f32; 3]]>) -> Self {
-        let per_slice: Vec<Vec<Claim>> = claim_slices(cands, cloud, normals, |i, c, d| (i, c, d))
-            .into_iter()
-            .map(|(_, v)| v)
-            .collect();
+        let per_slice = claim_slices(cands, cloud, normals, |i, c, d| (i, c, d));
         // A slice's claims are ordered by candidate, so the counting sort
         // puts a point claimed by two slices of one candidate twice in a
         // row: kept once.
-        let mut claims = by_point_then_candidate(cloud.points().len(), per_slice, |c| c.0);
+        let mut claims =
+            by_point_then_candidate(cloud.points().len(), per_slice, |c| c.0, |_, c| c);
         claims.dedup_by_key(|c| (c.0, c.1));
         Claims(claims)
     }
@@ -135,7 +133,8 @@ impl Sharing {
     /// The (point, candidate) pairs of [`Claims::of`].
     fn of(cands: &[Candidate], cloud: &Cloud<'_>, normals: Option<&[[f32; 3]]>) -> Self {
         let per_slice = claim_slices(cands, cloud, normals, |i, _, _| i);
-        let mut pairs = sort_sharing(cloud.points().len(), per_slice);
+        let mut pairs =
+            by_point_then_candidate(cloud.points().len(), per_slice, |&p| p, |c, p| (p, c));
         pairs.dedup();
         Sharing(pairs)
     }
@@ -258,17 +257,19 @@ fn shared_pairs<I: Iterator<Item = u32>>(
 }
 
 /// Lists of claims in candidate order (a candidate's, or one slice of a
-/// candidate's, each point at most once a list) on `n` points, ordered by
-/// point (`point_of`), then candidate: a counting sort by point, which
-/// keeps the lists' order within each point. Each list is freed once
-/// placed.
-fn by_point_then_candidate<T: Copy + Default>(
+/// candidate's, each point at most once a list, each with its candidate)
+/// on `n` points, ordered by point (`point_of`), then candidate, each
+/// claim written as `out(candidate, claim)`: a counting sort by point,
+/// which keeps the lists' order within each point. Each list is freed
+/// once placed.
+fn by_point_then_candidate<T, U: Copy + Default>(
     n: usize,
-    per_cand: Vec<Vec<T>>,
+    per_cand: Vec<(u32, Vec<T>)>,
     point_of: impl Fn(&T) -> u32,
-) -> Vec<T> {
+    out: impl Fn(u32, T) -> U,
+) -> Vec<U> {
     let mut start = vec![0usize; n + 1];
-    for c in &per_cand {
+    for (_, c) in &per_cand {
         for x in c {
             start[point_of(x) as usize + 1] += 1;
         }
@@ -276,34 +277,11 @@ fn by_point_then_candidate<T: Copy + Default>(
     for i in 0..n {
         start[i + 1] += start[i];
     }
-    let mut sorted: Vec<T> = vec![T::default(); start[n]];
-    for c in per_cand {
+    let mut sorted: Vec<U> = vec![U::default(); start[n]];
+    for (cand, c) in per_cand {
         for x in c {
             let at = &mut start[point_of(&x) as usize];
-            sorted[*at] = x;
-            *at += 1;
-        }
-    }
-    sorted
-}
-
-/// [`by_point_then_candidate`] of slices that hold their points alone,
-/// each numbered by its candidate: (point, candidate) pairs.
-fn sort_sharing(n: usize, per_slice: Vec<(u32, Vec<u32>)>) -> Vec<(u32, u32)> {
-    let mut start = vec![0usize; n + 1];
-    for (_, ps) in &per_slice {
-        for &p in ps {
-            start[p as usize + 1] += 1;
-        }
-    }
-    for i in 0..n {
-        start[i + 1] += start[i];
-    }
-    let mut sorted: Vec<(u32, u32)> = vec![(0, 0); start[n]];
-    for (c, ps) in per_slice {
-        for p in ps {
-            let at = &mut start[p as usize];
-            sorted[*at] = (p, c);
+            sorted[*at] = out(cand, x);
             *at += 1;
         }
     }
@@ -647,7 +625,8 @@ mod tests {
         }
         let mut want: Vec<Claim> = per_cand.iter().flatten().copied().collect();
         want.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.cmp(&b.1)));
-        assert_eq!(by_point_then_candidate(200, per_cand, |c| c.0), want);
+        let lists: Vec<(u32, Vec<Claim>)> = (0..).zip(per_cand).collect();
+        assert_eq!(by_point_then_candidate(200, lists, |c| c.0, |_, c| c), want);
     }
 
     #[test]
