@@ -68,12 +68,16 @@ impl Claims {
     /// a point claimed by two slices of one candidate is kept once. The
     /// claims do not depend on the slicing.
     pub(super) fn of(cands: &[Candidate], cloud: &Cloud<'_>, normals: Option<&[[f32; 3]]>) -> Self {
-        let per_slice = claim_slices(cands, cloud, normals, |i, c, d| (i, c, d));
+        let per_slice = claim_slices(cands, cloud, normals, |i, d| (i, d));
         // A slice's claims are ordered by candidate, so the counting sort
         // puts a point claimed by two slices of one candidate twice in a
         // row: kept once.
-        let mut claims =
-            by_point_then_candidate(cloud.points().len(), per_slice, |c| c.0, |_, c| c);
+        let mut claims = by_point_then_candidate(
+            cloud.points().len(),
+            per_slice,
+            |c| c.0,
+            |c, (i, d)| (i, c, d),
+        );
         claims.dedup_by_key(|c| (c.0, c.1));
         Claims(claims)
     }
@@ -132,7 +136,7 @@ struct Sharing(Vec<(u32, u32)>);
 impl Sharing {
     /// The (point, candidate) pairs of [`Claims::of`].
     fn of(cands: &[Candidate], cloud: &Cloud<'_>, normals: Option<&[[f32; 3]]>) -> Self {
-        let per_slice = claim_slices(cands, cloud, normals, |i, _, _| i);
+        let per_slice = claim_slices(cands, cloud, normals, |i, _| i);
         let mut pairs =
             by_point_then_candidate(cloud.points().len(), per_slice, |&p| p, |c, p| (p, c));
         pairs.dedup();
@@ -169,8 +173,8 @@ fn slices_of(blocks: &[Vec<([f64; 3], f64)>]) -> Vec<(usize, usize, usize)> {
 }
 
 /// The claims of `cands` slice by slice ([`slices_of`] of their footprint
-/// blocks), each claim made by `make(point, candidate, distance)`, with
-/// the candidate of each slice: in parallel over the slices (so
+/// blocks), each claim made by `make(point, distance)`, with the
+/// candidate of each slice: in parallel over the slices (so
 /// that one large candidate, a scan's ground, is shared between threads),
 /// each range of slices with its own stamps. A slice's balls reach into
 /// the next slice's blocks, whose points both report: slices are as long
@@ -179,7 +183,7 @@ fn claim_slices<T: Send>(
     cands: &[Candidate],
     cloud: &Cloud<'_>,
     normals: Option<&[[f32; 3]]>,
-    make: impl Fn(u32, u32, f64) -> T + Sync,
+    make: impl Fn(u32, f64) -> T + Sync,
 ) -> Vec<(u32, Vec<T>)> {
     let points = cloud.points();
     let blocks: Vec<Vec<([f64; 3], f64)>> =
@@ -203,7 +207,7 @@ fn claim_slices<T: Send>(
                 &blocks[ci][from..to],
                 &mut |i, d| {
                     if agrees(i) {
-                        claims.push(make(i, ci as u32, d));
+                        claims.push(make(i, d));
                     }
                 },
             );
@@ -577,18 +581,30 @@ mod tests {
     use crate::detect::cloud::Copies;
     use crate::detect::fit::{fit_line_indices, fit_plane_indices};
 
+    /// A candidate of the primitive `fit` of `seeds`, with the claim
+    /// radius `tau` and footprint cells of side `cell`.
+    fn candidate(
+        fit: Primitive,
+        pts: &[[f64; 3]],
+        seeds: Vec<u32>,
+        tau: f64,
+        cell: f64,
+    ) -> Candidate {
+        let foot = Footprint::new(&fit, pts, &seeds, cell).unwrap();
+        Candidate {
+            fit,
+            tau,
+            cell,
+            seeds,
+            foot,
+        }
+    }
+
     /// A plane candidate fitted to `seeds`, with the claim radius `tau`
     /// and footprint cells of side 2.
     fn plane_candidate(pts: &[[f64; 3]], seeds: Vec<u32>, tau: f64) -> Candidate {
         let fit = Primitive::Plane(fit_plane_indices(pts, &seeds).unwrap());
-        let foot = Footprint::new(&fit, pts, &seeds, 2.0).unwrap();
-        Candidate {
-            fit,
-            tau,
-            cell: 2.0,
-            seeds,
-            foot,
-        }
+        candidate(fit, pts, seeds, tau, 2.0)
     }
 
     /// Claims of three candidates on five points.
@@ -661,14 +677,7 @@ mod tests {
         let cloud = Cloud::new(&pts, &copies);
         let cand = |seeds: Vec<u32>| {
             let fit = Primitive::Line(fit_line_indices(&pts, &seeds).unwrap());
-            let foot = Footprint::new(&fit, &pts, &seeds, 2.0).unwrap();
-            Candidate {
-                fit,
-                tau: 0.1,
-                cell: 2.0,
-                seeds,
-                foot,
-            }
+            candidate(fit, &pts, seeds, 0.1, 2.0)
         };
         let up: Vec<u32> = std::iter::once(10).chain(21..28).collect();
         let cands = vec![cand((0..11).collect()), cand((10..21).collect()), cand(up)];
@@ -834,14 +843,7 @@ mod tests {
         let cloud = Cloud::new(&pts, &copies);
         let cand = |seeds: Vec<u32>| {
             let fit = Primitive::Plane(fit_plane_indices(&pts, &seeds).unwrap());
-            let foot = Footprint::new(&fit, &pts, &seeds, 1.0).unwrap();
-            Candidate {
-                fit,
-                tau: 0.1,
-                cell: 1.0,
-                seeds,
-                foot,
-            }
+            candidate(fit, &pts, seeds, 0.1, 1.0)
         };
         let on: Vec<u32> = (0..pts.len() as u32)
             .filter(|&i| pts[i as usize][2] < 0.1)
