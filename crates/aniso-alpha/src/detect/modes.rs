@@ -102,20 +102,15 @@ pub fn modes(axes: &[[f64; 3]], h: f64, min_support: usize) -> Vec<Mode> {
     let density: Vec<u32> = crate::par::map_ranges(
         ns,
         || (),
-        |_, i| {
-            let mut c = 0u32;
-            neighbours(samples[i], &mut |_, _| c += 1);
-            c
-        },
+        |_, i| tree.count_within(&samples[i], chord) as u32,
     );
+    // A seed: no sample within h beats it (the search stops at the first
+    // that does, which is most samples' case).
     let seed = |i: usize| {
-        let mut peak = true;
-        neighbours(samples[i], &mut |s, _| {
-            if density[s] > density[i] || (density[s] == density[i] && s < i) {
-                peak = false;
-            }
-        });
-        peak
+        !tree.any_within(&samples[i], chord, |t| {
+            let s = t as usize % ns;
+            density[s] > density[i] || (density[s] == density[i] && s < i)
+        })
     };
     let seeds: Vec<usize> = crate::par::map_ranges(ns, || (), |_, i| seed(i))
         .into_iter()

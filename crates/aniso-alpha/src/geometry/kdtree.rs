@@ -55,6 +55,16 @@ fn d2(a: &[f64; 3], b: &[f64; 3]) -> f64 {
     x * x + y * y + z * z
 }
 
+/// Squared distance from `q` to the box's farthest corner.
+fn far_d2(q: &[f64; 3], b: &([f64; 3], [f64; 3])) -> f64 {
+    let mut s = 0.0;
+    for k in 0..3 {
+        let d = (q[k] - b.0[k]).abs().max((b.1[k] - q[k]).abs());
+        s += d * d;
+    }
+    s
+}
+
 /// Squared distance from `q` to the box.
 fn box_d2(q: &[f64; 3], b: &([f64; 3], [f64; 3])) -> f64 {
     let mut s = 0.0;
@@ -240,6 +250,78 @@ impl KdTree {
             }
         }
     }
+    /// The number of points within distance `r` of `q` (inclusive): the
+    /// count of [`within`](Self::within)'s calls, without visiting the
+    /// points of a node whose box lies inside the ball.
+    ///
+    /// Exact: a point of a box is no farther from `q`, per axis and in
+    /// floating point, than the box's farther face (subtraction, squaring
+    /// and addition round monotonically, and both sums add the axes in
+    /// the same order), so a box whose farthest corner is within `r`
+    /// holds only points within `r`.
+    pub fn count_within(&self, q: &[f64; 3], r: f64) -> usize {
+        if self.ids.is_empty() {
+            return 0;
+        }
+        let r2 = r * r;
+        let mut count = 0usize;
+        let mut stack: [u32; 64] = [0; 64];
+        let mut top = 1usize;
+        while top > 0 {
+            top -= 1;
+            let node = stack[top] as usize;
+            let b = &self.bbox[node];
+            if box_d2(q, b) > r2 {
+                continue;
+            }
+            let (s, e) = self.range[node];
+            if far_d2(q, b) <= r2 {
+                count += (e - s) as usize;
+            } else if self.is_leaf(node) {
+                count += self.pts[s as usize..e as usize]
+                    .iter()
+                    .filter(|p| d2(q, p) <= r2)
+                    .count();
+            } else {
+                stack[top] = (2 * node + 1) as u32;
+                stack[top + 1] = (2 * node + 2) as u32;
+                top += 2;
+            }
+        }
+        count
+    }
+
+    /// Whether `stop` returns `true` for a point within distance `r` of
+    /// `q` (inclusive): [`within`](Self::within)'s points, in tree order,
+    /// until the first for which it does.
+    pub fn any_within(&self, q: &[f64; 3], r: f64, mut stop: impl FnMut(u32) -> bool) -> bool {
+        if self.ids.is_empty() {
+            return false;
+        }
+        let r2 = r * r;
+        let mut stack: [u32; 64] = [0; 64];
+        let mut top = 1usize;
+        while top > 0 {
+            top -= 1;
+            let node = stack[top] as usize;
+            if box_d2(q, &self.bbox[node]) > r2 {
+                continue;
+            }
+            if self.is_leaf(node) {
+                let (s, e) = self.range[node];
+                for t in s as usize..e as usize {
+                    if d2(q, &self.pts[t]) <= r2 && stop(self.ids[t]) {
+                        return true;
+                    }
+                }
+            } else {
+                stack[top] = (2 * node + 1) as u32;
+                stack[top + 1] = (2 * node + 2) as u32;
+                top += 2;
+            }
+        }
+        false
+    }
 }
 
 #[cfg(test)]
@@ -289,6 +371,23 @@ mod tests {
                 let mut want: Vec<u32> = all.iter().filter(|x| x.0 <= r * r).map(|x| x.1).collect();
                 want.sort_unstable();
                 assert_eq!(got, want, "query {qi} r {r}");
+                assert_eq!(
+                    tree.count_within(q, r),
+                    want.len(),
+                    "count: query {qi} r {r}"
+                );
+                // The first point `any_within` stops at is `within`'s
+                // first of those the predicate accepts.
+                let odd = |i: u32| i % 2 == 1;
+                let mut seen = Vec::new();
+                let found = tree.any_within(q, r, |i| {
+                    seen.push(i);
+                    odd(i)
+                });
+                assert_eq!(found, want.iter().any(|&i| odd(i)), "any: query {qi} r {r}");
+                let mut order = Vec::new();
+                tree.within(q, r, |i| order.push(i));
+                assert_eq!(seen[..], order[..seen.len()], "any: query {qi} r {r}");
             }
         }
     }
