@@ -21,7 +21,12 @@ With `--peer` (scripts/peers/cgal_shapes.cpp), CGAL's Efficient RANSAC
 (one thread) runs on the same cloud in the same loop (`--peer-args`, e.g.
 the scan's best preset of scripts/bench_corpus.py; `--peer-copies` limits
 the sizes it runs on), and its rows get its wall time, peak RSS and our
-ratios to them (each thread count's). `--deadline S` skips the runs that
+ratios to them (each thread count's). `--inputs ply,laz` runs
+each row on the copies as a binary PLY and as one LAZ file (laspy with
+lazrs; coordinates quantised to 1 mm first, the PLY holding the same
+values): the CLI reads a PLY whole and a LAS/LAZ region run a piece of
+2^20 points at a time, never whole, so the two rows compare the memory of
+the two reads on the same points (and their labels must agree). `--deadline S` skips the runs that
 would start after S seconds and caps each run's timeout at what is left
 (the device machine's one prepared script); `--json FILE` appends every
 row as one JSON object as soon as it is measured.
@@ -29,9 +34,10 @@ row as one JSON object as soon as it is measured.
     python3 scripts/bench_scaling.py [--bin target/release/aniso-alpha] [--copies 1,4,16,32]
         [--scan FILE.ply --spacing 1] [--timeout S] [--threads 1,2] [--regions auto,off]
         [--peer cgal_shapes --peer-args "--epsilon 0.15 --cluster-epsilon 0.49 --min-points 100"]
-        [--peer-copies 16] [--deadline S] [--json FILE]
+        [--peer-copies 16] [--inputs ply,laz] [--deadline S] [--json FILE]
 
-Needs numpy. Peak RSS is the child's own (`os.wait4`), so no GNU time.
+Needs numpy (and laspy with lazrs for `--inputs laz`) and GNU time
+(`/usr/bin/time`, Debian `time`) for the peak RSS.
 """
 import argparse
 import hashlib
@@ -89,6 +95,7 @@ def main():
     ap.add_argument("--regions", default=None,
                     help="detect's --regions, a comma list (SIDE, auto or off; default: the CLI's, auto)")
     ap.add_argument("--json", default=None, help="append each row to this file as one JSON object")
+    ap.add_argument("--inputs", default="ply", help="input formats, a comma list of ply and laz")
     a = ap.parse_args()
     truth = None
     if a.scan:
@@ -106,25 +113,48 @@ def main():
     clock = Clock(a.deadline)
     peer_cols = " RANSAC wall s | RANSAC RSS MiB | wall / RANSAC | RSS / RANSAC |" if a.peer else ""
     f1_col = " plane F1 |" if truth is not None else ""
-    print("| copies | points | regions | threads | wall s | peak RSS MiB | µs / point | parts | parts / copy"
+    inputs = a.inputs.split(",")
+    print("| copies | points | input | regions | threads | wall s | peak RSS MiB | µs / point | parts | parts / copy"
           " | labels | phases (s) |" + f1_col + peer_cols)
-    print("|---:|---:|---|---:|---:|---:|---:|---:|---:|---|---|" + ("---:|" if truth is not None else "")
+    print("|---:|---:|---|---|---:|---:|---:|---:|---:|---:|---|---|" + ("---:|" if truth is not None else "")
           + ("---:|" * 4 if a.peer else ""))
     with tempfile.TemporaryDirectory() as tmp:
         for c in map(int, a.copies.split(",")):
             side = int(np.ceil(np.sqrt(c)))
             cloud = np.concatenate([pts + np.array([pitch[0] * (k % side), pitch[1] * (k // side), 0.0])
                                     for k in range(c)])
-            f = os.path.join(tmp, "copies.ply")
-            write_xyz_ply(f, cloud)
+            files = {"ply": os.path.join(tmp, "copies.ply")}
+            if "laz" in inputs:
+                files["laz"] = os.path.join(tmp, "copies.laz")
+                cloud = write_laz(files["laz"], cloud)
+            write_xyz_ply(files["ply"], cloud)
             peer = None
             if a.peer and (peer_copies is None or c in peer_copies):
                 peer = measure_peer(a, clock, cloud, tmp)
             for reg in regions:
                 for th in threads:
-                    row = measure_ours(a, clock, f, c, len(cloud), reg, th, truth, tmp)
-                    print_row(a, row, peer, truth is not None)
+                    for fmt in inputs:
+                        row = measure_ours(a, clock, files[fmt], c, len(cloud), reg, th, truth, tmp)
+                        row["input"] = fmt
+                        print_row(a, row, peer, truth is not None)
             del cloud
+
+
+def write_laz(path, xyz):
+    """`xyz` quantised to 1 mm as one LAZ file (point format 0, laspy):
+    returns the coordinates the file holds, as a LAS reader computes them
+    (integer × scale + offset)."""
+    import laspy
+
+    offset = np.floor(xyz.min(0))
+    scale = np.array([0.001, 0.001, 0.001])
+    ints = np.round((xyz - offset) / scale).astype(np.int64)
+    header = laspy.LasHeader(point_format=0, version="1.2")
+    header.offsets, header.scales = offset, scale
+    las = laspy.LasData(header)
+    las.X, las.Y, las.Z = ints[:, 0], ints[:, 1], ints[:, 2]
+    las.write(path)
+    return ints * scale + offset
 
 
 def write_xyz_ply(path, xyz):
@@ -191,7 +221,7 @@ def measure_peer(a, clock, cloud, tmp):
 
 def print_row(a, row, peer, has_truth):
     """One markdown row (and one JSON line with `--json`)."""
-    head = f"| {row['copies']} | {row['points']} | {row['regions']} | {row['threads']} |"
+    head = f"| {row['copies']} | {row['points']} | {row.get('input', 'ply')} | {row['regions']} | {row['threads']} |"
     if row["wall"] is None:
         why = "skipped" if row.get("skipped") else f"> {row['timeout']:.0f}"
         print(head + f" {why} | | | | | | |" + (" |" if has_truth else "") + (" | | | |" if a.peer else ""),
@@ -220,30 +250,31 @@ def print_row(a, row, peer, has_truth):
 def run_measured(args, timeout):
     """`args` to completion: (wall s, peak RSS MiB, stdout, stderr), or
     killed with every process it started after `timeout` seconds, raising
-    subprocess.TimeoutExpired. The peak RSS is the child's own, from
-    `os.wait4` (ru_maxrss, KiB on Linux); its output goes through files so
-    that nothing but `wait4` reaps it."""
-    with tempfile.TemporaryFile("w+") as out, tempfile.TemporaryFile("w+") as err:
+    subprocess.TimeoutExpired. The peak RSS is GNU time's `%M` of the
+    command (`/usr/bin/time -o`): the command is forked by `time`, a small
+    process. The child's own `ru_maxrss` from `os.wait4` is not used: Linux
+    carries the parent's high-water mark into a child across fork and exec,
+    so it reports at least this script's RSS (the copies it holds: 1.3 GiB
+    at 11M points)."""
+    with tempfile.TemporaryFile("w+") as out, tempfile.TemporaryFile("w+") as err, \
+            tempfile.NamedTemporaryFile("r") as peak:
         t = time.perf_counter()
-        p = subprocess.Popen(args, stdout=out, stderr=err, text=True, start_new_session=True)
-        while True:
-            pid, status, usage = os.wait4(p.pid, os.WNOHANG)
-            if pid == p.pid:
-                break
-            if timeout is not None and time.perf_counter() - t > timeout:
-                os.killpg(p.pid, signal.SIGKILL)
-                os.wait4(p.pid, 0)
-                p.returncode = -9
-                raise subprocess.TimeoutExpired(args, timeout)
-            time.sleep(0.02)
+        p = subprocess.Popen(["/usr/bin/time", "-f", "%M", "-o", peak.name, *args], stdout=out, stderr=err,
+                             text=True, start_new_session=True)
+        try:
+            p.wait(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            os.killpg(p.pid, signal.SIGKILL)
+            p.wait()
+            raise
         wall = time.perf_counter() - t
-        p.returncode = os.waitstatus_to_exitcode(status)
         out.seek(0)
         err.seek(0)
         o, e = out.read(), err.read()
+        lines = [x for x in peak.read().splitlines() if x.strip().isdigit()]
     if p.returncode != 0:
         raise subprocess.CalledProcessError(p.returncode, args, o, e)
-    return wall, usage.ru_maxrss / 1024, o, e
+    return wall, int(lines[-1]) / 1024, o, e
 
 
 if __name__ == "__main__":

@@ -115,7 +115,9 @@ pub struct DetectArgs {
     /// memory bounded by one region's run. 'auto' (the default unless an
     /// output needs a whole run: --html, --png, --union, .obj): regions of
     /// about 250,000 points, a whole run up to 1,000,000 points. 'off': one
-    /// whole run
+    /// whole run. A LAS/LAZ input of a region run is read a piece at a
+    /// time, never whole (not with --background-classes or a labelled
+    /// .ply --output)
     #[arg(long, value_name = "SIDE|auto|off", value_parser = crate::cmd_regions::parse_regions, requires = "input")]
     pub regions: Option<crate::cmd_regions::Regions>,
     /// Regions detected at once (default: the thread count); each holds
@@ -584,10 +586,60 @@ fn write_report_and_views(
     Ok(())
 }
 
+/// Where a region run writes: the labels, part labels, a labelled
+/// `--output` and the report.
+fn region_outputs<'a>(
+    args: &DetectArgs,
+    paths: &'a OutputPaths,
+) -> crate::cmd_regions::RegionOutputs<'a> {
+    crate::cmd_regions::RegionOutputs {
+        labels: paths.labels.as_ref(),
+        parts: paths.parts.as_ref(),
+        output: paths.output.as_ref(),
+        classify: args.classify.map(|c| c.class),
+        report: paths.report.as_ref(),
+    }
+}
+
+/// The region run of a LAS/LAZ `input` streamed from the file, when the
+/// run is one (`cmd_regions::streamed`); `false` when it is not (or the
+/// data give no region side), and the file is read whole.
+fn run_streamed(
+    args: &DetectArgs,
+    input: &std::path::Path,
+    paths: &OutputPaths,
+    timings: &mut Timings,
+) -> Result<bool, CliError> {
+    let whole = !paths.whole_outputs(args).is_empty();
+    let Some(side) = crate::cmd_regions::streamed(
+        input,
+        args.regions,
+        whole,
+        args.background_classes.is_some(),
+        paths.output.as_ref(),
+    )?
+    else {
+        return Ok(false);
+    };
+    crate::cmd_regions::run_streamed(
+        input,
+        side,
+        args.region_jobs.map_or(0, NonZeroUsize::get),
+        &options(args, false),
+        &region_outputs(args, paths),
+        timings,
+    )
+}
+
 /// Runs `detect`.
 pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
     let example = args.input.is_none();
     let paths = OutputPaths::prepare(args, example)?;
+    if let Some(input) = &args.input {
+        if run_streamed(args, input, &paths, timings)? {
+            return Ok(());
+        }
+    }
     let Input {
         cloud,
         normals,
@@ -611,13 +663,7 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
     let keep = keep.as_deref();
     let whole = !paths.whole_outputs(args).is_empty();
     if let Some(side) = crate::cmd_regions::side(args.regions, whole, points) {
-        let out = crate::cmd_regions::RegionOutputs {
-            labels: paths.labels.as_ref(),
-            parts: paths.parts.as_ref(),
-            output: paths.output.as_ref(),
-            classify: args.classify.map(|c| c.class),
-            report: paths.report.as_ref(),
-        };
+        let out = region_outputs(args, &paths);
         let input = crate::cmd_regions::RegionInput {
             name: &name,
             cloud: &cloud,

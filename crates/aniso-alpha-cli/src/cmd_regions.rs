@@ -7,11 +7,17 @@
 //! union and the meshes need a whole run (asking for them without
 //! `--regions` runs whole).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-use aniso_alpha::detect::regions::{detect_by_regions_with_progress, side_for, RegionRun};
+use aniso_alpha::detect::regions::stream::{
+    detect_streamed, refit_streamed, survey, Pieces, Survey,
+};
+use aniso_alpha::detect::regions::{
+    detect_by_regions_with_progress, side_for, side_for_extent, RegionJoin, RegionJoined,
+    RegionRun, REGIONS_ABOVE,
+};
 use aniso_alpha::detect::{DetectError, Primitive};
-use aniso_alpha::io::{self, PointCloud};
+use aniso_alpha::io::{self, PointCloud, ReadOptions};
 use aniso_alpha::options::{region_warnings, DetectOptions, Style};
 use serde_json::json;
 
@@ -246,4 +252,215 @@ fn summary(name: &str, n: usize, side: f64, run: &RegionRun, seconds: f64) -> St
         s.push_str(&format!("  ... {} more (--report)\n", run.parts.len() - 40));
     }
     s
+}
+
+/// Points read from a LAS/LAZ file at a time in a streamed region run
+/// (2^20: 24 MiB of coordinates), as Python's `distributed.detect_tiles`
+/// reads its tiles.
+pub const PIECE_POINTS: u64 = 1 << 20;
+
+/// A LAS/LAZ file read `piece` points at a time.
+struct LasPieces<'a> {
+    path: &'a Path,
+    count: u64,
+    piece: u64,
+}
+
+impl<'a> LasPieces<'a> {
+    /// The pieces of `path`: [`PIECE_POINTS`] points each (the CLI tests
+    /// set smaller pieces through `ANISO_ALPHA_TEST_PIECE_POINTS`).
+    fn new(path: &'a Path) -> Result<Self, CliError> {
+        let piece = std::env::var("ANISO_ALPHA_TEST_PIECE_POINTS")
+            .ok()
+            .and_then(|v| v.parse::<u64>().ok())
+            .filter(|&p| p > 0)
+            .unwrap_or(PIECE_POINTS);
+        Ok(LasPieces {
+            path,
+            count: io::las_point_count(path)?,
+            piece,
+        })
+    }
+
+    /// Piece `k`'s first record and number of records.
+    fn range(&self, k: usize) -> (u64, u64) {
+        let start = k as u64 * self.piece;
+        (start, self.piece.min(self.count - start))
+    }
+
+    /// Piece `k`'s records, for the labelled copy.
+    fn records(&self, k: usize) -> Result<io::LasSource, CliError> {
+        let (start, count) = self.range(k);
+        let cloud = io::read_las_range_records(self.path, start, count)?;
+        cloud
+            .las
+            .map(|l| *l)
+            .ok_or_else(|| CliError::in_file(self.path, "no LAS records read"))
+    }
+}
+
+impl Pieces for LasPieces<'_> {
+    type Error = CliError;
+
+    fn len(&self) -> usize {
+        self.count.div_ceil(self.piece) as usize
+    }
+
+    fn points(&self, k: usize) -> Result<Vec<[f64; 3]>, CliError> {
+        let (start, count) = self.range(k);
+        let options = ReadOptions {
+            attributes: false,
+            ..ReadOptions::default()
+        };
+        Ok(io::read_las_range(self.path, start, count, &options)?.points)
+    }
+}
+
+/// Whether a run of `detect` on the LAS/LAZ file `input` is a region run
+/// streamed from the file (never holding its points whole): `Some(side)`
+/// (`None`: the side from the data) when `--regions` gives a side, or
+/// asks for regions (`auto`, or no flag and no output that needs a whole
+/// run) and the header counts more than `REGIONS_ABOVE` points. Not with
+/// `--background-classes` (the points kept depend on their class) nor a
+/// labelled PLY `--output` (written from the whole cloud): those read the
+/// file whole.
+pub fn streamed(
+    input: &Path,
+    regions: Option<Regions>,
+    whole: bool,
+    background_classes: bool,
+    output: Option<&PathBuf>,
+) -> Result<Option<Option<f64>>, CliError> {
+    let las = matches!(common::input_format(input), Some(io::Format::Las));
+    let las_output = output.is_none_or(|p| {
+        p.extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("las") || e.eq_ignore_ascii_case("laz"))
+    });
+    if !las || background_classes || !las_output {
+        return Ok(None);
+    }
+    Ok(match regions {
+        Some(Regions::Side(s)) => Some(Some(s)),
+        Some(Regions::Off) => None,
+        None if whole => None,
+        Some(Regions::Auto) | None => {
+            let n = io::las_point_count(input)?;
+            (n > REGIONS_ABOVE as u64).then_some(None)
+        }
+    })
+}
+
+/// The region run of a LAS/LAZ file read a piece at a time
+/// (`aniso_alpha::detect::regions::stream`): the same labels, parts and
+/// report as the region run of the file read whole. Returns `false`
+/// without output when the data give no region side (a cloud flat in x
+/// or y): the caller reads the file whole.
+pub fn run_streamed(
+    input: &Path,
+    side: Option<f64>,
+    jobs: usize,
+    options: &DetectOptions,
+    out: &RegionOutputs<'_>,
+    timings: &mut Timings,
+) -> Result<bool, CliError> {
+    let src = LasPieces::new(input)?;
+    let survey = timings.phase("read", || survey(&src))?;
+    let Some(side) = side.or_else(|| side_for_extent(survey.lo, survey.hi, survey.n)) else {
+        return Ok(false);
+    };
+    // The part ids (4 bytes a point) in a scratch file, in a hidden folder
+    // next to the first output (or in the system's temporary folder),
+    // removed at the end or on an interruption.
+    let folder = out
+        .labels
+        .or(out.parts)
+        .or(out.output)
+        .or(out.report)
+        .and_then(|p| p.parent())
+        .filter(|d| !d.as_os_str().is_empty())
+        .map_or_else(std::env::temp_dir, Path::to_path_buf);
+    let scratch = io::ScratchFolder::create(&folder)?;
+    let join = RegionJoin::with_scratch(survey.n, scratch.path())?;
+    let bar = common::progress(0, "regions");
+    let start = std::time::Instant::now();
+    let joined = timings.phase("regions", || {
+        detect_streamed(
+            &src,
+            &survey,
+            side,
+            jobs,
+            join,
+            |ids, sub| options.build_region(ids, sub, None, Style::Cli),
+            &mut |done, total| {
+                bar.set_length(total as u64);
+                bar.set_position(done as u64);
+                true
+            },
+        )
+    })?;
+    bar.finish_and_clear();
+    let run = timings.phase("write", || write_streamed(&src, &survey, &joined, out))?;
+    let seconds = start.elapsed().as_secs_f64();
+    for w in region_warnings(&run) {
+        common::warn(format_args!("{w}"));
+    }
+    let name = input.display().to_string();
+    if let Some(p) = out.report {
+        common::write_json(p, &report(&name, side, &run, seconds), timings)?;
+    }
+    let mut text = summary(&name, survey.n, side, &run, seconds);
+    let read = format!(
+        "  streamed from the file: {} piece(s) of at most {} points, never held whole\n",
+        src.len(),
+        src.piece
+    );
+    let at = text.find('\n').map_or(text.len(), |i| i + 1);
+    text.insert_str(at, &read);
+    common::print_summary(&text)?;
+    Ok(true)
+}
+
+/// The joined parts' fits over the pieces, and in the first pass the
+/// labels, part labels and labelled LAS/LAZ copy, a piece at a time; each
+/// output complete or absent.
+fn write_streamed(
+    src: &LasPieces<'_>,
+    survey: &Survey,
+    joined: &RegionJoined,
+    out: &RegionOutputs<'_>,
+) -> Result<RegionRun, CliError> {
+    let create = |p: Option<&PathBuf>| p.map(|p| io::AtomicWriter::create(p)).transpose();
+    let mut labels = create(out.labels)?;
+    let mut parts = create(out.parts)?;
+    let mut las: Option<io::LasLabelWriter> = None;
+    let run = refit_streamed(src, survey, joined, |k, _, _, structures, part_ids| {
+        if let Some(w) = &mut labels {
+            w.write(|w| crate::cmd_detect::write_ints(w, structures))?;
+        }
+        if let Some(w) = &mut parts {
+            w.write(|w| crate::cmd_detect::write_ints(w, part_ids))?;
+        }
+        if let Some(path) = out.output {
+            let records = src.records(k)?;
+            if las.is_none() {
+                las = Some(io::LasLabelWriter::create(
+                    path,
+                    &records,
+                    src.count,
+                    out.classify,
+                )?);
+            }
+            if let Some(w) = &mut las {
+                w.append(&records.records, structures, part_ids)?;
+            }
+        }
+        Ok(())
+    })?;
+    for w in [labels, parts].into_iter().flatten() {
+        w.finish()?;
+    }
+    if let Some(w) = las {
+        w.finish()?;
+    }
+    Ok(run)
 }

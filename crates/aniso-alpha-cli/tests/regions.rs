@@ -233,3 +233,186 @@ fn regions_warn_once_for_normals_that_disagree() {
     assert_eq!(o.status.code(), Some(0));
     assert!(!String::from_utf8_lossy(&o.stderr).contains("normals disagree"));
 }
+
+/// The labels of a LAS/LAZ file's `structure` and `part` fields.
+fn las_ids(path: &Path) -> (Vec<i64>, Vec<i64>) {
+    let options = aniso_alpha::io::ReadOptions {
+        attributes: true,
+        ..Default::default()
+    };
+    let cloud = aniso_alpha::io::read_points(path, &options).unwrap();
+    let column = |name: &str| -> Vec<i64> {
+        let a = cloud
+            .attributes
+            .iter()
+            .find(|a| a.name == name)
+            .unwrap_or_else(|| panic!("no {name} field"));
+        (0..cloud.points.len())
+            .map(|i| a.values.get_f64(i) as i64)
+            .collect()
+    };
+    (column("structure"), column("part"))
+}
+
+/// A report without its timing.
+fn report_without_seconds(path: &Path) -> serde_json::Value {
+    let mut r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    r.as_object_mut().unwrap().remove("seconds");
+    r
+}
+
+#[test]
+fn a_las_input_is_streamed_a_piece_at_a_time_with_the_whole_reads_result() {
+    let d = TempDir::new("regions", "streamed");
+    let xyz = d.path("scene.xyz");
+    let n = scene(&xyz);
+    // The scene as a LAZ file (a labelled copy of the text input).
+    let laz = d.path("scene.laz");
+    let o = detect_planes(
+        &xyz,
+        &["--regions", "off", "--output", laz.to_str().unwrap()],
+    );
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    // The whole read: a labelled PLY output needs the cloud in memory.
+    let whole_ply = d.path("whole.ply");
+    let whole_report = d.path("whole.json");
+    let (_, whole_l, whole_p) = labelled_run(
+        &d,
+        &laz,
+        "whole",
+        &[
+            "--output",
+            whole_ply.to_str().unwrap(),
+            "--report",
+            whole_report.to_str().unwrap(),
+        ],
+    );
+    // Streamed, in pieces of 1,500 points (LAZ chunks of 50,000: each
+    // piece starts inside a chunk).
+    let out = d.path("out.laz");
+    let report = d.path("streamed.json");
+    let mut args = vec![
+        "detect",
+        laz.to_str().unwrap(),
+        "--structure",
+        "planes",
+        "--regions",
+        "40",
+        "--labels",
+        d.path("s-l.txt").to_str().unwrap().to_string().leak(),
+        "--part-labels",
+        d.path("s-p.txt").to_str().unwrap().to_string().leak(),
+        "--output",
+        out.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+        "--timings",
+    ];
+    let o = Command::new(BIN)
+        .args(&args)
+        .env("ANISO_ALPHA_TEST_PIECE_POINTS", "1500")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        stdout.contains(&format!(
+            "streamed from the file: {} piece(s) of at most 1500 points",
+            n.div_ceil(1500)
+        )),
+        "{stdout}"
+    );
+    let (l, p) = (ints(&d.path("s-l.txt")), ints(&d.path("s-p.txt")));
+    assert_eq!(l.len(), n);
+    assert_eq!((&l, &p), (&whole_l, &whole_p));
+    assert!(p.iter().any(|&x| x > 0), "parts found");
+    assert_eq!(las_ids(&out), (l, p));
+    assert_eq!(
+        report_without_seconds(&report),
+        report_without_seconds(&whole_report)
+    );
+    assert!(hidden(&d).is_empty(), "{:?}", hidden(&d));
+    // The oracle can fail: another region side gives other parts.
+    args[5] = "25";
+    let o = Command::new(BIN).args(&args).output().unwrap();
+    assert_eq!(o.status.code(), Some(0));
+    assert_ne!(
+        report_without_seconds(&report),
+        report_without_seconds(&whole_report)
+    );
+}
+
+/// The hidden entries of `d` (temporary outputs, scratch folders).
+fn hidden(d: &TempDir) -> Vec<String> {
+    std::fs::read_dir(&d.0)
+        .unwrap()
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .filter(|n| n.starts_with('.'))
+        .collect()
+}
+
+#[cfg(unix)]
+#[test]
+fn an_interrupted_streamed_run_leaves_no_scratch_folder() {
+    use std::time::{Duration, Instant};
+    let d = TempDir::new("regions", "streamed-int");
+    let xyz = d.path("scene.xyz");
+    scene(&xyz);
+    let laz = d.path("scene.laz");
+    let o = detect_planes(
+        &xyz,
+        &["--regions", "off", "--output", laz.to_str().unwrap()],
+    );
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    // The labels' writer waits 20 s once the regions are done: the
+    // scratch folder (the part ids) is there until the run ends.
+    let labels = d.path("l.txt");
+    let mut child = Command::new(BIN)
+        .args([
+            "detect",
+            laz.to_str().unwrap(),
+            "--structure",
+            "planes",
+            "--regions",
+            "40",
+        ])
+        .args(["--labels", labels.to_str().unwrap(), "--quiet"])
+        .env("ANISO_ALPHA_TEST_WRITE_DELAY_MS", "20000")
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while !hidden(&d).iter().any(|n| n.starts_with(".l.txt.tmp")) {
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "no temporary labels"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    assert!(
+        hidden(&d)
+            .iter()
+            .any(|n| n.starts_with(".aniso-alpha-scratch-")),
+        "{:?}",
+        hidden(&d)
+    );
+    let killed = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    assert_eq!(child.wait().unwrap().code(), Some(130));
+    assert!(hidden(&d).is_empty(), "{:?}", hidden(&d));
+    assert!(!labels.exists());
+}

@@ -202,9 +202,64 @@ pub fn output_key(path: &Path) -> PathBuf {
 pub fn remove_temp_files() {
     let mut temps = TEMPS.lock().unwrap_or_else(|e| e.into_inner());
     for p in temps.0.drain(..) {
-        let _ = fs::remove_file(p);
+        if fs::remove_file(&p).is_err() {
+            // A scratch folder ([`ScratchFolder`]) and what it holds.
+            let _ = fs::remove_dir_all(p);
+        }
     }
     temps.1 = true;
+}
+
+/// A hidden scratch folder next to an output (`.aniso-alpha-scratch-<pid>-<n>`),
+/// registered as the temporary outputs are: removed with what it holds
+/// when dropped, and by [`remove_temp_files`] (a signal handler's) while
+/// it exists. For the scratch files of a long run (a region run's part
+/// ids), which no interruption should leave behind.
+pub struct ScratchFolder {
+    path: PathBuf,
+}
+
+impl ScratchFolder {
+    /// Creates the folder inside `folder`.
+    ///
+    /// # Errors
+    /// [`IoError::Write`] when it cannot be made (or the process is being
+    /// interrupted).
+    pub fn create(folder: &Path) -> Result<ScratchFolder, IoError> {
+        static COUNTER: AtomicU64 = AtomicU64::new(0);
+        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+        let path = folder.join(format!(".aniso-alpha-scratch-{}-{n}", std::process::id()));
+        let err = |source| IoError::Write {
+            path: path.clone(),
+            source,
+        };
+        {
+            let mut temps = TEMPS.lock().unwrap_or_else(|e| e.into_inner());
+            if temps.1 {
+                return Err(err(std::io::Error::new(
+                    std::io::ErrorKind::Interrupted,
+                    "interrupted",
+                )));
+            }
+            temps.0.push(path.clone());
+        }
+        let scratch = ScratchFolder { path: path.clone() };
+        fs::create_dir(&path).map_err(err)?;
+        Ok(scratch)
+    }
+
+    /// The folder.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+}
+
+impl Drop for ScratchFolder {
+    fn drop(&mut self) {
+        let mut temps = TEMPS.lock().unwrap_or_else(|e| e.into_inner());
+        let _ = fs::remove_dir_all(&self.path);
+        temps.0.retain(|p| p != &self.path);
+    }
 }
 
 fn temp_name(target: &Path, tag: &str) -> PathBuf {
@@ -304,6 +359,16 @@ where
     })
 }
 
+/// Test hook (CLI tests of the signal handler): holds a temporary file
+/// open for `ANISO_ALPHA_TEST_WRITE_DELAY_MS` milliseconds before writing.
+fn test_write_delay() {
+    if let Some(ms) = std::env::var_os("ANISO_ALPHA_TEST_WRITE_DELAY_MS")
+        .and_then(|v| v.to_str().and_then(|s| s.parse::<u64>().ok()))
+    {
+        std::thread::sleep(std::time::Duration::from_millis(ms));
+    }
+}
+
 /// [`atomic_write`] handing the temporary [`File`] itself to `write`
 /// (for writers that seek), which gives it back when done.
 pub(crate) fn atomic_write_file<F>(path: &Path, write: F) -> Result<(), IoError>
@@ -311,13 +376,7 @@ where
     F: FnOnce(File) -> std::io::Result<File>,
 {
     let (pending, file) = PendingFile::create(path)?;
-    // Test hook (CLI tests of the signal handler): hold the temporary file
-    // open for this many milliseconds before writing.
-    if let Some(ms) = std::env::var_os("ANISO_ALPHA_TEST_WRITE_DELAY_MS")
-        .and_then(|v| v.to_str().and_then(|s| s.parse::<u64>().ok()))
-    {
-        std::thread::sleep(std::time::Duration::from_millis(ms));
-    }
+    test_write_delay();
     let file = write(file).map_err(|source| IoError::Write {
         path: path.to_path_buf(),
         source,
@@ -367,6 +426,59 @@ impl PendingFile {
     }
 }
 
+/// An output written over several calls, atomically as [`atomic_write`]
+/// writes (a temporary file, renamed onto the output by
+/// [`AtomicWriter::finish`], removed when dropped before): for outputs
+/// written a piece at a time, such as the labels of a cloud read in
+/// pieces.
+pub struct AtomicWriter {
+    pending: PendingFile,
+    out: BufWriter<File>,
+}
+
+impl AtomicWriter {
+    /// Checks `path` as [`atomic_write`] does and creates the temporary
+    /// file.
+    ///
+    /// # Errors
+    /// As [`atomic_write`].
+    pub fn create(path: &Path) -> Result<AtomicWriter, IoError> {
+        let (pending, file) = PendingFile::create(path)?;
+        test_write_delay();
+        Ok(AtomicWriter {
+            pending,
+            out: BufWriter::with_capacity(BUFFER, file),
+        })
+    }
+
+    /// Writes through `write` (buffered).
+    ///
+    /// # Errors
+    /// [`IoError::Write`] naming the output.
+    pub fn write(
+        &mut self,
+        write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+    ) -> Result<(), IoError> {
+        write(&mut self.out).map_err(|source| IoError::Write {
+            path: self.pending.path.clone(),
+            source,
+        })
+    }
+
+    /// Flushes, syncs and renames the file onto the output.
+    ///
+    /// # Errors
+    /// [`IoError::Write`] naming the output.
+    pub fn finish(self) -> Result<(), IoError> {
+        let path = self.pending.path.clone();
+        let file = self.out.into_inner().map_err(|e| IoError::Write {
+            path,
+            source: e.into_error(),
+        })?;
+        self.pending.commit(file)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -376,6 +488,39 @@ mod tests {
         let _ = fs::remove_dir_all(&d);
         fs::create_dir_all(&d).unwrap();
         d
+    }
+
+    #[test]
+    fn a_writer_over_several_calls_commits_at_the_end_only() {
+        let d = dir("writer");
+        let p = d.join("out.txt");
+        let mut w = AtomicWriter::create(&p).unwrap();
+        w.write(|o| o.write_all(b"ab")).unwrap();
+        w.write(|o| o.write_all(b"c")).unwrap();
+        assert!(!p.exists());
+        w.finish().unwrap();
+        assert_eq!(fs::read(&p).unwrap(), b"abc");
+        // Dropped before its end: nothing, not even the temporary file.
+        let q = d.join("dropped.txt");
+        let mut w = AtomicWriter::create(&q).unwrap();
+        w.write(|o| o.write_all(&[b'x'; 3 << 20])).unwrap();
+        drop(w);
+        assert!(!q.exists());
+        assert_eq!(fs::read_dir(&d).unwrap().count(), 1);
+        fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn a_scratch_folder_goes_when_dropped_or_on_a_signal() {
+        let d = dir("scratch");
+        let a = ScratchFolder::create(&d).unwrap();
+        fs::write(a.path().join("ids"), b"1234").unwrap();
+        assert!(a.path().is_dir() && a.path().starts_with(&d));
+        let kept = a.path().to_path_buf();
+        drop(a);
+        assert!(!kept.exists());
+        assert_eq!(fs::read_dir(&d).unwrap().count(), 0);
+        fs::remove_dir_all(&d).unwrap();
     }
 
     #[test]

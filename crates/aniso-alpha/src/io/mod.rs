@@ -54,6 +54,7 @@ use std::path::Path;
 
 pub use atomic::{
     atomic_write, check_output_path, output_key, remove_temp_files, resolve_output, same_file,
+    AtomicWriter, ScratchFolder,
 };
 pub use attributes::{Attribute, AttributeType, LasSource, Values, Vlr};
 pub use error::IoError;

@@ -37,6 +37,9 @@ pub enum DetectError {
     /// A region run's scratch file (its part ids, kept on disk) could not
     /// be made, written or read (the operating system's message).
     Scratch(String),
+    /// The input read in pieces changed during the run (a piece holds
+    /// other points than when the run began).
+    InputChanged(String),
     /// An internal invariant broke (a bug: please report it).
     Internal(String),
 }
@@ -65,6 +68,7 @@ impl fmt::Display for DetectError {
             DetectError::Anisotropy(e) => write!(f, "anisotropy: {e}"),
             DetectError::Cancelled => write!(f, "cancelled"),
             DetectError::Scratch(m) => write!(f, "the region run's scratch file failed: {m}"),
+            DetectError::InputChanged(m) => write!(f, "the input changed during the run: {m}"),
             DetectError::Internal(m) => write!(f, "internal error (a bug, please report): {m}"),
         }
     }

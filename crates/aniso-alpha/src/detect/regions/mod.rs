@@ -50,6 +50,7 @@
 mod join;
 mod part_ids;
 mod plan;
+pub mod stream;
 
 pub use join::{PartsRefit, RegionJoin, RegionJoined};
 pub use plan::{side_for, side_for_extent, RegionGrid, RegionPlan, RegionWindow, FIRST_MARGIN};
@@ -57,6 +58,7 @@ pub use plan::{side_for, side_for_extent, RegionGrid, RegionPlan, RegionWindow, 
 use super::detection::{Detection, Primitive};
 use super::scan::halo_width;
 use super::{DetectError, Detector};
+use std::borrow::Cow;
 use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
@@ -247,29 +249,30 @@ pub fn detect_by_regions_with_progress(
 }
 
 /// One region's run as the joining takes it: its points (core and margin,
-/// ascending), its step (`None`: a region of one position), and how many
-/// times its margin was widened.
-struct RegionDone {
+/// ascending), its core (ascending, a subset of them), its step (`None`: a
+/// region of one position), and how many times its margin was widened.
+struct RegionDone<'a> {
     ids: Vec<u32>,
+    core: Cow<'a, [u32]>,
     step: Option<RegionStep>,
     widened: usize,
 }
 
 /// Region `r`'s run (module doc, steps 1–2): its detector built on its
 /// core and first margin, estimated again on a wider margin while its
-/// reach asks for one, then run.
-fn run_region(
-    plan: &RegionPlan,
-    points: &[[f64; 3]],
-    r: usize,
+/// reach asks for one, then run. `select(margin)` gives the region's
+/// points within `margin` of its column: their input indices, their
+/// core's, and their coordinates.
+fn run_region<'a, E: From<DetectError>>(
+    first_margin: f64,
+    mut select: impl FnMut(f64) -> Result<Selection<'a>, E>,
     build: &(impl Fn(&[u32], &[[f64; 3]]) -> Result<Detector, DetectError> + Sync),
-) -> Result<RegionDone, DetectError> {
-    let mut margin = plan.first_margin();
+) -> Result<RegionDone<'a>, E> {
+    let mut margin = first_margin;
     let mut widened = 0;
     loop {
-        let ids = plan.points_within(points, r, margin);
-        let sub: Vec<[f64; 3]> = ids.iter().map(|&i| points[i as usize]).collect();
-        let detector = match build(&ids, &sub) {
+        let Selection { ids, core, points } = select(margin)?;
+        let detector = match build(&ids, &points) {
             Ok(d) => d,
             // A region of one position (a stray point, a stack of copies)
             // has no spacing to estimate: its points are background, as a
@@ -277,17 +280,19 @@ fn run_region(
             Err(DetectError::NoSpacing) => {
                 return Ok(RegionDone {
                     ids: Vec::new(),
+                    core: Cow::Borrowed(&[]),
                     step: None,
                     widened,
                 })
             }
-            Err(e) => return Err(e),
+            Err(e) => return Err(e.into()),
         };
         match wider_margin(&detector, margin)? {
             None => {
-                let step = region_step(&detector, &sub)?;
+                let step = region_step(&detector, &points)?;
                 return Ok(RegionDone {
                     ids,
+                    core,
                     step: Some(step),
                     widened,
                 });
@@ -300,21 +305,30 @@ fn run_region(
     }
 }
 
+/// A region's points within a margin of its column: their input indices
+/// (ascending), those of its core, and their coordinates.
+struct Selection<'a> {
+    ids: Vec<u32>,
+    core: Cow<'a, [u32]>,
+    points: Vec<[f64; 3]>,
+}
+
 /// The joining side of a run whose regions finish in any order: the
 /// regions done ahead of their turn wait in `pending`, and each is added
 /// to the join in the plan's order.
-struct InOrder<'a> {
+struct InOrder<'a, 'p, E> {
     joined: RegionJoin,
-    pending: BTreeMap<usize, RegionDone>,
+    pending: BTreeMap<usize, RegionDone<'a>>,
     next: usize,
-    progress: &'a mut (dyn FnMut(usize, usize) -> bool + Send),
+    total: usize,
+    progress: &'p mut (dyn FnMut(usize, usize) -> bool + Send),
     /// The first failure met (region, error).
-    failed: Option<(usize, DetectError)>,
+    failed: Option<(usize, E)>,
 }
 
-impl InOrder<'_> {
+impl<'a, E: From<DetectError>> InOrder<'a, '_, E> {
     /// Takes region `r`'s run and adds every region whose turn has come.
-    fn take(&mut self, plan: &RegionPlan, r: usize, done: RegionDone) -> Result<(), DetectError> {
+    fn take(&mut self, r: usize, done: RegionDone<'a>) -> Result<(), E> {
         self.pending.insert(r, done);
         while let Some(d) = self.pending.remove(&self.next) {
             for _ in 0..d.widened {
@@ -322,42 +336,40 @@ impl InOrder<'_> {
             }
             match &d.step {
                 None => self.joined.add(&[], &[], None)?,
-                Some(step) => self.joined.add(&d.ids, plan.core(self.next), Some(step))?,
+                Some(step) => self.joined.add(&d.ids, &d.core, Some(step))?,
             }
             self.next += 1;
-            if !(self.progress)(self.next, plan.len()) {
-                return Err(DetectError::Cancelled);
+            if !(self.progress)(self.next, self.total) {
+                return Err(DetectError::Cancelled.into());
             }
         }
         Ok(())
     }
 }
 
-/// [`detect_by_regions`], with or without the joining of step 4 (without:
-/// each region's parts stay apart). The regions run as tasks on the
-/// current pool, up to `jobs` at once, each of them parallel inside; a
-/// region's result does not depend on which ran first, and the joining
-/// takes them in the plan's order, so the run is the same for any `jobs`
-/// and any number of threads.
-fn regions_run(
-    points: &[[f64; 3]],
-    side: f64,
-    joining: bool,
+/// Runs regions `0..total` (`run(r)`) as tasks on the current pool, up to
+/// `jobs` at once (0: as many as the pool has threads), and adds each to
+/// `join` in the plan's order; the first region's error (by region) stops
+/// the run. A region's result does not depend on which ran first, so the
+/// joining is the same for any `jobs` and any number of threads.
+fn run_regions<'a, E: From<DetectError> + Send>(
+    total: usize,
     jobs: usize,
-    build: impl Fn(&[u32], &[[f64; 3]]) -> Result<Detector, DetectError> + Sync,
+    join: RegionJoin,
+    run: impl Fn(usize) -> Result<RegionDone<'a>, E> + Sync,
     progress: &mut (dyn FnMut(usize, usize) -> bool + Send),
-) -> Result<RegionRun, DetectError> {
-    let plan = RegionPlan::new(points, side)?;
+) -> Result<RegionJoin, E> {
     let jobs = if jobs == 0 {
         crate::par::threads()
     } else {
         jobs
     }
-    .clamp(1, plan.len());
+    .clamp(1, total.max(1));
     let state = Mutex::new(InOrder {
-        joined: RegionJoin::new(points.len()),
+        joined: join,
         pending: BTreeMap::new(),
         next: 0,
+        total,
         progress,
         failed: None,
     });
@@ -366,12 +378,12 @@ fn regions_run(
     let worker = || {
         while !stop.load(Ordering::Relaxed) {
             let r = next_region.fetch_add(1, Ordering::Relaxed);
-            if r >= plan.len() {
+            if r >= total {
                 return;
             }
-            let done = run_region(&plan, points, r, &build);
+            let done = run(r);
             let mut st = state.lock().unwrap_or_else(|p| p.into_inner());
-            if let Err(e) = done.and_then(|d| st.take(&plan, r, d)) {
+            if let Err(e) = done.and_then(|d| st.take(r, d)) {
                 stop.store(true, Ordering::Relaxed);
                 if st.failed.as_ref().is_none_or(|(f, _)| r < *f) {
                     st.failed = Some((r, e));
@@ -381,10 +393,37 @@ fn regions_run(
     };
     crate::par::spawn_workers(jobs, worker);
     let st = state.into_inner().unwrap_or_else(|p| p.into_inner());
-    if let Some((_, e)) = st.failed {
-        return Err(e);
+    match st.failed {
+        Some((_, e)) => Err(e),
+        None => Ok(st.joined),
     }
-    st.joined.finish_with(points, joining)
+}
+
+/// [`detect_by_regions`], with or without the joining of step 4 (without:
+/// each region's parts stay apart), on a cloud in memory.
+fn regions_run(
+    points: &[[f64; 3]],
+    side: f64,
+    joining: bool,
+    jobs: usize,
+    build: impl Fn(&[u32], &[[f64; 3]]) -> Result<Detector, DetectError> + Sync,
+    progress: &mut (dyn FnMut(usize, usize) -> bool + Send),
+) -> Result<RegionRun, DetectError> {
+    let plan = RegionPlan::new(points, side)?;
+    let run = |r: usize| {
+        let select = |margin: f64| -> Result<Selection<'_>, DetectError> {
+            let ids = plan.points_within(points, r, margin);
+            let sub = ids.iter().map(|&i| points[i as usize]).collect();
+            Ok(Selection {
+                ids,
+                core: Cow::Borrowed(plan.core(r)),
+                points: sub,
+            })
+        };
+        run_region(plan.first_margin(), select, &build)
+    };
+    let join = RegionJoin::new(points.len());
+    run_regions(plan.len(), jobs, join, run, progress)?.finish_with(points, joining)
 }
 
 #[cfg(test)]
