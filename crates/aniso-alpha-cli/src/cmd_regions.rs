@@ -264,6 +264,9 @@ struct LasPieces<'a> {
     path: &'a Path,
     count: u64,
     piece: u64,
+    /// The bar of the pass under way, advanced by each piece read (none
+    /// while the regions read: they have their own).
+    bar: std::sync::Mutex<Option<indicatif::ProgressBar>>,
 }
 
 impl<'a> LasPieces<'a> {
@@ -279,7 +282,18 @@ impl<'a> LasPieces<'a> {
             path,
             count: io::las_point_count(path)?,
             piece,
+            bar: std::sync::Mutex::new(None),
         })
+    }
+
+    /// Shows a bar of `reads` pieces read (`None`: no bar), replacing the
+    /// previous one.
+    fn show(&self, reads: Option<(usize, &str)>) {
+        let mut bar = self.bar.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(b) = bar.take() {
+            b.finish_and_clear();
+        }
+        *bar = reads.map(|(n, msg)| common::progress(n as u64, msg));
     }
 
     /// Piece `k`'s first record and number of records.
@@ -312,7 +326,11 @@ impl Pieces for LasPieces<'_> {
             attributes: false,
             ..ReadOptions::default()
         };
-        Ok(io::read_las_range(self.path, start, count, &options)?.points)
+        let points = io::read_las_range(self.path, start, count, &options)?.points;
+        if let Some(b) = &*self.bar.lock().unwrap_or_else(|e| e.into_inner()) {
+            b.inc(1);
+        }
+        Ok(points)
     }
 }
 
@@ -364,7 +382,9 @@ pub fn run_streamed(
     timings: &mut Timings,
 ) -> Result<bool, CliError> {
     let src = LasPieces::new(input)?;
+    src.show(Some((src.len(), "reading")));
     let survey = timings.phase("read", || survey(&src))?;
+    src.show(None);
     let Some(side) = side.or_else(|| side_for_extent(survey.lo, survey.hi, survey.n)) else {
         return Ok(false);
     };
@@ -399,7 +419,9 @@ pub fn run_streamed(
         )
     })?;
     bar.finish_and_clear();
+    src.show(Some((3 * src.len(), "writing")));
     let run = timings.phase("write", || write_streamed(&src, &survey, &joined, out))?;
+    src.show(None);
     let seconds = start.elapsed().as_secs_f64();
     for w in region_warnings(&run) {
         common::warn(format_args!("{w}"));

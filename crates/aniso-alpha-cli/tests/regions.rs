@@ -350,7 +350,14 @@ fn a_las_input_is_streamed_a_piece_at_a_time_with_the_whole_reads_result() {
     std::fs::write(&bad, bytes).unwrap();
     let bad_out = d.path("bad-out.laz");
     let o = Command::new(BIN)
-        .args(["detect", bad.to_str().unwrap(), "--structure", "planes", "--regions", "40"])
+        .args([
+            "detect",
+            bad.to_str().unwrap(),
+            "--structure",
+            "planes",
+            "--regions",
+            "40",
+        ])
         .args(["--labels", d.path("bad-l.txt").to_str().unwrap()])
         .args(["--output", bad_out.to_str().unwrap()])
         .env("ANISO_ALPHA_TEST_PIECE_POINTS", "1500")
@@ -358,7 +365,10 @@ fn a_las_input_is_streamed_a_piece_at_a_time_with_the_whole_reads_result() {
         .unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
     assert_ne!(o.status.code(), Some(0));
-    assert!(err.contains("bad.laz") && !err.contains("panicked"), "{err}");
+    assert!(
+        err.contains("bad.laz") && !err.contains("panicked"),
+        "{err}"
+    );
     assert!(!bad_out.exists() && !d.path("bad-l.txt").exists());
     assert!(hidden(&d).is_empty(), "{:?}", hidden(&d));
     // The oracle can fail: another region side gives other parts.
