@@ -125,6 +125,15 @@ pub struct RegionInput<'a> {
     pub jobs: usize,
 }
 
+/// A region run's progress function: `bar` shows the regions joined.
+fn advance(bar: &indicatif::ProgressBar) -> impl FnMut(usize, usize) -> bool + Send + '_ {
+    move |done, total| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+        true
+    }
+}
+
 /// The region run of `input` with `options`, then its outputs and summary.
 pub fn run(
     input: &RegionInput<'_>,
@@ -150,11 +159,7 @@ pub fn run(
                 side,
                 jobs,
                 |ids, sub| options.build_region(ids, sub, normals, Style::Cli),
-                &mut |done, total| {
-                    bar.set_length(total as u64);
-                    bar.set_position(done as u64);
-                    true
-                },
+                &mut advance(&bar),
             )
         })
         .map_err(|e: DetectError| CliError::msg(e.to_string()))?;
@@ -411,11 +416,7 @@ pub fn run_streamed(
             jobs,
             join,
             |ids, sub| options.build_region(ids, sub, None, Style::Cli),
-            &mut |done, total| {
-                bar.set_length(total as u64);
-                bar.set_position(done as u64);
-                true
-            },
+            &mut advance(&bar),
         )
     })?;
     bar.finish_and_clear();

@@ -254,20 +254,11 @@ fn las_ids(path: &Path) -> (Vec<i64>, Vec<i64>) {
     (column("structure"), column("part"))
 }
 
-/// A report without its timing.
-fn report_without_seconds(path: &Path) -> serde_json::Value {
-    let mut r: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
-    r.as_object_mut().unwrap().remove("seconds");
-    r
-}
-
-#[test]
-fn a_las_input_is_streamed_a_piece_at_a_time_with_the_whole_reads_result() {
-    let d = TempDir::new("regions", "streamed");
+/// [`scene`] as a LAZ file in `d` (the labelled copy of the text scene),
+/// and its number of points.
+fn scene_laz(d: &TempDir) -> (std::path::PathBuf, usize) {
     let xyz = d.path("scene.xyz");
     let n = scene(&xyz);
-    // The scene as a LAZ file (a labelled copy of the text input).
     let laz = d.path("scene.laz");
     let o = detect_planes(
         &xyz,
@@ -279,6 +270,21 @@ fn a_las_input_is_streamed_a_piece_at_a_time_with_the_whole_reads_result() {
         "{}",
         String::from_utf8_lossy(&o.stderr)
     );
+    (laz, n)
+}
+
+/// A report without its timing.
+fn report_without_seconds(path: &Path) -> serde_json::Value {
+    let mut r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    r.as_object_mut().unwrap().remove("seconds");
+    r
+}
+
+#[test]
+fn a_las_input_is_streamed_a_piece_at_a_time_with_the_whole_reads_result() {
+    let d = TempDir::new("regions", "streamed");
+    let (laz, n) = scene_laz(&d);
     // The whole read: a labelled PLY output needs the cloud in memory.
     let whole_ply = d.path("whole.ply");
     let whole_report = d.path("whole.json");
@@ -395,19 +401,7 @@ fn hidden(d: &TempDir) -> Vec<String> {
 fn an_interrupted_streamed_run_leaves_no_scratch_folder() {
     use std::time::{Duration, Instant};
     let d = TempDir::new("regions", "streamed-int");
-    let xyz = d.path("scene.xyz");
-    scene(&xyz);
-    let laz = d.path("scene.laz");
-    let o = detect_planes(
-        &xyz,
-        &["--regions", "off", "--output", laz.to_str().unwrap()],
-    );
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    let (laz, _) = scene_laz(&d);
     // The labels' writer waits 20 s once the regions are done: the
     // scratch folder (the part ids) is there until the run ends.
     let labels = d.path("l.txt");

@@ -224,32 +224,12 @@ impl KdTree {
     /// Calls `f` with the index of every point within distance `r` of `q`
     /// (inclusive), in tree order.
     pub fn within(&self, q: &[f64; 3], r: f64, mut f: impl FnMut(u32)) {
-        if self.ids.is_empty() {
-            return;
-        }
-        let r2 = r * r;
-        let mut stack: [u32; 64] = [0; 64];
-        let mut top = 1usize;
-        while top > 0 {
-            top -= 1;
-            let node = stack[top] as usize;
-            if box_d2(q, &self.bbox[node]) > r2 {
-                continue;
-            }
-            if self.is_leaf(node) {
-                let (s, e) = self.range[node];
-                for t in s as usize..e as usize {
-                    if d2(q, &self.pts[t]) <= r2 {
-                        f(self.ids[t]);
-                    }
-                }
-            } else {
-                stack[top] = (2 * node + 1) as u32;
-                stack[top + 1] = (2 * node + 2) as u32;
-                top += 2;
-            }
-        }
+        self.any_within(q, r, |i| {
+            f(i);
+            false
+        });
     }
+
     /// The number of points within distance `r` of `q` (inclusive): the
     /// count of [`within`](Self::within)'s calls, without visiting the
     /// points of a node whose box lies inside the ball.

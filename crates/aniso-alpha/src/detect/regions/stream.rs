@@ -32,6 +32,8 @@
 use std::borrow::Cow;
 use std::collections::BTreeSet;
 
+use crate::geometry::bounding_box;
+
 use super::{
     run_region, run_regions, DetectError, Detector, RegionGrid, RegionJoin, RegionJoined,
     RegionRun, Selection,
@@ -76,19 +78,6 @@ pub struct Survey {
     pub hi: [f64; 3],
 }
 
-/// The bounding box of `points` (inverted when there is none).
-fn bounds(points: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for p in points {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    (lo, hi)
-}
-
 /// Reads every piece once, on the current pool (one piece a thread at a
 /// time), and gives `f` its index and points; the results in piece order.
 fn each_piece<P: Pieces, T: Send>(
@@ -107,7 +96,7 @@ fn each_piece<P: Pieces, T: Send>(
 /// [`DetectError::BadParameter`] past 2³² points (a region run numbers
 /// points with 32 bits).
 pub fn survey<P: Pieces>(src: &P) -> Result<Survey, P::Error> {
-    let found = each_piece(src, |_, p| (p.len(), bounds(&p)))?;
+    let found = each_piece(src, |_, p| (p.len(), bounding_box(&p)))?;
     let counts: Vec<usize> = found.iter().map(|f| f.0).collect();
     let mut firsts = Vec::with_capacity(counts.len());
     let mut n = 0usize;
