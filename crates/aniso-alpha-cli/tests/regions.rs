@@ -442,3 +442,54 @@ fn an_interrupted_streamed_run_leaves_no_scratch_folder() {
     assert!(hidden(&d).is_empty(), "{:?}", hidden(&d));
     assert!(!labels.exists());
 }
+
+#[test]
+fn a_copc_file_is_streamed_across_its_chunks_with_the_whole_reads_result() {
+    // COPC: LAZ 1.4 with chunks of varying sizes (its octree's nodes), in
+    // pieces of 100 points that start and end inside them.
+    let copc = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../aniso-alpha/tests/fixtures/las/simple.copc.laz");
+    let d = TempDir::new("regions", "copc");
+    let (streamed, whole) = (d.path("s.txt"), d.path("w.txt"));
+    let o = Command::new(BIN)
+        .args(["detect", copc.to_str().unwrap(), "--structure", "planes"])
+        .args([
+            "--regions",
+            "1000",
+            "--part-labels",
+            streamed.to_str().unwrap(),
+        ])
+        .env("ANISO_ALPHA_TEST_PIECE_POINTS", "100")
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("11 piece(s) of at most 100 points"), "{out}");
+    let ply = d.path("w.ply");
+    let o = detect_planes(
+        &copc,
+        &[
+            "--regions",
+            "1000",
+            "--part-labels",
+            whole.to_str().unwrap(),
+            "--output",
+            ply.to_str().unwrap(),
+        ],
+    );
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let (s, w) = (ints(&streamed), ints(&whole));
+    assert_eq!(s.len(), 1065);
+    assert!(s.iter().any(|&p| p >= 0));
+    assert_eq!(s, w);
+}
