@@ -4,11 +4,16 @@
 //! makes it least explicable by chance, as the significance test measures
 //! it. A line jittered by σ has its points' distances to the line
 //! Rayleigh-distributed; a claim radius of α alone would leave a noisy
-//! line's points out.
+//! line's points out. A line candidate is judged at a wider radius as it
+//! would claim there: fitted again on its points within that radius (a
+//! short piece of a noisy line leans), and the radius chosen brings its
+//! refitted line.
 
 use super::super::cloud::Cloud;
+use super::super::detection::Primitive;
+use super::super::fit::{fit_line_indices, fit_plane_indices};
 use super::super::significance::{log10_n_tests, part_log10_nfa};
-use super::footprint::{for_near, Stamps};
+use super::footprint::{for_near, Footprint, Stamps};
 use super::significance::SHELL_RATIO;
 use super::{Candidate, Shape};
 use crate::par::map_ranges;
@@ -44,8 +49,23 @@ pub(super) fn claim_radii<S: Shape>(cands: &mut [Candidate], cloud: &Cloud<'_>) 
         || Stamps::new(cloud.points().len()),
         |stamp, ci| best_radius::<S>(&cands[ci], cloud, stamp, rho_global, log10_tests),
     );
-    for (c, tau) in cands.iter_mut().zip(taus) {
+    for (c, (tau, fit)) in cands.iter_mut().zip(taus) {
         c.tau = tau;
+        if let Some(fit) = fit {
+            if let Some(foot) = Footprint::new(&fit, cloud.points(), &c.seeds, c.cell) {
+                c.fit = fit;
+                c.foot = foot;
+            }
+        }
+    }
+}
+
+/// `fit` fitted again on the points `ids` (the same kind of primitive).
+fn refit(fit: &Primitive, points: &[[f64; 3]], ids: &[u32]) -> Option<Primitive> {
+    match fit {
+        Primitive::Line(_) => fit_line_indices(points, ids).ok().map(Primitive::Line),
+        Primitive::Plane(_) => fit_plane_indices(points, ids).ok().map(Primitive::Plane),
+        Primitive::None => None,
     }
 }
 
@@ -60,19 +80,19 @@ fn best_radius<S: Shape>(
     stamp: &mut Stamps,
     rho_global: f64,
     log10_tests: f64,
-) -> f64 {
+) -> (f64, Option<Primitive>) {
     let points = cloud.points();
     let base = c.tau;
     let near = S::near(&c.fit, &c.foot, c.cell, &c.seeds, points);
     let radii = S::claim_radii(c, near, rho_global);
     if radii.len() < 2 {
-        return base;
+        return (base, None);
     }
     let vol = |t: f64| near.volume(t);
     // One pass over the points near the candidate, out to the widest
     // radius's shell; each radius then counts its own.
     let reach = SHELL_RATIO * radii.last().copied().unwrap_or(base);
-    let mut dist = Vec::new();
+    let mut near_pts: Vec<(u32, f64)> = Vec::new();
     for_near(
         &c.fit,
         &c.foot,
@@ -80,10 +100,30 @@ fn best_radius<S: Shape>(
         points,
         cloud.index(),
         stamp,
-        &mut |_, d| dist.push(d),
+        &mut |i, d| near_pts.push((i, d)),
     );
-    let mut best = (f64::INFINITY, base);
+    let mut best = (f64::INFINITY, base, None);
     for &r in &radii {
+        // A line as it would claim at r: fitted again on its points within
+        // r. A line candidate is often a short piece of its line (the
+        // chain its ellipsoid followed until a jittered point fell outside
+        // it), and the fit of a few points over a short span leans: the
+        // line's far points lie outside the piece's tube at any radius,
+        // and inside a tube of the line through all of them. A plane's
+        // candidate spans a patch both ways, and is not fitted again.
+        let fit_r = if S::K == 1 && r > base {
+            let within: Vec<u32> = near_pts.iter().filter(|x| x.1 <= r).map(|x| x.0).collect();
+            refit(&c.fit, points, &within)
+        } else {
+            None
+        };
+        let dist: Vec<f64> = match &fit_r {
+            Some(f) => near_pts
+                .iter()
+                .map(|&(i, _)| f.distance(&points[i as usize]))
+                .collect(),
+            None => near_pts.iter().map(|x| x.1).collect(),
+        };
         let outer = SHELL_RATIO * r;
         let residuals: Vec<f64> = dist.iter().copied().filter(|&d| d <= r).collect();
         let shell = dist.iter().filter(|&&d| d > r && d <= outer).count();
@@ -91,18 +131,16 @@ fn best_radius<S: Shape>(
         let rho = rho_local.max(rho_global);
         let nfa = part_log10_nfa(&residuals, S::K, r, rho, &vol, log10_tests);
         if nfa < best.0 - WIDEN_GAIN {
-            best = (nfa, r);
+            best = (nfa, r, fit_r);
         }
     }
-    best.1
+    (best.1, best.2)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::detect::cloud::Copies;
-    use crate::detect::detection::Primitive;
-    use crate::detect::fit::fit_line_indices;
     use crate::rng::SplitMix64;
 
     /// A line of 40 points along x, jittered by σ = 0.3 per coordinate
