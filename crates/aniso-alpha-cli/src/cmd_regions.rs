@@ -387,6 +387,9 @@ pub fn run_streamed(
     timings: &mut Timings,
 ) -> Result<bool, CliError> {
     let src = LasPieces::new(input)?;
+    if src.count == 0 {
+        return Err(CliError::in_file(input, "no points in file"));
+    }
     src.show(Some((src.len(), "reading")));
     let survey = timings.phase("read", || survey(&src))?;
     src.show(None);
