@@ -36,8 +36,9 @@ row as one JSON object as soon as it is measured.
         [--peer cgal_shapes --peer-args "--epsilon 0.15 --cluster-epsilon 0.49 --min-points 100"]
         [--peer-copies 16] [--inputs ply,laz] [--deadline S] [--json FILE]
 
-Needs numpy (and laspy with lazrs for `--inputs laz`) and GNU time
-(`/usr/bin/time`, Debian `time`) for the peak RSS.
+Needs numpy (and laspy with lazrs for `--inputs laz`); GNU time
+(`/usr/bin/time`, Debian `time`) for the peak RSS, else /proc's VmHWM
+read while the command runs.
 """
 import argparse
 import hashlib
@@ -255,18 +256,24 @@ def run_measured(args, timeout):
     process. The child's own `ru_maxrss` from `os.wait4` is not used: Linux
     carries the parent's high-water mark into a child across fork and exec,
     so it reports at least this script's RSS (the copies it holds: 1.3 GiB
-    at 11M points)."""
+    at 11M points). Without GNU time (a bare machine), the command's
+    `VmHWM` is read from /proc every 20 ms until it exits: the last reading,
+    a lower bound of the peak by at most the last 20 ms' growth."""
+    gnu_time = os.path.exists("/usr/bin/time")
     with tempfile.TemporaryFile("w+") as out, tempfile.TemporaryFile("w+") as err, \
             tempfile.NamedTemporaryFile("r") as peak:
+        cmd = ["/usr/bin/time", "-f", "%M", "-o", peak.name, *args] if gnu_time else list(args)
         t = time.perf_counter()
-        p = subprocess.Popen(["/usr/bin/time", "-f", "%M", "-o", peak.name, *args], stdout=out, stderr=err,
-                             text=True, start_new_session=True)
-        try:
-            p.wait(timeout=timeout)
-        except subprocess.TimeoutExpired:
-            os.killpg(p.pid, signal.SIGKILL)
-            p.wait()
-            raise
+        p = subprocess.Popen(cmd, stdout=out, stderr=err, text=True, start_new_session=True)
+        hwm = 0
+        while p.poll() is None:
+            if not gnu_time:
+                hwm = max(hwm, vm_hwm_kib(p.pid))
+            if timeout is not None and time.perf_counter() - t > timeout:
+                os.killpg(p.pid, signal.SIGKILL)
+                p.wait()
+                raise subprocess.TimeoutExpired(args, timeout)
+            time.sleep(0.02)
         wall = time.perf_counter() - t
         out.seek(0)
         err.seek(0)
@@ -274,7 +281,19 @@ def run_measured(args, timeout):
         lines = [x for x in peak.read().splitlines() if x.strip().isdigit()]
     if p.returncode != 0:
         raise subprocess.CalledProcessError(p.returncode, args, o, e)
-    return wall, int(lines[-1]) / 1024, o, e
+    return wall, (int(lines[-1]) if gnu_time else hwm) / 1024, o, e
+
+
+def vm_hwm_kib(pid):
+    """The process's peak resident set so far (`VmHWM`, KiB), 0 when gone."""
+    try:
+        with open(f"/proc/{pid}/status") as f:
+            for line in f:
+                if line.startswith("VmHWM:"):
+                    return int(line.split()[1])
+    except OSError:
+        pass
+    return 0
 
 
 if __name__ == "__main__":
