@@ -272,6 +272,11 @@ struct LasPieces<'a> {
     /// The bar of the pass under way, advanced by each piece read (none
     /// while the regions read: they have their own).
     bar: std::sync::Mutex<Option<indicatif::ProgressBar>>,
+    /// While the labelled copy is written: each piece is read with its
+    /// records, and the last piece's records wait here for the writer
+    /// (one decoding serves the refit and the copy).
+    keep_records: std::sync::atomic::AtomicBool,
+    last_records: std::sync::Mutex<Option<(usize, io::LasSource)>>,
 }
 
 impl<'a> LasPieces<'a> {
@@ -288,6 +293,8 @@ impl<'a> LasPieces<'a> {
             count: io::las_point_count(path)?,
             piece,
             bar: std::sync::Mutex::new(None),
+            keep_records: std::sync::atomic::AtomicBool::new(false),
+            last_records: std::sync::Mutex::new(None),
         })
     }
 
@@ -307,14 +314,25 @@ impl<'a> LasPieces<'a> {
         (start, self.piece.min(self.count - start))
     }
 
-    /// Piece `k`'s records, for the labelled copy.
+    /// Piece `k`'s records, for the labelled copy: those its last read
+    /// kept, else read again.
     fn records(&self, k: usize) -> Result<io::LasSource, CliError> {
+        let mut last = self.last_records.lock().unwrap_or_else(|e| e.into_inner());
+        match last.take() {
+            Some((j, records)) if j == k => Ok(records),
+            _ => Ok(self.read_records(k)?.1),
+        }
+    }
+
+    /// Piece `k`'s points and records.
+    fn read_records(&self, k: usize) -> Result<(Vec<[f64; 3]>, io::LasSource), CliError> {
         let (start, count) = self.range(k);
         let cloud = io::read_las_range_records(self.path, start, count)?;
-        cloud
+        let records = cloud
             .las
             .map(|l| *l)
-            .ok_or_else(|| CliError::in_file(self.path, "no LAS records read"))
+            .ok_or_else(|| CliError::in_file(self.path, "no LAS records read"))?;
+        Ok((cloud.points, records))
     }
 }
 
@@ -331,7 +349,13 @@ impl Pieces for LasPieces<'_> {
             attributes: false,
             ..ReadOptions::default()
         };
-        let points = io::read_las_range(self.path, start, count, &options)?.points;
+        let points = if self.keep_records.load(std::sync::atomic::Ordering::Relaxed) {
+            let (points, records) = self.read_records(k)?;
+            *self.last_records.lock().unwrap_or_else(|e| e.into_inner()) = Some((k, records));
+            points
+        } else {
+            io::read_las_range(self.path, start, count, &options)?.points
+        };
         if let Some(b) = &*self.bar.lock().unwrap_or_else(|e| e.into_inner()) {
             b.inc(1);
         }
@@ -459,6 +483,8 @@ fn write_streamed(
     let mut labels = create(out.labels)?;
     let mut parts = create(out.parts)?;
     let mut las: Option<io::LasLabelWriter> = None;
+    src.keep_records
+        .store(out.output.is_some(), std::sync::atomic::Ordering::Relaxed);
     let run = refit_streamed(src, survey, joined, |k, _, _, structures, part_ids| {
         if let Some(w) = &mut labels {
             w.write(|w| crate::cmd_detect::write_ints(w, structures))?;
@@ -481,7 +507,10 @@ fn write_streamed(
             }
         }
         Ok(())
-    })?;
+    });
+    src.keep_records
+        .store(false, std::sync::atomic::Ordering::Relaxed);
+    let run = run?;
     for w in [labels, parts].into_iter().flatten() {
         w.finish()?;
     }

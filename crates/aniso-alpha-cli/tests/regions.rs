@@ -11,7 +11,18 @@ use common::TempDir;
 const BIN: &str = env!("CARGO_BIN_EXE_aniso-alpha");
 
 fn run(args: &[&str]) -> Output {
-    let o = Command::new(BIN).args(args).output().unwrap();
+    in_pieces(args, None)
+}
+
+/// `run`, reading a LAS/LAZ input of a streamed run in pieces of `piece`
+/// points (`None`: the CLI's own size).
+fn in_pieces(args: &[&str], piece: Option<usize>) -> Output {
+    let mut cmd = Command::new(BIN);
+    cmd.args(args);
+    if let Some(n) = piece {
+        cmd.env("ANISO_ALPHA_TEST_PIECE_POINTS", n.to_string());
+    }
+    let o = cmd.output().unwrap();
     assert!(
         !String::from_utf8_lossy(&o.stderr).contains("panicked"),
         "{}",
@@ -99,6 +110,16 @@ fn labelled_run(
         String::from_utf8_lossy(&o.stderr)
     );
     (o, ints(&labels), ints(&parts))
+}
+
+/// Asserts that `o` exited with status 0, showing its stderr if not.
+fn succeeded(o: &Output) {
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
 }
 
 fn ints(path: &Path) -> Vec<i64> {
@@ -264,12 +285,7 @@ fn scene_laz(d: &TempDir) -> (std::path::PathBuf, usize) {
         &xyz,
         &["--regions", "off", "--output", laz.to_str().unwrap()],
     );
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    succeeded(&o);
     (laz, n)
 }
 
@@ -303,6 +319,7 @@ fn a_las_input_is_streamed_a_piece_at_a_time_with_the_whole_reads_result() {
     // piece starts inside a chunk).
     let out = d.path("out.laz");
     let report = d.path("streamed.json");
+    let (labels, parts) = (d.path("s-l.txt"), d.path("s-p.txt"));
     let mut args = vec![
         "detect",
         laz.to_str().unwrap(),
@@ -311,22 +328,17 @@ fn a_las_input_is_streamed_a_piece_at_a_time_with_the_whole_reads_result() {
         "--regions",
         "40",
         "--labels",
-        d.path("s-l.txt").to_str().unwrap().to_string().leak(),
+        labels.to_str().unwrap(),
         "--part-labels",
-        d.path("s-p.txt").to_str().unwrap().to_string().leak(),
+        parts.to_str().unwrap(),
         "--output",
         out.to_str().unwrap(),
         "--report",
         report.to_str().unwrap(),
         "--timings",
     ];
-    let o = Command::new(BIN)
-        .args(&args)
-        .env("ANISO_ALPHA_TEST_PIECE_POINTS", "1500")
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(0), "{err}");
+    let o = in_pieces(&args, Some(1500));
+    succeeded(&o);
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(
         stdout.contains(&format!(
@@ -335,7 +347,7 @@ fn a_las_input_is_streamed_a_piece_at_a_time_with_the_whole_reads_result() {
         )),
         "{stdout}"
     );
-    let (l, p) = (ints(&d.path("s-l.txt")), ints(&d.path("s-p.txt")));
+    let (l, p) = (ints(&labels), ints(&parts));
     assert_eq!(l.len(), n);
     assert_eq!((&l, &p), (&whole_l, &whole_p));
     assert!(p.iter().any(|&x| x > 0), "parts found");
@@ -354,33 +366,33 @@ fn a_las_input_is_streamed_a_piece_at_a_time_with_the_whole_reads_result() {
         *b ^= 0x5a;
     }
     std::fs::write(&bad, bytes).unwrap();
-    let bad_out = d.path("bad-out.laz");
-    let o = Command::new(BIN)
-        .args([
+    let (bad_out, bad_labels) = (d.path("bad-out.laz"), d.path("bad-l.txt"));
+    let o = in_pieces(
+        &[
             "detect",
             bad.to_str().unwrap(),
             "--structure",
             "planes",
             "--regions",
             "40",
-        ])
-        .args(["--labels", d.path("bad-l.txt").to_str().unwrap()])
-        .args(["--output", bad_out.to_str().unwrap()])
-        .env("ANISO_ALPHA_TEST_PIECE_POINTS", "1500")
-        .output()
-        .unwrap();
+            "--labels",
+            bad_labels.to_str().unwrap(),
+            "--output",
+            bad_out.to_str().unwrap(),
+        ],
+        Some(1500),
+    );
     let err = String::from_utf8_lossy(&o.stderr);
     assert_ne!(o.status.code(), Some(0));
     assert!(
         err.contains("bad.laz") && !err.contains("panicked"),
         "{err}"
     );
-    assert!(!bad_out.exists() && !d.path("bad-l.txt").exists());
+    assert!(!bad_out.exists() && !bad_labels.exists());
     assert!(hidden(&d).is_empty(), "{:?}", hidden(&d));
     // The oracle can fail: another region side gives other parts.
     args[5] = "25";
-    let o = Command::new(BIN).args(&args).output().unwrap();
-    assert_eq!(o.status.code(), Some(0));
+    succeeded(&run(&args));
     assert_ne!(
         report_without_seconds(&report),
         report_without_seconds(&whole_report)
@@ -451,23 +463,20 @@ fn a_copc_file_is_streamed_across_its_chunks_with_the_whole_reads_result() {
         .join("../aniso-alpha/tests/fixtures/las/simple.copc.laz");
     let d = TempDir::new("regions", "copc");
     let (streamed, whole) = (d.path("s.txt"), d.path("w.txt"));
-    let o = Command::new(BIN)
-        .args(["detect", copc.to_str().unwrap(), "--structure", "planes"])
-        .args([
+    let o = in_pieces(
+        &[
+            "detect",
+            copc.to_str().unwrap(),
+            "--structure",
+            "planes",
             "--regions",
             "1000",
             "--part-labels",
             streamed.to_str().unwrap(),
-        ])
-        .env("ANISO_ALPHA_TEST_PIECE_POINTS", "100")
-        .output()
-        .unwrap();
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
+        ],
+        Some(100),
     );
+    succeeded(&o);
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(out.contains("11 piece(s) of at most 100 points"), "{out}");
     let ply = d.path("w.ply");
@@ -482,12 +491,7 @@ fn a_copc_file_is_streamed_across_its_chunks_with_the_whole_reads_result() {
             ply.to_str().unwrap(),
         ],
     );
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    succeeded(&o);
     let (s, w) = (ints(&streamed), ints(&whole));
     assert_eq!(s.len(), 1065);
     assert!(s.iter().any(|&p| p >= 0));

@@ -233,16 +233,7 @@ impl ScratchFolder {
             path: path.clone(),
             source,
         };
-        {
-            let mut temps = TEMPS.lock().unwrap_or_else(|e| e.into_inner());
-            if temps.1 {
-                return Err(err(std::io::Error::new(
-                    std::io::ErrorKind::Interrupted,
-                    "interrupted",
-                )));
-            }
-            temps.0.push(path.clone());
-        }
+        register(&path).map_err(err)?;
         let scratch = ScratchFolder { path: path.clone() };
         fs::create_dir(&path).map_err(err)?;
         Ok(scratch)
@@ -272,6 +263,21 @@ fn temp_name(target: &Path, tag: &str) -> PathBuf {
     output_folder(target).join(format!(".{name}.{tag}-{}-{n}", std::process::id()))
 }
 
+/// Registers `path` for [`remove_temp_files`] (before it is made, so that
+/// a signal handler never misses it); an error once the process is being
+/// interrupted.
+fn register(path: &Path) -> std::io::Result<()> {
+    let mut temps = TEMPS.lock().unwrap_or_else(|e| e.into_inner());
+    if temps.1 {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::Interrupted,
+            "interrupted",
+        ));
+    }
+    temps.0.push(path.to_path_buf());
+    Ok(())
+}
+
 /// A registered temporary file, removed (and unregistered) unless renamed.
 struct TempGuard {
     path: PathBuf,
@@ -281,16 +287,7 @@ impl TempGuard {
     /// Registers `path` and creates it (registered first, so that a signal
     /// handler never misses a file).
     fn create(path: PathBuf) -> std::io::Result<(TempGuard, File)> {
-        {
-            let mut temps = TEMPS.lock().unwrap_or_else(|e| e.into_inner());
-            if temps.1 {
-                return Err(std::io::Error::new(
-                    std::io::ErrorKind::Interrupted,
-                    "interrupted",
-                ));
-            }
-            temps.0.push(path.clone());
-        }
+        register(&path)?;
         let guard = TempGuard { path };
         let file = OpenOptions::new()
             .write(true)
@@ -511,7 +508,7 @@ mod tests {
     }
 
     #[test]
-    fn a_scratch_folder_goes_when_dropped_or_on_a_signal() {
+    fn a_scratch_folder_goes_with_its_content_when_dropped() {
         let d = dir("scratch");
         let a = ScratchFolder::create(&d).unwrap();
         fs::write(a.path().join("ids"), b"1234").unwrap();

@@ -11,7 +11,7 @@
 
 use super::super::cloud::Cloud;
 use super::super::detection::Primitive;
-use super::super::fit::{fit_line_indices, fit_plane_indices};
+use super::super::fit::fit_line_indices;
 use super::super::significance::{log10_n_tests, part_log10_nfa};
 use super::footprint::{for_near, Footprint, Stamps};
 use super::significance::SHELL_RATIO;
@@ -60,15 +60,6 @@ pub(super) fn claim_radii<S: Shape>(cands: &mut [Candidate], cloud: &Cloud<'_>) 
     }
 }
 
-/// `fit` fitted again on the points `ids` (the same kind of primitive).
-fn refit(fit: &Primitive, points: &[[f64; 3]], ids: &[u32]) -> Option<Primitive> {
-    match fit {
-        Primitive::Line(_) => fit_line_indices(points, ids).ok().map(Primitive::Line),
-        Primitive::Plane(_) => fit_plane_indices(points, ids).ok().map(Primitive::Plane),
-        Primitive::None => None,
-    }
-}
-
 /// The claim radius of one candidate: among its shape's radii
 /// ([`Shape::claim_radii`]), the one of smallest NFA, a wider one only if
 /// it lowers the NFA by [`WIDEN_GAIN`]. The local density is measured in
@@ -113,7 +104,7 @@ fn best_radius<S: Shape>(
         // candidate spans a patch both ways, and is not fitted again.
         let fit_r = if S::K == 1 && r > base {
             let within: Vec<u32> = near_pts.iter().filter(|x| x.1 <= r).map(|x| x.0).collect();
-            refit(&c.fit, points, &within)
+            fit_line_indices(points, &within).ok().map(Primitive::Line)
         } else {
             None
         };

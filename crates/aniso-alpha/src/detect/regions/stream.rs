@@ -78,13 +78,15 @@ pub struct Survey {
     pub hi: [f64; 3],
 }
 
-/// Reads every piece once, on the current pool (one piece a thread at a
-/// time), and gives `f` its index and points; the results in piece order.
-fn each_piece<P: Pieces, T: Send>(
-    src: &P,
-    f: impl Fn(usize, Vec<[f64; 3]>) -> T + Sync,
-) -> Result<Vec<T>, P::Error> {
-    crate::par::map_ranges(src.len(), || (), |_, k| src.points(k).map(|p| f(k, p)))
+/// Reads every piece once through `read` (piece `k`'s points), on the
+/// current pool (one piece a thread at a time), and gives `f` its points;
+/// the results in piece order.
+fn each_piece<E: Send, T: Send>(
+    pieces: usize,
+    read: impl Fn(usize) -> Result<Vec<[f64; 3]>, E> + Sync,
+    f: impl Fn(Vec<[f64; 3]>) -> T + Sync,
+) -> Result<Vec<T>, E> {
+    crate::par::map_ranges(pieces, || (), |_, k| read(k).map(&f))
         .into_iter()
         .collect()
 }
@@ -96,7 +98,11 @@ fn each_piece<P: Pieces, T: Send>(
 /// [`DetectError::BadParameter`] past 2³² points (a region run numbers
 /// points with 32 bits).
 pub fn survey<P: Pieces>(src: &P) -> Result<Survey, P::Error> {
-    let found = each_piece(src, |_, p| (p.len(), bounding_box(&p)))?;
+    let found = each_piece(
+        src.len(),
+        |k| src.points(k),
+        |p| (p.len(), bounding_box(&p)),
+    )?;
     let counts: Vec<usize> = found.iter().map(|f| f.0).collect();
     let mut firsts = Vec::with_capacity(counts.len());
     let mut n = 0usize;
@@ -167,7 +173,8 @@ pub fn detect_streamed<P: Pieces>(
 ) -> Result<RegionJoined, P::Error> {
     let grid = RegionGrid::of_extent(survey.lo, side)?;
     let mut cells = BTreeSet::new();
-    for piece in each_piece(src, |_, p| grid.cells(&p))? {
+    let again = |k| piece_again(src, survey, k);
+    for piece in each_piece(src.len(), again, |p| grid.cells(&p))? {
         cells.extend(piece);
     }
     let cells: Vec<(i64, i64)> = cells.into_iter().collect();
