@@ -3,7 +3,8 @@
 //! `main` parses the command line (clap; bad usage exits 2), sets up the
 //! global options, dispatches to one module per subcommand and turns any
 //! error into one line `error: <message>` on stderr with exit status 1.
-#![forbid(unsafe_code)]
+// One call into glibc (`memory::one_arena`) is the only unsafe code.
+#![deny(unsafe_code)]
 
 mod cmd_alpha;
 mod cmd_delaunay;
@@ -13,6 +14,7 @@ mod cmd_regions;
 mod cmd_synth;
 mod cmd_view;
 mod common;
+mod memory;
 mod picture;
 mod view;
 
@@ -186,6 +188,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
 }
 
 fn main() -> ExitCode {
+    memory::one_arena();
     install_panic_hook();
     common::install_signal_cleanup();
     let cli = Cli::parse();

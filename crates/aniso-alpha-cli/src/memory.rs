@@ -1,0 +1,47 @@
+//! The process's allocator setting: one glibc malloc arena.
+//!
+//! glibc's malloc gives a thread that finds the main arena busy an arena of
+//! its own, up to eight per core, and memory freed into one arena serves
+//! only that arena's later requests. A detection allocates its working
+//! buffers on every worker thread in turn (the orientations'
+//! triangulations and faces, then the incidences, candidates and claims of
+//! the assembly), so each arena keeps the high-water mark of its own
+//! threads, and the peak resident memory is their sum. With one arena,
+//! every thread reuses what any thread freed. On the corpus this lowers
+//! the peak RSS by a quarter to a third at the same wall time
+//! (BENCHMARKS.md, "One malloc arena"); malloc and free take under 1% of
+//! the cycles of a detection, so the one lock they share is rarely
+//! contended. Small requests still come from glibc's lock-free per-thread
+//! cache.
+//!
+//! Only the command-line program sets this: the Python extension lives in
+//! the interpreter's process, whose allocator is not its to tune. A user's
+//! own arena setting (`MALLOC_ARENA_MAX`, or `arena_max` in
+//! `GLIBC_TUNABLES`) is left as it is: it is also how the many-core
+//! benchmark (`scripts/device_scaling.sh`) times glibc's default beside
+//! this one.
+
+/// Limits glibc's malloc to one arena, unless the environment sets the
+/// arena count. Called first in `main`, before any thread exists.
+///
+/// Not tested by a unit test: glibc's `mallopt` answers 1 for any
+/// parameter, known or not, and has no reading back; the effect is the
+/// peak RSS measured in BENCHMARKS.md.
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+#[allow(unsafe_code)]
+pub fn one_arena() {
+    let tunables = std::env::var("GLIBC_TUNABLES").unwrap_or_default();
+    if std::env::var_os("MALLOC_ARENA_MAX").is_some() || tunables.contains("arena_max") {
+        return;
+    }
+    // SAFETY: mallopt only sets a parameter of glibc's allocator, and may
+    // be called at any time; had it no effect, the default arenas would
+    // stay, which is correct too, only larger.
+    unsafe {
+        libc::mallopt(libc::M_ARENA_MAX, 1);
+    }
+}
+
+/// Limits glibc's malloc to one arena: without glibc, nothing to set.
+#[cfg(not(all(target_os = "linux", target_env = "gnu")))]
+pub fn one_arena() {}
