@@ -1,14 +1,14 @@
 //! The process's allocator setting: one glibc malloc arena.
 //!
-//! glibc's malloc gives a thread that finds the main arena busy an arena of
-//! its own, up to eight per core, and memory freed into one arena serves
-//! only that arena's later requests. A detection allocates its working
+//! glibc's malloc attaches each new thread to an arena of its own (up to
+//! eight per core; a finished thread's arena goes to the next), and memory
+//! freed into one arena serves only that arena's later requests. A detection allocates its working
 //! buffers on every worker thread in turn (the orientations'
 //! triangulations and faces, then the incidences, candidates and claims of
 //! the assembly), so each arena keeps the high-water mark of its own
 //! threads, and the peak resident memory is their sum. With one arena,
 //! every thread reuses what any thread freed. On the corpus this lowers
-//! the peak RSS by a quarter to a third at the same wall time
+//! the peak RSS by a third on most scans (12–49%) at the same wall time
 //! (BENCHMARKS.md, "One malloc arena"); malloc and free take under 1% of
 //! the cycles of a detection, so the one lock they share is rarely
 //! contended. Small requests still come from glibc's lock-free per-thread
