@@ -34,6 +34,10 @@ cloud whole, and the labelled tiles are written to OUT (the F1 read back
 from them). `--one-file` concatenates the tiling's LAS files into one LAS
 file (their records in list order: the same cloud) and runs
 `detect_tiles` on that file alone, which tasks and driver read in pieces.
+`--kill-after S` kills one worker process S seconds into each run (a
+machine lost mid-run; the run must finish with the same outputs: with
+`--tiles` the labelled tiles' SHA-256 is printed, to compare with a run
+without it). The worker peak RSS is then the survivors' and the new one's.
 
     .venv/bin/python scripts/bench_distributed.py --regions --workers 2 \
         --tiling ahn_2386_9702.ply 48 --per-file 8 --memory-limit 3GiB
@@ -103,6 +107,8 @@ def main() -> None:
                     help="with --tiles: detect_tiles' piece (default: the package's PIECE_POINTS)")
     ap.add_argument("--tiles", default=None, metavar="OUT",
                     help="with --tiling: distributed.detect_tiles, the labelled tiles written to OUT")
+    ap.add_argument("--kill-after", type=float, default=None, metavar="S",
+                    help="with --regions: kill one worker process (SIGKILL) S seconds into each run")
     args = ap.parse_args()
     if args.regions:
         return regions(args)
@@ -163,6 +169,41 @@ def peak_rss_mib() -> float:
     import resource
 
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
+def kill_a_worker_after(client, seconds: float, log: list):
+    """A timer that kills one worker process of `client` (the first by
+    address) with SIGKILL `seconds` from now, as a machine lost mid-run
+    would; its nanny starts a new one and Dask runs the lost tasks again.
+    What happened is appended to `log`."""
+    import signal
+    import threading
+
+    def kill() -> None:
+        try:
+            pids = client.run(os.getpid)
+            addr = sorted(pids)[0]
+            os.kill(pids[addr], signal.SIGKILL)
+            log.append(f"killed worker {addr} (pid {pids[addr]}) at {seconds:.0f} s")
+        except Exception as e:  # the run may have ended first
+            log.append(f"no worker killed: {e!r}")
+
+    timer = threading.Timer(seconds, kill)
+    timer.daemon = True
+    timer.start()
+    return timer
+
+
+def outputs_digest(paths: list) -> str:
+    """SHA-256 of the output files' bytes, in order (first 16 hex digits)."""
+    import hashlib
+
+    h = hashlib.sha256()
+    for p in paths:
+        with open(p, "rb") as f:
+            while chunk := f.read(64 << 20):
+                h.update(chunk)
+    return h.hexdigest()[:16]
 
 
 def tiling(scan: str, k: int, per_file: int, workdir: str) -> list:
@@ -324,6 +365,8 @@ def regions(args: argparse.Namespace) -> None:
             cluster = LocalCluster(n_workers=w, threads_per_worker=1, processes=True, dashboard_address=None,
                                    memory_limit=args.memory_limit or "auto")
             client = Client(cluster)
+            killed: list = []
+            timer = kill_a_worker_after(client, args.kill_after, killed) if args.kill_after else None
             try:
                 t0 = time.perf_counter()
                 if args.tiles:
@@ -332,6 +375,8 @@ def regions(args: argparse.Namespace) -> None:
                 else:
                     r = distributed.detect_regions(pts, "planes", client=client)
                 t = time.perf_counter() - t0
+                if timer is not None:
+                    timer.cancel()
                 workers = client.run(peak_rss_mib)
             finally:
                 client.close()
@@ -342,6 +387,10 @@ def regions(args: argparse.Namespace) -> None:
             driver = peak_rss_mib()
             print(f"| {n:,} | {w} worker(s){' (tiles)' if args.tiles else ''} | {t:.1f} | {r.regions} "
                   f"| {len(r.parts)} | {driver:.0f} | {max(workers.values()):.0f} | {same} |", flush=True)
+            for line in killed:
+                print(line, flush=True)
+            if args.tiles:
+                print(f"labelled tiles' SHA-256: {outputs_digest(r.outputs)}", flush=True)
             if args.tiling:
                 # After the driver's peak was read: the labels are read back
                 # from the outputs one file at a time.
