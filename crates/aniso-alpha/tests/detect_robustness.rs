@@ -134,6 +134,34 @@ fn lines_in_ten_times_the_background() {
 }
 
 #[test]
+fn short_lines_whose_fit_leans_on_background_points_are_still_significant() {
+    // Seed 5 at 10× background: two lines of ten exact points are
+    // extracted with three or four background points near their ends, and
+    // their least-squares fits (and the fits of their better halves) lean
+    // by up to 0.6 α: log₁₀ NFA 0.5 and 0.7, rejected (3 lines of 5 found,
+    // F1 0.70). The line through two of a part's points, one of the test's
+    // own primitives, holds the ten exactly.
+    let scene = SceneOptions::lines()
+        .background_density_in_box(0.1)
+        .seed(5)
+        .generate()
+        .unwrap();
+    let det = lines(&scene);
+    let ev = score(&scene, &det);
+    eprintln!("lines 10x background, seed 5: {ev}");
+    assert_eq!(ev.structures_found, 5, "{ev}");
+    assert!(ev.f1 >= 0.85, "{ev}");
+    for s in &det.structures {
+        assert!(
+            s.log10_nfa <= 0.0,
+            "structure {} log10 NFA {}",
+            s.id,
+            s.log10_nfa
+        );
+    }
+}
+
+#[test]
 fn planes_jittered_by_a_tenth_of_the_spacing() {
     let scene = SceneOptions::planes()
         .jitter_of_spacing(0.1)
