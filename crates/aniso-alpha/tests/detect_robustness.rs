@@ -18,6 +18,18 @@ fn score(scene: &Scene, det: &Detection) -> Evaluation {
     .unwrap()
 }
 
+/// Every structure kept is significant, and says how much.
+fn assert_all_significant(det: &Detection) {
+    for s in &det.structures {
+        assert!(
+            s.log10_nfa <= 0.0,
+            "structure {} log10 NFA {}",
+            s.id,
+            s.log10_nfa
+        );
+    }
+}
+
 fn lines(scene: &Scene) -> Detection {
     Detector::lines(1.0, 10.0, 4).run(&scene.points).unwrap()
 }
@@ -75,15 +87,7 @@ fn lines_in_three_times_the_background_and_the_test_rejects_chance_chains() {
     eprintln!("lines 3x background: {ev}");
     assert!(ev.f1 >= 0.85, "{ev}");
     assert!(ev.structures_found >= 4, "{ev}");
-    // Every structure kept is significant, and says how much.
-    for s in &det.structures {
-        assert!(
-            s.log10_nfa <= 0.0,
-            "structure {} log10 NFA {}",
-            s.id,
-            s.log10_nfa
-        );
-    }
+    assert_all_significant(&det);
     // Without the test (nb_c alone, the paper) chance chains pile up:
     // the test is what keeps the precision.
     let off = Detector::lines(1.0, 10.0, 4)
@@ -151,14 +155,7 @@ fn short_lines_whose_fit_leans_on_background_points_are_still_significant() {
     eprintln!("lines 10x background, seed 5: {ev}");
     assert_eq!(ev.structures_found, 5, "{ev}");
     assert!(ev.f1 >= 0.85, "{ev}");
-    for s in &det.structures {
-        assert!(
-            s.log10_nfa <= 0.0,
-            "structure {} log10 NFA {}",
-            s.id,
-            s.log10_nfa
-        );
-    }
+    assert_all_significant(&det);
 }
 
 #[test]

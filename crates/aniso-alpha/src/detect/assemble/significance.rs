@@ -4,10 +4,12 @@
 //! part, and the parts above ε dropped.
 
 use super::super::cloud::Cloud;
+use super::super::detection::Primitive;
+use super::super::fit::LineFit;
 use super::super::significance::{log10_n_tests, part_log10_nfa};
 use super::footprint::{for_near, Stamps};
 use super::{Candidate, Draft, Footprint, Shape};
-use crate::geometry::{dot, norm, normalize, sub};
+use crate::geometry::{normalize, sub};
 use crate::par::map_ranges;
 
 /// Ratio of the outer to the inner radius of the shell in which the local
@@ -100,7 +102,7 @@ fn part_nfa<S: Shape>(
     let tests = log10_tests + std::f64::consts::LOG10_2;
     let mut nfa = part_log10_nfa(&residuals, S::K, tau, rho, &vol, tests);
     let core_fit = S::fit(points, &core);
-    if !matches!(core_fit, super::super::detection::Primitive::None) {
+    if !matches!(core_fit, Primitive::None) {
         let core_res: Vec<f64> = p
             .members
             .iter()
@@ -151,17 +153,17 @@ fn pair_line_nfa(
     let mut best: Option<f64> = None;
     for (a, p) in picks.iter().enumerate() {
         for q in &picks[a + 1..] {
-            let Some(dir) = normalize(sub(*q, *p)) else {
+            let Some(direction) = normalize(sub(*q, *p)) else {
                 continue;
             };
+            let line = Primitive::Line(LineFit {
+                centroid: *p,
+                direction,
+                rms_residual: 0.0,
+                extent: 0.0,
+            });
             for (r, &v) in residuals.iter_mut().zip(members) {
-                let w = sub(points[v as usize], *p);
-                let along = dot(w, dir);
-                *r = norm([
-                    w[0] - along * dir[0],
-                    w[1] - along * dir[1],
-                    w[2] - along * dir[2],
-                ]);
+                *r = line.distance(&points[v as usize]);
             }
             let nfa = part_log10_nfa(&residuals, 1, tau, rho, vol, tests);
             best = Some(best.map_or(nfa, |b: f64| b.min(nfa)));
