@@ -59,10 +59,13 @@ pub trait Simplex: Copy + Ord + sealed::Sealed {
     /// Key of face `i` (0 ≤ i < VERTICES) of a canonical simplex: the
     /// vertex for an edge, `(a << 32) | b` (a < b) for a triangle's edge.
     fn face_key(&self, i: usize) -> u64;
+    /// `face_key >> LEAD_SHIFT` is the face's smallest vertex.
+    const LEAD_SHIFT: u32;
 }
 
 impl Simplex for [u32; 2] {
     const VERTICES: usize = 2;
+    const LEAD_SHIFT: u32 = 0;
     fn canonical(self) -> Option<Self> {
         let [a, b] = self;
         match a.cmp(&b) {
@@ -78,6 +81,7 @@ impl Simplex for [u32; 2] {
 
 impl Simplex for [u32; 3] {
     const VERTICES: usize = 3;
+    const LEAD_SHIFT: u32 = 32;
     fn canonical(self) -> Option<Self> {
         let mut s = self;
         s.sort_unstable();
@@ -138,6 +142,45 @@ pub(crate) struct Incidence {
     k: usize,
 }
 
+/// The half-faces h = s·k + i (face i of simplex s) of canonical
+/// simplices, sorted by (face key, h): each face's simplices in ascending
+/// order. Where the keys' leading vertices are dense (fewer than the
+/// half-faces), a counting sort by that vertex, then each vertex's few
+/// half-faces by key: 4 bytes a half-face and a count a vertex. Elsewhere
+/// (a small piece of a large cloud), (key, h) pairs sorted: 16 bytes a
+/// half-face. The two orders are the same.
+fn half_faces_by_key<S: Simplex>(unique: &[S]) -> Vec<u32> {
+    let k = S::VERTICES;
+    let m = unique.len() * k;
+    let key = |h: usize| unique[h / k].face_key(h % k);
+    let lead = |h: usize| (key(h) >> S::LEAD_SHIFT) as usize;
+    let top = (0..m).map(lead).max().unwrap_or(0);
+    if top >= m {
+        let mut pairs: Vec<(u64, u32)> = (0..m).map(|h| (key(h), h as u32)).collect();
+        pairs.sort_unstable();
+        return pairs.into_iter().map(|(_, h)| h).collect();
+    }
+    let mut start = vec![0u32; top + 2];
+    for h in 0..m {
+        start[lead(h) + 1] += 1;
+    }
+    for v in 0..=top {
+        start[v + 1] += start[v];
+    }
+    let mut half = vec![0u32; m];
+    let mut next = start.clone();
+    for h in 0..m {
+        let slot = &mut next[lead(h)];
+        half[*slot as usize] = h as u32;
+        *slot += 1;
+    }
+    drop(next);
+    for w in start.windows(2) {
+        half[w[0] as usize..w[1] as usize].sort_unstable_by_key(|&h| (key(h as usize), h));
+    }
+    half
+}
+
 impl Incidence {
     pub(crate) fn new<S: Simplex>(simplices: &[S]) -> Result<Self, FilterError> {
         // Incidence counts (3 per triangle) must fit u32 as well.
@@ -152,42 +195,45 @@ impl Incidence {
         let mut order: Vec<u32> = (0..canon.len() as u32).collect();
         order.sort_unstable_by(|&a, &b| canon[a as usize].cmp(&canon[b as usize]).then(a.cmp(&b)));
         let mut input_to_unique = vec![0u32; canon.len()];
-        let mut unique: Vec<S> = Vec::with_capacity(canon.len());
         let mut unique_to_input: Vec<u32> = Vec::with_capacity(canon.len());
+        let mut last: Option<S> = None;
         for &i in &order {
             let s = canon[i as usize];
-            if unique.last() != Some(&s) {
-                unique.push(s);
+            if last != Some(s) {
+                last = Some(s);
                 unique_to_input.push(i);
             }
-            input_to_unique[i as usize] = (unique.len() - 1) as u32;
+            input_to_unique[i as usize] = (unique_to_input.len() - 1) as u32;
         }
+        drop(order);
+        unique_to_input.shrink_to_fit();
+        let unique: Vec<S> = unique_to_input.iter().map(|&i| canon[i as usize]).collect();
+        drop(canon);
         let k = S::VERTICES;
         let n = unique.len();
-        let mut pairs: Vec<(u64, u32)> = Vec::with_capacity(n * k);
-        for (si, s) in unique.iter().enumerate() {
-            for i in 0..k {
-                pairs.push((s.face_key(i), si as u32));
-            }
-        }
-        pairs.sort_unstable();
+        let key = |h: u32| unique[h as usize / k].face_key(h as usize % k);
+        let mut half = half_faces_by_key(&unique);
         let mut simplex_faces = vec![0u32; n * k];
         let mut fill = vec![0u8; n];
-        let mut face_start: Vec<u32> = Vec::with_capacity(pairs.len() / 2 + 2);
-        let mut face_simplices: Vec<u32> = Vec::with_capacity(pairs.len());
+        let mut face_start: Vec<u32> = Vec::with_capacity(half.len() / 2 + 2);
         let mut last_key = None;
-        for (idx, &(key, s)) in pairs.iter().enumerate() {
+        for (idx, h) in half.iter_mut().enumerate() {
+            let key = key(*h);
             if last_key != Some(key) {
                 face_start.push(idx as u32);
                 last_key = Some(key);
             }
             let f = (face_start.len() - 1) as u32;
-            face_simplices.push(s);
-            let slot = &mut fill[s as usize];
-            simplex_faces[s as usize * k + *slot as usize] = f;
+            let s = *h as usize / k;
+            let slot = &mut fill[s];
+            simplex_faces[s * k + *slot as usize] = f;
             *slot += 1;
+            // The half-face becomes its simplex: the faces' CSR list.
+            *h = s as u32;
         }
-        face_start.push(pairs.len() as u32);
+        face_start.push(half.len() as u32);
+        face_start.shrink_to_fit();
+        let face_simplices = half;
         Ok(Self {
             input_to_unique,
             unique_to_input,

@@ -73,14 +73,15 @@ pub fn outline(points: &[[f64; 3]], ids: &[u32], plane: &PlaneFit, r: f64) -> Ou
             w[0] * a1[0] + w[1] * a1[1] + w[2] * a1[2],
         )
     };
-    let mut verts: Vec<V> = ids
-        .iter()
-        .map(|&i| V {
-            p: uv(&points[i as usize]),
-            id: i,
-        })
-        .filter(|v| v.p.x.is_finite() && v.p.y.is_finite())
-        .collect();
+    let mut verts: Vec<V> = Vec::with_capacity(ids.len());
+    verts.extend(
+        ids.iter()
+            .map(|&i| V {
+                p: uv(&points[i as usize]),
+                id: i,
+            })
+            .filter(|v| v.p.x.is_finite() && v.p.y.is_finite()),
+    );
     // Merge equal 2D positions (keep the smallest index).
     verts.sort_by(|a, b| {
         (a.p.x, a.p.y, a.id)
@@ -100,7 +101,7 @@ pub fn outline(points: &[[f64; 3]], ids: &[u32], plane: &PlaneFit, r: f64) -> Ou
     // points wide, claimed along a fitted plane) has no triangle at r: the
     // radius doubles until one is kept, up to the convex hull (r = ∞), so
     // every planar part of three non-collinear points has an outline.
-    let mut triangles: Vec<[u32; 3]> = Vec::new();
+    let mut triangles: Vec<[u32; 3]> = Vec::with_capacity(tri.num_inner_faces());
     // Per face index of the triangulation: kept.
     let mut kept = vec![false; tri.num_all_faces()];
     let mut r2 = r * r;

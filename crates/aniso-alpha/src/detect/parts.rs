@@ -118,16 +118,15 @@ fn grow<S: Simplex>(
     }
     let inc = Incidence::new(simplices)?;
     let n = inc.n;
-    let axis: Vec<Option<[f64; 3]>> = inc
+    // Each unique simplex's axis, NaN where it has none: 24 bytes, not
+    // an `Option`'s 32 (a NaN axis is alike to none, as `None` was).
+    let axis: Vec<[f64; 3]> = inc
         .unique_to_input
         .iter()
-        .map(|&i| axes(&simplices[i as usize]))
+        .map(|&i| axes(&simplices[i as usize]).unwrap_or([f64::NAN; 3]))
         .collect();
     let cos_tol = max_angle_deg.to_radians().cos();
-    let alike = |a: usize, b: usize| match (axis[a], axis[b]) {
-        (Some(u), Some(v)) => dot(u, v).abs() >= cos_tol,
-        _ => false,
-    };
+    let alike = |a: usize, b: usize| dot(axis[a], axis[b]).abs() >= cos_tol;
     // Like-oriented neighbour counts (through faces).
     let mut support = vec![0u32; n];
     for (s, sup) in support.iter_mut().enumerate() {
@@ -155,7 +154,7 @@ fn grow<S: Simplex>(
         let id = next;
         next += 1;
         part[seed as usize] = id;
-        if axis[seed as usize].is_none() {
+        if axis[seed as usize].iter().any(|x| x.is_nan()) {
             continue;
         }
         stack.push(seed);

@@ -263,6 +263,6 @@ pub(crate) fn finish<S: Shape>(
     }
     // 6. Structures, outlines, labels.
     clock.time(Stage::Structures, || {
-        structures::detection::<S>(cloud, regime.kind(), &parts, &cands, &claims, &kept, stats)
+        structures::detection::<S>(cloud, regime.kind(), parts, cands, claims, kept, stats)
     })
 }

@@ -12,36 +12,58 @@ use super::super::cloud::Cloud;
 use super::super::detection::{Detection, Part, RunStats, Simplices, Structure};
 use super::super::StructureKind;
 use super::claims::Claims;
-use super::shape::{crosses, PartShape};
+use super::shape::crosses;
 use super::{Candidate, Draft, Shape};
 use crate::par::map_ranges;
 use crate::unionfind::UnionFind;
 
 /// The detection of `parts` (module doc); `claims` are the candidates'
-/// final claims, `kept` the cleaned union.
+/// final claims, `kept` the cleaned union. What the outlines do not need
+/// (the claims, the candidates but their cells, the union) is dropped
+/// before they are drawn, and the parts' members move into the
+/// detection: a large part's 2D triangulation is the last peak of a
+/// run's memory.
 pub(super) fn detection<S: Shape>(
     cloud: &Cloud<'_>,
     kind: StructureKind,
-    parts: &[Draft],
-    cands: &[Candidate],
-    claims: &Claims,
-    kept: &[S],
+    parts: Vec<Draft>,
+    cands: Vec<Candidate>,
+    claims: Claims,
+    kept: Vec<S>,
     mut stats: RunStats,
 ) -> Detection {
     let points = cloud.points();
-    let groups = group_parts::<S>(parts, cands.len(), claims, points);
+    let groups = group_parts::<S>(&parts, cands.len(), &claims, points);
+    drop(claims);
+    // Each part's cell (its candidate's), in the order they are numbered.
+    let cells: Vec<f64> = groups
+        .iter()
+        .flatten()
+        .map(|&pi| cands[parts[pi as usize].cand].cell)
+        .collect();
+    drop(cands);
+    let (mut structures, vstruct, vpart) = number::<S>(parts, groups, points);
+    let (simplices, simplex_structure) = simplices(&mut structures, &kept, &vstruct, &vpart);
+    drop(kept);
+    stats.structure_simplices = simplices.len();
     // Each part's outline and mesh, or segment, the parts in parallel.
-    let mut shapes: Vec<PartShape> = map_ranges(
-        parts.len(),
+    let numbered: Vec<&Part> = structures.iter().flat_map(|st| &st.parts).collect();
+    let shapes = map_ranges(
+        numbered.len(),
         || (),
-        |_, pi| {
-            let p = &parts[pi];
-            S::outline(&p.fit, &p.members, cands[p.cand].cell, points)
+        |_, k| {
+            S::outline(
+                &numbered[k].primitive,
+                &numbered[k].vertices,
+                cells[k],
+                points,
+            )
         },
     );
-    let (mut structures, vstruct, vpart) = number::<S>(parts, groups, &mut shapes, points);
-    let (simplices, simplex_structure) = simplices(&mut structures, kept, &vstruct, &vpart);
-    stats.structure_simplices = simplices.len();
+    let parts = structures.iter_mut().flat_map(|st| st.parts.iter_mut());
+    for (part, (outline, mesh)) in parts.zip(shapes) {
+        (part.outline, part.mesh) = (outline, mesh);
+    }
     let first = cloud.copies().first().to_vec();
     let labels: Vec<i64> = first
         .iter()
@@ -108,33 +130,30 @@ fn group_parts<S: Shape>(
         .collect()
 }
 
-/// The structures of `groups` (their parts, in order) with their parts'
-/// `shapes`, and per point its structure and its global part number (as
-/// in the report), `u32::MAX` for none.
+/// The structures of `groups` (their parts, in order; outlines and
+/// meshes not yet drawn), and per point its structure and its global part
+/// number (as in the report), `u32::MAX` for none.
 fn number<S: Shape>(
-    parts: &[Draft],
+    parts: Vec<Draft>,
     groups: Vec<Vec<u32>>,
-    shapes: &mut [PartShape],
     points: &[[f64; 3]],
 ) -> (Vec<Structure>, Vec<u32>, Vec<u32>) {
     let mut vstruct = vec![u32::MAX; points.len()];
     let mut vpart = vec![u32::MAX; points.len()];
     let mut structures: Vec<Structure> = Vec::with_capacity(groups.len());
     let mut part_base = 0u32;
+    let mut parts: Vec<Option<Draft>> = parts.into_iter().map(Some).collect();
     for (id, ps) in groups.into_iter().enumerate() {
         let sparts: Vec<Part> = ps
             .iter()
-            .map(|&pi| {
-                let p = &parts[pi as usize];
-                let (outline, mesh) = std::mem::take(&mut shapes[pi as usize]);
-                Part {
-                    simplices: Vec::new(),
-                    vertices: p.members.clone(),
-                    primitive: p.fit.clone(),
-                    outline,
-                    mesh,
-                    log10_nfa: p.log10_nfa,
-                }
+            .filter_map(|&pi| parts[pi as usize].take())
+            .map(|p| Part {
+                simplices: Vec::new(),
+                vertices: p.members,
+                primitive: p.fit,
+                outline: Vec::new(),
+                mesh: Vec::new(),
+                log10_nfa: p.log10_nfa,
             })
             .collect();
         let mut v: Vec<u32> = sparts
@@ -240,10 +259,10 @@ mod tests {
         let det = detection::<[u32; 2]>(
             &cloud,
             StructureKind::Lines,
-            &parts,
-            &cands,
-            &claims,
-            &kept,
+            parts,
+            cands,
+            claims,
+            kept,
             RunStats::default(),
         );
         assert_eq!(det.structures.len(), 2);

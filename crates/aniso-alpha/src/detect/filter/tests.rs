@@ -303,3 +303,52 @@ fn grid_patches_match_oracle() {
         })
         .unwrap();
 }
+
+/// The half-faces of `s` sorted by (face key, h) with the (key, h) pairs
+/// themselves: the oracle of [`half_faces_by_key`].
+fn half_faces_naive<S: Simplex>(s: &[S]) -> Vec<u32> {
+    let k = S::VERTICES;
+    let mut pairs: Vec<(u64, u32)> = (0..s.len() * k)
+        .map(|h| (s[h / k].face_key(h % k), h as u32))
+        .collect();
+    pairs.sort_unstable();
+    pairs.into_iter().map(|(_, h)| h).collect()
+}
+
+/// Random canonical simplices over `n` vertices numbered from `base`.
+fn random_simplices<S: Simplex>(
+    rng: &mut crate::rng::SplitMix64,
+    count: usize,
+    n: u64,
+    base: u32,
+    make: impl Fn([u32; 3]) -> Option<S>,
+) -> Vec<S> {
+    let mut out = Vec::new();
+    while out.len() < count {
+        let v = [0, 1, 2].map(|_| base + rng.below(n) as u32);
+        if let Some(s) = make(v) {
+            out.push(s);
+        }
+    }
+    out
+}
+
+/// The counting sort by leading vertex (dense vertex ids) and the pairs'
+/// sort (ids far apart) give the oracle's order, edges and triangles;
+/// and a wrong order is told apart.
+#[test]
+fn half_faces_sorted_by_key_dense_and_sparse() {
+    let mut rng = crate::rng::SplitMix64::new(91);
+    for (n, base) in [(40u64, 0u32), (400, 0), (2000, 0), (40, 3_000_000_000)] {
+        let tris = random_simplices(&mut rng, 500, n, base, <[u32; 3] as Simplex>::canonical);
+        let edges = random_simplices(&mut rng, 500, n, base, |v| {
+            <[u32; 2] as Simplex>::canonical([v[0], v[1]])
+        });
+        assert_eq!(half_faces_by_key(&tris), half_faces_naive(&tris));
+        assert_eq!(half_faces_by_key(&edges), half_faces_naive(&edges));
+    }
+    // The oracle can fail: the half-faces in their own order are not it.
+    let tris = random_simplices(&mut rng, 50, 20, 0, <[u32; 3] as Simplex>::canonical);
+    let identity: Vec<u32> = (0..150).collect();
+    assert_ne!(identity, half_faces_naive(&tris));
+}

@@ -21,9 +21,10 @@
 //! whose smallest input index lies in its cube: the union is exactly the
 //! job's `F_{k,α,Q}` (tested against the untiled result). Tiles bound the
 //! memory of one triangulation and are independent tasks (in parallel here,
-//! or spread over machines). On 4 threads or more, a job of many points
-//! is cut into tiles for the threads alone ([`parallel_side`]): the same
-//! faces, its triangulations at once.
+//! or spread over machines). A job of many points is always cut so
+//! ([`tile_side`], tiles of about [`TILE_POINTS`] points): the same faces,
+//! one triangulation's memory bounded, its tiles on the pool's threads at
+//! once.
 //!
 //! The path filter is not local (a path can cross tiles): it runs on the
 //! job's gathered simplices. The union is a set, sorted; each simplex keeps
@@ -314,7 +315,7 @@ fn raw_faces_at<S: Face>(
     let Some(side) = tile.filter(|&s| s.is_finite() && s > 0.0) else {
         let (map, q) = pruned(points, ids, a, radius, pruning);
         let n = map.len();
-        let faces = match parallel_side(points, &map, job) {
+        let faces = match tile_side(points, &map, job) {
             Some(side) => faces_in_tiles::<S>(points, &map, &q, alphas, side, halo_width(job))?,
             None => {
                 let mut faces = faces_at::<S>(q, &map, alphas, &|_| true)?;
@@ -356,47 +357,47 @@ fn raw_faces_at<S: Face>(
     Ok((faces, triangulated))
 }
 
-/// Points per tile of a large job cut for the threads ([`parallel_side`]):
-/// 2^15, enough tiles for 16 threads on the ground of an airborne region
-/// of 500,000 points, each still a triangulation of tens of milliseconds
-/// beside which a tile's own costs (its points from the kd-tree, its first
-/// tetrahedron) are small. On the AHN tiles the halo is about 1 m against
-/// tiles of 50–70 m: 3–4% of a tile's points are triangulated twice.
+/// Points per tile of a large job ([`tile_side`]): 2^15. One
+/// triangulation holds about 7 cells of 32 bytes a point besides its
+/// points, so a job of 72,000 points (the table of a depth frame) held
+/// 18 MB at once, as much as CGAL's Efficient RANSAC's whole process on
+/// that frame; cut, its two tiles run on two threads at once, and a larger
+/// job's tiles a few at a time. Measured on the train half (2 threads,
+/// BENCHMARKS.md "Peaks of one stage at a time"): 2^14 cost the simulated
+/// room 45% more scan time (its walls' halos, 2α·λ with λ = 7.9, are a
+/// fifth of a tile) for 8% less memory; 2^16 left the depth frames' table
+/// whole; 2^15 gave the house 13% less peak at the same time. It is also
+/// enough tiles for 16 threads on an airborne region of 500,000 points,
+/// each still a triangulation of tens of milliseconds beside which a
+/// tile's own costs (its points from the kd-tree, its first tetrahedron)
+/// are small.
 #[cfg(not(test))]
-const PARALLEL_TILE_POINTS: usize = 1 << 15;
+const TILE_POINTS: usize = 1 << 15;
 /// A few hundred points in the tests, so that small clouds take the path.
 #[cfg(test)]
-const PARALLEL_TILE_POINTS: usize = 1 << 8;
+const TILE_POINTS: usize = 1 << 8;
 
-/// Threads from which a large job is cut into tiles run at once: 4. On
-/// two threads the scan's other jobs already share them, and cutting
-/// gained nothing (the 697k-point AHN tiling on 2 cores: scan stage 1.82 s
-/// cut, 1.80 s whole, medians of 3); on 16 threads it ran 3.4× faster
-/// than on one (BENCHMARKS.md, "Threads").
-const PARALLEL_TILE_THREADS: usize = 4;
-
-/// The tile side at which a large job's kept points `map` are cut so that
-/// its tiles run on the pool's threads at once, or `None` for one
-/// triangulation: with fewer than [`PARALLEL_TILE_THREADS`] threads, fewer
-/// than two tiles' worth of points, or where the halo (2α·λ_max) leaves
-/// tiles less than eight halos wide. The result does not depend on it
-/// (module doc: the tiles' union is the job's `F_{k,α,Q}` exactly), so the
-/// choice may follow the thread count; the points triangulated are counted
-/// once, as untiled.
-fn parallel_side(points: &[[f64; 3]], map: &[u32], job: &Job<'_>) -> Option<f64> {
-    let threads = crate::par::threads();
-    if threads < PARALLEL_TILE_THREADS || map.len() < 2 * PARALLEL_TILE_POINTS {
+/// The tile side at which a large job's kept points `map` are cut, so that
+/// no triangulation holds much more than [`TILE_POINTS`] points and the
+/// tiles run on the pool's threads at once, or `None` for one
+/// triangulation: fewer than two tiles' worth of points, or a halo
+/// (2α·λ_max) that leaves tiles less than eight halos wide. The result
+/// does not depend on it (module doc: the tiles' union is the job's
+/// `F_{k,α,Q}` exactly); the points triangulated are counted once, as
+/// untiled.
+fn tile_side(points: &[[f64; 3]], map: &[u32], job: &Job<'_>) -> Option<f64> {
+    if map.len() < 2 * TILE_POINTS {
         return None;
     }
-    let tiles = (map.len() / PARALLEL_TILE_POINTS).min(4 * threads);
+    let tiles = map.len() / TILE_POINTS;
     let (lo, hi) = crate::geometry::bounding_box_of(points, map);
     let mut ext = [0, 1, 2].map(|k| hi[k] - lo[k]);
     ext.sort_unstable_by(f64::total_cmp);
     // Cubes over the two largest extents: a surface's points (a scan's
-    // ground, a facade) spread over two of them.
+    // ground, a facade, a table) spread over two of them.
     let side = (ext[1] * ext[2] / tiles as f64).sqrt();
     let h = halo_width(job);
-    (side.is_finite() && side >= 8.0 * h && ext[2] >= 2.0 * side).then_some(side)
+    (side.is_finite() && side >= 8.0 * h && ext[2] > side).then_some(side)
 }
 
 /// `F_{k,α,Q}` at each α of `alphas` of the kept points `map` (transforms
@@ -543,11 +544,46 @@ mod tests {
             .collect()
     }
 
-    /// A large job cut into tiles for the threads gives the faces of one
-    /// triangulation, edges and triangles, at several α; and it was cut.
+    /// Faces per α, and the points triangulated.
+    #[cfg(feature = "parallel")]
+    type Run<S> = (Vec<Vec<S>>, usize);
+
+    /// The faces of `job` at `alphas`: one triangulation of every kept
+    /// point (the oracle), and the job as run on 1 and 4 threads.
+    #[cfg(feature = "parallel")]
+    fn whole_and_run<S: Face + Ord>(
+        pts: &[[f64; 3]],
+        job: &Job<'_>,
+        alphas: &[f64],
+    ) -> (Vec<Vec<S>>, Vec<Run<S>>) {
+        let all: Vec<u32> = (0..pts.len() as u32).collect();
+        let (map, q) = pruned(
+            pts,
+            &all,
+            &job.anisotropy,
+            prune_radius(job),
+            &Pruning::Grid,
+        );
+        let mut whole = faces_at::<S>(q, &map, alphas, &|_| true).unwrap();
+        whole.iter_mut().for_each(|f| f.sort_unstable());
+        let runs = [1, 4]
+            .map(|threads| {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap();
+                pool.install(|| raw_faces_at::<S>(pts, job, alphas, &Pruning::Grid, None).unwrap())
+            })
+            .to_vec();
+        (whole, runs)
+    }
+
+    /// A large job is cut into tiles, on one thread as on four, and gives
+    /// the faces of one triangulation of all its kept points, edges and
+    /// triangles, at several α.
     #[cfg(feature = "parallel")]
     #[test]
-    fn a_job_cut_for_the_threads_has_the_untiled_faces() {
+    fn a_large_job_cut_into_tiles_has_the_faces_of_one_triangulation() {
         let pts = ground();
         let anisotropy = Anisotropy::plane([0.0, 0.0, 1.0], [1.0, 0.0, 0.0], 2.0, 2.0).unwrap();
         let job = Job {
@@ -556,44 +592,26 @@ mod tests {
             ids: None,
             group: 0,
         };
-        let alphas = [0.3, 0.4, 0.5];
-        let on = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            pool.install(|| {
-                let (map, _) = pruned(
-                    &pts,
-                    &(0..6000).collect::<Vec<u32>>(),
-                    &job.anisotropy,
-                    prune_radius(&job),
-                    &Pruning::Grid,
-                );
-                let side = parallel_side(&pts, &map, &job);
-                let e =
-                    raw_faces_at::<[u32; 2]>(&pts, &job, &alphas, &Pruning::Grid, None).unwrap();
-                let t =
-                    raw_faces_at::<[u32; 3]>(&pts, &job, &alphas, &Pruning::Grid, None).unwrap();
-                (side, e, t)
-            })
-        };
-        let (side1, e1, t1) = on(1);
-        let (side4, e4, t4) = on(4);
-        assert_eq!(side1, None);
-        let side = side4.expect("cut into tiles on 4 threads");
-        assert!(side < 50.0, "{side}");
-        let sizes = |f: &[Vec<[u32; 2]>]| f.iter().map(Vec::len).collect::<Vec<_>>();
-        assert!(
-            e1 == e4,
-            "edges {:?} against {:?}",
-            sizes(&e1.0),
-            sizes(&e4.0)
+        let all: Vec<u32> = (0..6000).collect();
+        let (map, _) = pruned(
+            &pts,
+            &all,
+            &job.anisotropy,
+            prune_radius(&job),
+            &Pruning::Grid,
         );
-        assert!(t1.0 == t4.0, "triangles differ");
-        assert!(e1.0.iter().all(|f| !f.is_empty()) && t1.0[2].len() > 1000);
-        // The faces grow with α, and the tiles count each point once.
-        assert!(t1.0[0].len() < t1.0[2].len());
-        assert_eq!(t1.1, t4.1);
+        let side = tile_side(&pts, &map, &job).expect("cut into tiles");
+        assert!(side < 50.0, "{side}");
+        let alphas = [0.3, 0.4, 0.5];
+        let (whole_e, runs_e) = whole_and_run::<[u32; 2]>(&pts, &job, &alphas);
+        let (whole_t, runs_t) = whole_and_run::<[u32; 3]>(&pts, &job, &alphas);
+        for (e, t) in runs_e.iter().zip(&runs_t) {
+            assert!(e.0 == whole_e, "edges differ");
+            assert!(t.0 == whole_t, "triangles differ");
+            assert_eq!(t.1, map.len());
+        }
+        assert!(whole_e.iter().all(|f| !f.is_empty()) && whole_t[2].len() > 1000);
+        // The faces grow with α.
+        assert!(whole_t[0].len() < whole_t[2].len());
     }
 }
