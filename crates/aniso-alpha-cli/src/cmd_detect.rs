@@ -403,6 +403,7 @@ fn detect_points(
     let detector = timings
         .phase("estimate", || options.build(points, normals, Style::Cli))
         .map_err(in_file)?;
+    crate::memory::release_free();
     let threads = rayon::current_num_threads();
     for w in run_warnings(&options, &detector, points.len(), threads, Style::Cli) {
         common::warn(format_args!("{w}"));
@@ -422,6 +423,7 @@ fn detect_points(
     let observe = {
         let stages = stages.clone();
         move |stage: Stage, secs: f64| {
+            crate::memory::release_free();
             if let Ok(mut s) = stages.lock() {
                 s.push((stage, secs));
             }

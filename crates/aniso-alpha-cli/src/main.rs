@@ -3,7 +3,8 @@
 //! `main` parses the command line (clap; bad usage exits 2), sets up the
 //! global options, dispatches to one module per subcommand and turns any
 //! error into one line `error: <message>` on stderr with exit status 1.
-// One call into glibc (`memory::one_arena`) is the only unsafe code.
+// Two calls into glibc (`memory::one_arena`, `memory::release_free`) are
+// the only unsafe code.
 #![deny(unsafe_code)]
 
 mod cmd_alpha;
