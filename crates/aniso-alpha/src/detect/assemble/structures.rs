@@ -20,9 +20,9 @@ use crate::unionfind::UnionFind;
 /// The detection of `parts` (module doc); `claims` are the candidates'
 /// final claims, `kept` the cleaned union. What the outlines do not need
 /// (the claims, the candidates but their cells, the union) is dropped
-/// before they are drawn, and the parts' members move into the
-/// detection: a large part's 2D triangulation is the last peak of a
-/// run's memory.
+/// before they are drawn, the parts' members move into the detection,
+/// and the union's simplices are listed after: a large part's 2D
+/// triangulation is the last peak of a run's memory.
 pub(super) fn detection<S: Shape>(
     cloud: &Cloud<'_>,
     kind: StructureKind,
@@ -43,10 +43,8 @@ pub(super) fn detection<S: Shape>(
         .collect();
     drop(cands);
     let (mut structures, vstruct, vpart) = number::<S>(parts, groups, points);
-    let (simplices, simplex_structure) = simplices(&mut structures, &kept, &vstruct, &vpart);
-    drop(kept);
-    stats.structure_simplices = simplices.len();
-    // Each part's outline and mesh, or segment, the parts in parallel.
+    // Each part's outline and mesh, or segment, the parts in parallel;
+    // then the union's simplices into the structures.
     let numbered: Vec<&Part> = structures.iter().flat_map(|st| &st.parts).collect();
     let shapes = map_ranges(
         numbered.len(),
@@ -64,6 +62,9 @@ pub(super) fn detection<S: Shape>(
     for (part, (outline, mesh)) in parts.zip(shapes) {
         (part.outline, part.mesh) = (outline, mesh);
     }
+    let (simplices, simplex_structure) = simplices(&mut structures, &kept, &vstruct, &vpart);
+    drop(kept);
+    stats.structure_simplices = simplices.len();
     let first = cloud.copies().first().to_vec();
     let labels: Vec<i64> = first
         .iter()
@@ -198,15 +199,23 @@ fn simplices<S: Shape>(
         .enumerate()
         .flat_map(|(s, st)| (0..st.parts.len() as u32).map(move |p| (s as u32, p)))
         .collect();
-    let mut simplices = Simplices::new(S::K + 1);
-    let mut simplex_structure: Vec<u32> = Vec::new();
+    let structure_of = |vs: &[u32]| -> Option<u32> {
+        let st = vstruct[vs[0] as usize];
+        (st != u32::MAX && vs.iter().all(|&v| vstruct[v as usize] == st)).then_some(st)
+    };
+    // Counted first, so that the lists hold no spare capacity.
+    let count = kept
+        .iter()
+        .filter(|s| structure_of(s.as_ref()).is_some())
+        .count();
+    let mut flat: Vec<u32> = Vec::with_capacity(count * (S::K + 1));
+    let mut simplex_structure: Vec<u32> = Vec::with_capacity(count);
     for s in kept {
         let vs = s.as_ref();
-        let st = vstruct[vs[0] as usize];
-        if st == u32::MAX || !vs.iter().all(|&v| vstruct[v as usize] == st) {
+        let Some(st) = structure_of(vs) else {
             continue;
-        }
-        let idx = simplices.len() as u32;
+        };
+        let idx = simplex_structure.len() as u32;
         let gp = vpart[vs[0] as usize];
         if vs.iter().all(|&v| vpart[v as usize] == gp) {
             let (_, p) = part_index[gp as usize];
@@ -215,9 +224,16 @@ fn simplices<S: Shape>(
                 .push(idx);
         }
         structures[st as usize].simplices.push(idx);
-        simplices.push(vs);
+        flat.extend_from_slice(vs);
         simplex_structure.push(st);
     }
+    for st in structures.iter_mut() {
+        st.simplices.shrink_to_fit();
+        st.parts
+            .iter_mut()
+            .for_each(|p| p.simplices.shrink_to_fit());
+    }
+    let simplices = Simplices::from_flat(S::K + 1, flat);
     (simplices, simplex_structure)
 }
 
