@@ -280,6 +280,30 @@ pub(crate) fn tile_cell(p: &[f64; 3], side: f64) -> [i64; 3] {
     p.map(|x| (x / side).floor() as i64)
 }
 
+/// The cubes a large job is cut into ([`tile_side`]): side `side`, corner
+/// of cube (0, 0, 0) at `origin`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct TileGrid {
+    side: f64,
+    origin: [f64; 3],
+}
+
+impl TileGrid {
+    /// The cube that owns point `p`.
+    fn cell(&self, p: &[f64; 3]) -> [i64; 3] {
+        [0, 1, 2].map(|k| ((p[k] - self.origin[k]) / self.side).floor() as i64)
+    }
+
+    /// The lower and upper corners of cube `t`.
+    fn bounds(&self, t: [i64; 3]) -> ([f64; 3], [f64; 3]) {
+        let corner = |c: i64, k: usize| self.origin[k] + c as f64 * self.side;
+        (
+            [0, 1, 2].map(|k| corner(t[k], k)),
+            [0, 1, 2].map(|k| corner(t[k] + 1, k)),
+        )
+    }
+}
+
 /// Unfiltered `F_{k,α,Q}` of one job, as sorted input-index simplices, and
 /// the number of points triangulated. With `tile = Some(side)`, the job's
 /// points are cut into tiles with halos (module doc).
@@ -316,7 +340,7 @@ fn raw_faces_at<S: Face>(
         let (map, q) = pruned(points, ids, a, radius, pruning);
         let n = map.len();
         let faces = match tile_side(points, &map, job) {
-            Some(side) => faces_in_tiles::<S>(points, &map, &q, alphas, side, halo_width(job))?,
+            Some(grid) => faces_in_tiles::<S>(points, &map, &q, alphas, grid, halo_width(job))?,
             None => {
                 let mut faces = faces_at::<S>(q, &map, alphas, &|_| true)?;
                 faces.iter_mut().for_each(|f| f.sort_unstable());
@@ -327,7 +351,11 @@ fn raw_faces_at<S: Face>(
     };
     // Tiles: integer cells of side `side`; halo `h` around each.
     let h = halo_width(job);
-    let cell = |p: &[f64; 3]| -> [i64; 3] { tile_cell(p, side) };
+    let grid = TileGrid {
+        side,
+        origin: [0.0; 3],
+    };
+    let cell = |p: &[f64; 3]| -> [i64; 3] { grid.cell(p) };
     let mut keyed: Vec<([i64; 3], u32)> = ids
         .iter()
         .map(|&i| (cell(&points[i as usize]), i))
@@ -339,7 +367,7 @@ fn raw_faces_at<S: Face>(
     let mut faces: Vec<Vec<S>> = vec![Vec::new(); alphas.len()];
     let mut triangulated = 0usize;
     for t in tiles {
-        let sub = tile_points(points, &index, t, side, h);
+        let sub = tile_points(points, &index, grid.bounds(t), h);
         let (map, q) = pruned(points, &sub, a, radius, &Pruning::Grid);
         triangulated += map.len();
         let owned = |v: u32| cell(&points[v as usize]) == t;
@@ -357,35 +385,36 @@ fn raw_faces_at<S: Face>(
     Ok((faces, triangulated))
 }
 
-/// Points per tile of a large job ([`tile_side`]): 2^15. One
+/// Points per tile of a large job ([`tile_side`]): 2^14. One
 /// triangulation holds about 7 cells of 32 bytes a point besides its
 /// points, so a job of 72,000 points (the table of a depth frame) held
 /// 18 MB at once, as much as CGAL's Efficient RANSAC's whole process on
-/// that frame; cut, its two tiles run on two threads at once, and a larger
-/// job's tiles a few at a time. Measured on the train half (2 threads,
-/// BENCHMARKS.md "Peaks of one stage at a time"): 2^14 cost the simulated
-/// room 45% more scan time (its walls' halos, 2α·λ with λ = 7.9, are a
-/// fifth of a tile) for 8% less memory; 2^16 left the depth frames' table
-/// whole; 2^15 gave the house 13% less peak at the same time. It is also
-/// enough tiles for 16 threads on an airborne region of 500,000 points,
-/// each still a triangulation of tens of milliseconds beside which a
-/// tile's own costs (its points from the kd-tree, its first tetrahedron)
-/// are small.
+/// that frame; cut, its tiles run on the threads at once, a few at a
+/// time. Measured on the train half (BENCHMARKS.md, "Peaks of one stage
+/// at a time"; 2 threads, tiles of 2^14 / 2^15 / 2^16 / never): mOSD
+/// learn 5 peak 35 / 37 / 38 / 40 MB, scan 0.12 / 0.13 / 0.19 / 0.19 s;
+/// the simulated house 5.2 / 4.9 / 4.9 / 5.9 s; the room and the AHN
+/// tile alike within 0.03 s. On one thread a tile's own costs (its halo,
+/// its points from the kd-tree, its first tetrahedron) cost the house's
+/// scan 12%.
 #[cfg(not(test))]
-const TILE_POINTS: usize = 1 << 15;
+const TILE_POINTS: usize = 1 << 14;
 /// A few hundred points in the tests, so that small clouds take the path.
 #[cfg(test)]
 const TILE_POINTS: usize = 1 << 8;
 
-/// The tile side at which a large job's kept points `map` are cut, so that
-/// no triangulation holds much more than [`TILE_POINTS`] points and the
-/// tiles run on the pool's threads at once, or `None` for one
-/// triangulation: fewer than two tiles' worth of points, or a halo
-/// (2α·λ_max) that leaves tiles less than eight halos wide. The result
-/// does not depend on it (module doc: the tiles' union is the job's
-/// `F_{k,α,Q}` exactly); the points triangulated are counted once, as
-/// untiled.
-fn tile_side(points: &[[f64; 3]], map: &[u32], job: &Job<'_>) -> Option<f64> {
+/// The cubes in which a large job's kept points `map` are cut, so that no
+/// triangulation holds much more than [`TILE_POINTS`] points and the tiles
+/// run on the pool's threads at once, or `None` for one triangulation:
+/// fewer than two tiles' worth of points, or a halo (2α·λ_max) that leaves
+/// tiles less than eight halos wide. The cubes start at the lower corner
+/// of the points' box, so that a surface along a face of the box (a scan's
+/// ground, lower than all else) lies inside one layer of cubes rather
+/// than on a face between two, where every point would be in both halos.
+/// The result does not depend on it (module doc: the tiles' union is the
+/// job's `F_{k,α,Q}` exactly); the points triangulated are counted once,
+/// as untiled.
+fn tile_side(points: &[[f64; 3]], map: &[u32], job: &Job<'_>) -> Option<TileGrid> {
     if map.len() < 2 * TILE_POINTS {
         return None;
     }
@@ -397,11 +426,11 @@ fn tile_side(points: &[[f64; 3]], map: &[u32], job: &Job<'_>) -> Option<f64> {
     // ground, a facade, a table) spread over two of them.
     let side = (ext[1] * ext[2] / tiles as f64).sqrt();
     let h = halo_width(job);
-    (side.is_finite() && side >= 8.0 * h && ext[2] > side).then_some(side)
+    (side.is_finite() && side >= 8.0 * h && ext[2] > side).then_some(TileGrid { side, origin: lo })
 }
 
 /// `F_{k,α,Q}` at each α of `alphas` of the kept points `map` (transforms
-/// `q`, input indices ascending) cut into tiles of side `side` with halos
+/// `q`, input indices ascending) cut into the cubes of `grid` with halos
 /// `h`, the tiles triangulated at once on the pool's threads; each tile
 /// keeps the simplices whose smallest vertex it owns, so the union, sorted,
 /// is the untiled result (module doc).
@@ -410,10 +439,10 @@ fn faces_in_tiles<S: Face>(
     map: &[u32],
     q: &[[f64; 3]],
     alphas: &[f64],
-    side: f64,
+    grid: TileGrid,
     h: f64,
 ) -> Result<Vec<Vec<S>>, ScanError> {
-    let cell = |p: &[f64; 3]| -> [i64; 3] { tile_cell(p, side) };
+    let cell = |p: &[f64; 3]| -> [i64; 3] { grid.cell(p) };
     let mut tiles: Vec<[i64; 3]> = map.iter().map(|&i| cell(&points[i as usize])).collect();
     tiles.sort_unstable();
     tiles.dedup();
@@ -423,7 +452,7 @@ fn faces_in_tiles<S: Face>(
         || (),
         |_, k| {
             let t = tiles[k];
-            let sub = tile_points(points, &index, t, side, h);
+            let sub = tile_points(points, &index, grid.bounds(t), h);
             // `map` is ascending: a kept point's transform is at its rank.
             let sub_q: Vec<[f64; 3]> = sub
                 .iter()
@@ -446,20 +475,17 @@ fn faces_in_tiles<S: Face>(
     Ok(faces)
 }
 
-/// The points of `index` in tile `t`'s cube (side `side`) grown by `h`,
-/// ascending: the kd-tree gives those within the circumscribed sphere,
-/// and those in the grown box are kept.
+/// The points of `index` in the cube `(lo, hi)` grown by `h`, ascending:
+/// the kd-tree gives those within the circumscribed sphere, and those in
+/// the grown box are kept.
 fn tile_points(
     points: &[[f64; 3]],
     index: &crate::geometry::kdtree::KdTree,
-    t: [i64; 3],
-    side: f64,
+    (lo, hi): ([f64; 3], [f64; 3]),
     h: f64,
 ) -> Vec<u32> {
-    let lo = t.map(|c| c as f64 * side);
-    let hi = t.map(|c| (c + 1) as f64 * side);
     let centre = [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]));
-    let r = (3.0f64).sqrt() * (0.5 * side + h);
+    let r = (3.0f64).sqrt() * (0.5 * (hi[0] - lo[0]) + h);
     let mut sub: Vec<u32> = Vec::new();
     index.within(&centre, r, |i| {
         let p = &points[i as usize];
@@ -548,6 +574,40 @@ mod tests {
     #[cfg(feature = "parallel")]
     type Run<S> = (Vec<Vec<S>>, usize);
 
+    /// A ground across z = 0 lies in one layer of the cubes it is cut
+    /// into (they start at its box's corner): a grid from the origin cut
+    /// it along the plane z = 0, and every point was in two tiles' halos.
+    #[test]
+    fn a_ground_across_zero_is_cut_into_one_layer_of_tiles() {
+        let pts: Vec<[f64; 3]> = ground()
+            .into_iter()
+            .map(|[x, y, z]| [x, y, z - 0.025])
+            .collect();
+        assert!(pts.iter().any(|p| p[2] < 0.0) && pts.iter().any(|p| p[2] > 0.0));
+        let job = Job {
+            anisotropy: Anisotropy::plane([0.0, 0.0, 1.0], [1.0, 0.0, 0.0], 2.0, 2.0).unwrap(),
+            alpha: 0.5,
+            ids: None,
+            group: 0,
+        };
+        let all: Vec<u32> = (0..pts.len() as u32).collect();
+        let grid = tile_side(&pts, &all, &job).expect("cut into tiles");
+        let layers: std::collections::BTreeSet<i64> = pts
+            .iter()
+            .filter(|p| p[2] < 1.0)
+            .map(|p| grid.cell(p)[2])
+            .collect();
+        assert_eq!(layers.len(), 1, "{layers:?}");
+        // The oracle tells a grid from the origin apart.
+        let from_origin = TileGrid {
+            origin: [0.0; 3],
+            ..grid
+        };
+        assert!(pts
+            .iter()
+            .any(|p| from_origin.cell(p)[2] != grid.cell(p)[2]));
+    }
+
     /// The faces of `job` at `alphas`: one triangulation of every kept
     /// point (the oracle), and the job as run on 1 and 4 threads.
     #[cfg(feature = "parallel")]
@@ -600,8 +660,8 @@ mod tests {
             prune_radius(&job),
             &Pruning::Grid,
         );
-        let side = tile_side(&pts, &map, &job).expect("cut into tiles");
-        assert!(side < 50.0, "{side}");
+        let grid = tile_side(&pts, &map, &job).expect("cut into tiles");
+        assert!(grid.side < 50.0, "{grid:?}");
         let alphas = [0.3, 0.4, 0.5];
         let (whole_e, runs_e) = whole_and_run::<[u32; 2]>(&pts, &job, &alphas);
         let (whole_t, runs_t) = whole_and_run::<[u32; 3]>(&pts, &job, &alphas);
