@@ -155,19 +155,19 @@ impl Sharing {
 }
 
 /// The (candidate, first block, end block) of each slice of the
-/// candidates' footprint blocks, in order: at least [`CLAIM_BLOCKS`] blocks
+/// candidates' footprint blocks (`blocks`: how many each has), in order: at least [`CLAIM_BLOCKS`] blocks
 /// a slice, longer where the blocks are many for the threads (about four
 /// slices a thread in all).
-fn slices_of(blocks: &[Vec<([f64; 3], f64)>]) -> Vec<(usize, usize, usize)> {
-    let total: usize = blocks.iter().map(Vec::len).sum();
+fn slices_of(blocks: &[usize]) -> Vec<(usize, usize, usize)> {
+    let total: usize = blocks.iter().sum();
     let size = CLAIM_BLOCKS.max(total.div_ceil(4 * crate::par::threads()));
     blocks
         .iter()
         .enumerate()
-        .flat_map(|(ci, b)| {
-            (0..b.len().max(1))
+        .flat_map(|(ci, &b)| {
+            (0..b.max(1))
                 .step_by(size)
-                .map(move |s| (ci, s, (s + size).min(b.len())))
+                .map(move |s| (ci, s, (s + size).min(b)))
         })
         .collect()
 }
@@ -186,9 +186,13 @@ fn claim_slices<T: Send>(
     make: impl Fn(u32, f64) -> T + Sync,
 ) -> Vec<(u32, Vec<T>)> {
     let points = cloud.points();
-    let blocks: Vec<Vec<([f64; 3], f64)>> =
-        cands.iter().map(|c| c.foot.near_blocks(c.tau)).collect();
-    let slices = slices_of(&blocks);
+    // Counted first, each slice's balls made by its own task: the balls of
+    // every candidate at once were the largest buffer of the claims.
+    let counts: Vec<usize> = cands
+        .iter()
+        .map(|c| c.foot.near_block_count(c.tau))
+        .collect();
+    let slices = slices_of(&counts);
     map_ranges(
         slices.len(),
         || Stamps::new(points.len()),
@@ -204,7 +208,7 @@ fn claim_slices<T: Send>(
                 points,
                 cloud.index(),
                 stamp,
-                &blocks[ci][from..to],
+                &c.foot.near_blocks_in(c.tau, (from, to)),
                 &mut |i, d| {
                     if agrees(i) {
                         claims.push(make(i, d));

@@ -215,8 +215,30 @@ impl Footprint {
     /// each point once per cell within its reach), as the blocks' centres
     /// and half-diagonals.
     pub(super) fn near_blocks(&self, radius: f64) -> Vec<([f64; 3], f64)> {
-        let b = ((2.0 * radius / self.cell).ceil() as usize).max(1);
-        self.blocks(b).collect()
+        self.blocks(self.block_cells(radius)).collect()
+    }
+
+    /// How many balls [`Self::near_blocks`] gives for `radius`.
+    pub(super) fn near_block_count(&self, radius: f64) -> usize {
+        self.blocks(self.block_cells(radius)).count()
+    }
+
+    /// Balls `from..to` of [`Self::near_blocks`] for `radius`, without
+    /// holding the others.
+    pub(super) fn near_blocks_in(
+        &self,
+        radius: f64,
+        (from, to): (usize, usize),
+    ) -> Vec<([f64; 3], f64)> {
+        self.blocks(self.block_cells(radius))
+            .skip(from)
+            .take(to.saturating_sub(from))
+            .collect()
+    }
+
+    /// Cells along a side of [`Self::near_blocks`]' blocks for `radius`.
+    fn block_cells(&self, radius: f64) -> usize {
+        ((2.0 * radius / self.cell).ceil() as usize).max(1)
     }
 }
 
