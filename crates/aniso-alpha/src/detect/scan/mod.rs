@@ -396,7 +396,7 @@ fn raw_faces_at<S: Face>(
 /// the simulated house 5.2 / 4.9 / 4.9 / 5.9 s; the room and the AHN
 /// tile alike within 0.03 s. On one thread a tile's own costs (its halo,
 /// its points from the kd-tree, its first tetrahedron) cost the house's
-/// scan 12%.
+/// scan 18%.
 #[cfg(not(test))]
 const TILE_POINTS: usize = 1 << 14;
 /// A few hundred points in the tests, so that small clouds take the path.
