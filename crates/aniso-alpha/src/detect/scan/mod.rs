@@ -22,7 +22,7 @@
 //! job's `F_{k,α,Q}` (tested against the untiled result). Tiles bound the
 //! memory of one triangulation and are independent tasks (in parallel here,
 //! or spread over machines). A job of many points is always cut so
-//! ([`tile_side`], tiles of about [`TILE_POINTS`] points): the same faces,
+//! ([`tile_grid`], tiles of about [`TILE_POINTS`] points): the same faces,
 //! one triangulation's memory bounded, its tiles on the pool's threads at
 //! once.
 //!
@@ -280,7 +280,7 @@ pub(crate) fn tile_cell(p: &[f64; 3], side: f64) -> [i64; 3] {
     p.map(|x| (x / side).floor() as i64)
 }
 
-/// The cubes a large job is cut into ([`tile_side`]): side `side`, corner
+/// The cubes a large job is cut into ([`tile_grid`]): side `side`, corner
 /// of cube (0, 0, 0) at `origin`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct TileGrid {
@@ -339,7 +339,7 @@ fn raw_faces_at<S: Face>(
     let Some(side) = tile.filter(|&s| s.is_finite() && s > 0.0) else {
         let (map, q) = pruned(points, ids, a, radius, pruning);
         let n = map.len();
-        let faces = match tile_side(points, &map, job) {
+        let faces = match tile_grid(points, &map, job) {
             Some(grid) => faces_in_tiles::<S>(points, &map, &q, alphas, grid, halo_width(job))?,
             None => {
                 let mut faces = faces_at::<S>(q, &map, alphas, &|_| true)?;
@@ -385,7 +385,7 @@ fn raw_faces_at<S: Face>(
     Ok((faces, triangulated))
 }
 
-/// Points per tile of a large job ([`tile_side`]): 2^14. One
+/// Points per tile of a large job ([`tile_grid`]): 2^14. One
 /// triangulation holds about 7 cells of 32 bytes a point besides its
 /// points, so a job of 72,000 points (the table of a depth frame) held
 /// 18 MB at once, as much as CGAL's Efficient RANSAC's whole process on
@@ -414,7 +414,7 @@ const TILE_POINTS: usize = 1 << 8;
 /// The result does not depend on it (module doc: the tiles' union is the
 /// job's `F_{k,α,Q}` exactly); the points triangulated are counted once,
 /// as untiled.
-fn tile_side(points: &[[f64; 3]], map: &[u32], job: &Job<'_>) -> Option<TileGrid> {
+fn tile_grid(points: &[[f64; 3]], map: &[u32], job: &Job<'_>) -> Option<TileGrid> {
     if map.len() < 2 * TILE_POINTS {
         return None;
     }
@@ -591,7 +591,7 @@ mod tests {
             group: 0,
         };
         let all: Vec<u32> = (0..pts.len() as u32).collect();
-        let grid = tile_side(&pts, &all, &job).expect("cut into tiles");
+        let grid = tile_grid(&pts, &all, &job).expect("cut into tiles");
         let layers: std::collections::BTreeSet<i64> = pts
             .iter()
             .filter(|p| p[2] < 1.0)
@@ -660,7 +660,7 @@ mod tests {
             prune_radius(&job),
             &Pruning::Grid,
         );
-        let grid = tile_side(&pts, &map, &job).expect("cut into tiles");
+        let grid = tile_grid(&pts, &map, &job).expect("cut into tiles");
         assert!(grid.side < 50.0, "{grid:?}");
         let alphas = [0.3, 0.4, 0.5];
         let (whole_e, runs_e) = whole_and_run::<[u32; 2]>(&pts, &job, &alphas);
