@@ -155,9 +155,9 @@ impl Sharing {
 }
 
 /// The (candidate, first block, end block) of each slice of the
-/// candidates' footprint blocks (`blocks`: how many each has), in order: at least [`CLAIM_BLOCKS`] blocks
-/// a slice, longer where the blocks are many for the threads (about four
-/// slices a thread in all).
+/// candidates' footprint blocks (`blocks`: how many each has), in order:
+/// at least [`CLAIM_BLOCKS`] blocks a slice, longer where the blocks are
+/// many for the threads (about four slices a thread in all).
 fn slices_of(blocks: &[usize]) -> Vec<(usize, usize, usize)> {
     let total: usize = blocks.iter().sum();
     let size = CLAIM_BLOCKS.max(total.div_ceil(4 * crate::par::threads()));
