@@ -3,11 +3,12 @@
 //!
 //! glibc's malloc attaches each new thread to an arena of its own (up to
 //! eight per core; a finished thread's arena goes to the next), and memory
-//! freed into one arena serves only that arena's later requests. A detection allocates its working
-//! buffers on every worker thread in turn (the orientations'
-//! triangulations and faces, then the incidences, candidates and claims of
-//! the assembly), so each arena keeps the high-water mark of its own
-//! threads, and the peak resident memory is their sum. With one arena,
+//! freed into one arena serves only that arena's later requests. A
+//! detection allocates its working buffers on every worker thread in turn
+//! (the orientations' triangulations and faces, then the incidences,
+//! candidates and claims of the assembly), so each arena keeps the
+//! high-water mark of its own threads, and the peak resident memory is
+//! their sum. With one arena,
 //! every thread reuses what any thread freed. On the corpus this lowers
 //! the peak RSS by a third on most scans (12–49%) at the same wall time
 //! (BENCHMARKS.md, "One malloc arena"); malloc and free take under 1% of
@@ -21,7 +22,7 @@
 //! their parts) stay in the peak of the next stage. The program hands the
 //! free pages back after the estimate and after each stage of a detection
 //! ([`release_free`], from the stage observer): about ten calls a run, each
-//! a walk over the free chunks, for a peak RSS lower by 5 MiB on the
+//! a walk over the free chunks, for a peak RSS lower by 4–5 MiB on the
 //! depth frames (BENCHMARKS.md, "Peaks of one stage at a time").
 //!
 //! Only the command-line program does this: the Python extension lives in

@@ -277,7 +277,11 @@ pub(crate) fn halo_width(job: &Job<'_>) -> f64 {
 
 /// The tile (integer cell of side `side`) that owns a point.
 pub(crate) fn tile_cell(p: &[f64; 3], side: f64) -> [i64; 3] {
-    p.map(|x| (x / side).floor() as i64)
+    TileGrid {
+        side,
+        origin: [0.0; 3],
+    }
+    .cell(p)
 }
 
 /// The cubes a large job is cut into ([`tile_grid`]): side `side`, corner
