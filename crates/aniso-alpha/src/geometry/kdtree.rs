@@ -1,6 +1,7 @@
 //! A static 3D kd-tree for the nearest-neighbour queries of the detection's
 //! local analysis: k nearest points (k ≤ [`MAX_K`], no allocation per query)
-//! and every point within a radius (through a callback).
+//! every point within a radius (through a callback), and every point in
+//! an oriented box ([`OrientedBox`]).
 //!
 //! Flat storage: the points are copied once in tree order (leaves of at
 //! most [`LEAF`] consecutive points), nodes are an implicit balanced binary
@@ -302,6 +303,100 @@ impl KdTree {
         }
         false
     }
+
+    /// Calls `f(index, point)` for every point inside the oriented box
+    /// `b` (and perhaps a few within its padding, [`OrientedBox::new`]),
+    /// in tree order. A node is skipped when an axis of the box or of the
+    /// node separates them (six of the fifteen separating axes: never a
+    /// node that meets the box, sometimes one that does not).
+    pub fn within_box(&self, b: &OrientedBox, mut f: impl FnMut(u32, &[f64; 3])) {
+        if self.ids.is_empty() {
+            return;
+        }
+        let mut stack: [u32; 64] = [0; 64];
+        let mut top = 1usize;
+        while top > 0 {
+            top -= 1;
+            let node = stack[top] as usize;
+            if b.separated(&self.bbox[node]) {
+                continue;
+            }
+            if self.is_leaf(node) {
+                let (s, e) = self.range[node];
+                for t in s as usize..e as usize {
+                    let p = &self.pts[t];
+                    if b.holds(p) {
+                        f(self.ids[t], p);
+                    }
+                }
+            } else {
+                stack[top] = (2 * node + 1) as u32;
+                stack[top + 1] = (2 * node + 2) as u32;
+                top += 2;
+            }
+        }
+    }
+}
+
+/// A box with its own orthonormal axes, for [`KdTree::within_box`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OrientedBox {
+    centre: [f64; 3],
+    axes: [[f64; 3]; 3],
+    /// Half extents along `axes`, padded.
+    half: [f64; 3],
+    /// Per world axis: the half extent of the box's projection on it.
+    reach: [f64; 3],
+}
+
+impl OrientedBox {
+    /// The box of centre `centre`, orthonormal `axes` and half extents
+    /// `half`, each padded by a millionth of the largest one and by a
+    /// relative 10⁻¹² of the coordinates' magnitude: the rounding of the
+    /// dot products that place a point must not leave out a point on the
+    /// box's faces (callers test their points exactly).
+    pub fn new(centre: [f64; 3], axes: [[f64; 3]; 3], half: [f64; 3]) -> Self {
+        let size = half.iter().fold(0.0f64, |m, &h| m.max(h));
+        let magnitude = centre.iter().fold(size, |m, &c| m.max(c.abs()));
+        let pad = 1e-6 * size + 1e-12 * magnitude;
+        let half = half.map(|h| h + pad);
+        let reach = [0, 1, 2].map(|j| (0..3).map(|k| axes[k][j].abs() * half[k]).sum());
+        OrientedBox {
+            centre,
+            axes,
+            half,
+            reach,
+        }
+    }
+
+    /// Whether the point lies in the (padded) box.
+    pub fn holds(&self, p: &[f64; 3]) -> bool {
+        let w = [
+            p[0] - self.centre[0],
+            p[1] - self.centre[1],
+            p[2] - self.centre[2],
+        ];
+        (0..3).all(|k| {
+            let a = &self.axes[k];
+            (w[0] * a[0] + w[1] * a[1] + w[2] * a[2]).abs() <= self.half[k]
+        })
+    }
+
+    /// Whether an axis of the box or of the axis-aligned box `(lo, hi)`
+    /// separates them.
+    fn separated(&self, (lo, hi): &([f64; 3], [f64; 3])) -> bool {
+        let m = [0, 1, 2].map(|j| 0.5 * (lo[j] + hi[j]) - self.centre[j]);
+        let e = [0, 1, 2].map(|j| 0.5 * (hi[j] - lo[j]));
+        if (0..3).any(|j| m[j].abs() > e[j] + self.reach[j]) {
+            return true;
+        }
+        (0..3).any(|k| {
+            let a = &self.axes[k];
+            let along = m[0] * a[0] + m[1] * a[1] + m[2] * a[2];
+            let spread = e[0] * a[0].abs() + e[1] * a[1].abs() + e[2] * a[2].abs();
+            along.abs() > self.half[k] + spread
+        })
+    }
 }
 
 #[cfg(test)]
@@ -370,6 +465,64 @@ mod tests {
                 assert_eq!(seen[..], order[..seen.len()], "any: query {qi} r {r}");
             }
         }
+    }
+
+    #[test]
+    fn within_box_matches_brute_force() {
+        let pts = cloud(3000, 11);
+        let tree = KdTree::new(&pts, None);
+        let mut rng = SplitMix64::new(4);
+        for trial in 0..60 {
+            // A random rotation (Gram–Schmidt of random vectors) and box.
+            let mut r = || rng.uniform() - 0.5;
+            let a0 = crate::geometry::normalize([r(), r(), r()]).unwrap();
+            let v = [r(), r(), r()];
+            let t = crate::geometry::dot(v, a0);
+            let a1 =
+                crate::geometry::normalize([v[0] - t * a0[0], v[1] - t * a0[1], v[2] - t * a0[2]])
+                    .unwrap();
+            let a2 = crate::geometry::cross(a0, a1);
+            let centre = [0.5 + r(), 0.5 + r(), 0.5 + r()];
+            let half = [
+                0.3 * r().abs(),
+                0.2 * r().abs(),
+                if trial % 3 == 0 { 0.0 } else { 0.1 * r().abs() },
+            ];
+            let b = OrientedBox::new(centre, [a0, a1, a2], half);
+            let mut got: Vec<u32> = Vec::new();
+            tree.within_box(&b, |i, p| {
+                assert_eq!(p, &pts[i as usize]);
+                got.push(i);
+            });
+            got.sort_unstable();
+            let want: Vec<u32> = (0..pts.len() as u32)
+                .filter(|&i| b.holds(&pts[i as usize]))
+                .collect();
+            assert_eq!(got, want, "trial {trial}");
+            // Every point strictly inside the unpadded box is held.
+            for p in &pts {
+                let w = [p[0] - centre[0], p[1] - centre[1], p[2] - centre[2]];
+                let inside = [a0, a1, a2]
+                    .iter()
+                    .zip(half)
+                    .all(|(a, h)| crate::geometry::dot(w, *a).abs() <= h);
+                assert!(!inside || b.holds(p));
+            }
+        }
+        // The oracle can fail: a box moved by its own width holds others.
+        let b = OrientedBox::new(
+            [0.5; 3],
+            [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            [0.1; 3],
+        );
+        let moved = OrientedBox::new(
+            [0.7, 0.5, 0.5],
+            [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            [0.1; 3],
+        );
+        let mut got = Vec::new();
+        tree.within_box(&b, |i, _| got.push(i));
+        assert!(!got.is_empty() && got.iter().any(|&i| !moved.holds(&pts[i as usize])));
     }
 
     #[test]

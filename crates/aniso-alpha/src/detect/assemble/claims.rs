@@ -48,12 +48,12 @@ use std::collections::HashSet;
 pub(crate) const NORMAL_AGREEMENT_COS: f64 = 0.8;
 
 /// The fewest footprint blocks in one slice of a candidate's claims
-/// ([`Claims::of`]): 64. A plane's blocks are about two claim radii wide,
-/// so a slice covers a few hundred cells' worth of points: enough work to
-/// be worth a task. Slices are longer where the candidates' blocks are
-/// many for the threads (about four slices a thread in all): a scan's
-/// ground (thousands of blocks) is cut into a few slices a thread.
-const CLAIM_BLOCKS: usize = 64;
+/// ([`Claims::of`]): 2. A block is 8 × 8 cells or more, a few thousand
+/// points of a dense plane, so two are enough work to be worth a task.
+/// Slices are longer where the candidates' blocks are many for the
+/// threads (about four slices a thread in all): a scan's ground
+/// (hundreds of blocks) is cut into a few slices a thread.
+const CLAIM_BLOCKS: usize = 2;
 
 /// A claim: (point, candidate, distance to the candidate's primitive).
 type Claim = (u32, u32, f64);
@@ -70,8 +70,8 @@ impl Claims {
     pub(super) fn of(cands: &[Candidate], cloud: &Cloud<'_>, normals: Option<&[[f32; 3]]>) -> Self {
         let per_slice = claim_slices(cands, cloud, normals, |i, d| (i, d));
         // A slice's claims are ordered by candidate, so the counting sort
-        // puts a point claimed by two slices of one candidate twice in a
-        // row: kept once.
+        // puts a point claimed by two slices of one candidate (one on the
+        // side between their blocks) twice in a row: kept once.
         let mut claims = by_point_then_candidate(
             cloud.points().len(),
             per_slice,
@@ -176,9 +176,9 @@ fn slices_of(blocks: &[usize]) -> Vec<(usize, usize, usize)> {
 /// blocks), each claim made by `make(point, distance)`, with the
 /// candidate of each slice: in parallel over the slices (so
 /// that one large candidate, a scan's ground, is shared between threads),
-/// each range of slices with its own stamps. A slice's balls reach into
-/// the next slice's blocks, whose points both report: slices are as long
-/// as the threads allow, so that few points are reported twice.
+/// each range of slices with its own stamps. Two slices of a candidate
+/// report the same point only when it lies on the side between their
+/// blocks ([`for_near_in`]).
 fn claim_slices<T: Send>(
     cands: &[Candidate],
     cloud: &Cloud<'_>,
@@ -186,8 +186,8 @@ fn claim_slices<T: Send>(
     make: impl Fn(u32, f64) -> T + Sync,
 ) -> Vec<(u32, Vec<T>)> {
     let points = cloud.points();
-    // Counted first, each slice's balls made by its own task: the balls of
-    // every candidate at once were the largest buffer of the claims.
+    // Counted first, each slice's boxes made by its own task: the boxes
+    // of every candidate at once were the largest buffer of the claims.
     let counts: Vec<usize> = cands
         .iter()
         .map(|c| c.foot.near_block_count(c.tau))
@@ -205,7 +205,6 @@ fn claim_slices<T: Send>(
                 &c.fit,
                 &c.foot,
                 c.tau,
-                points,
                 cloud.index(),
                 stamp,
                 &c.foot.near_blocks_in(c.tau, (from, to)),

@@ -80,19 +80,11 @@ fn part_nfa<S: Shape>(
     // Local density in the shell (τ, 4τ] over the footprint.
     let outer = SHELL_RATIO * tau;
     let mut shell = 0usize;
-    for_near(
-        &p.fit,
-        &foot,
-        outer,
-        points,
-        cloud.index(),
-        stamp,
-        &mut |_, d| {
-            if d > tau {
-                shell += 1;
-            }
-        },
-    );
+    for_near(&p.fit, &foot, outer, cloud.index(), stamp, &mut |_, d| {
+        if d > tau {
+            shell += 1;
+        }
+    });
     let rho_local = (shell as f64 + 1.0) / (vol(outer) - vol(tau)).max(1e-300);
     let rho = rho_local.max(rho_global);
     let mut order: Vec<usize> = (0..residuals.len()).collect();

@@ -84,15 +84,9 @@ fn best_radius<S: Shape>(
     // radius's shell; each radius then counts its own.
     let reach = SHELL_RATIO * radii.last().copied().unwrap_or(base);
     let mut near_pts: Vec<(u32, f64)> = Vec::new();
-    for_near(
-        &c.fit,
-        &c.foot,
-        reach,
-        points,
-        cloud.index(),
-        stamp,
-        &mut |i, d| near_pts.push((i, d)),
-    );
+    for_near(&c.fit, &c.foot, reach, cloud.index(), stamp, &mut |i, d| {
+        near_pts.push((i, d))
+    });
     let mut best = (f64::INFINITY, base, None);
     for &r in &radii {
         // A line as it would claim at r: fitted again on its points within
