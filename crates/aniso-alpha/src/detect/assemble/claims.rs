@@ -22,7 +22,7 @@
 
 use super::super::cloud::Cloud;
 use super::super::detection::Primitive;
-use super::footprint::{for_near_in, Stamps};
+use super::footprint::for_near_in;
 use super::moments::Moments;
 use super::same::{absorbed, Piece};
 use super::{Candidate, Draft, Footprint, Shape};
@@ -69,16 +69,14 @@ impl Claims {
     /// claims do not depend on the slicing.
     pub(super) fn of(cands: &[Candidate], cloud: &Cloud<'_>, normals: Option<&[[f32; 3]]>) -> Self {
         let per_slice = claim_slices(cands, cloud, normals, |i, d| (i, d));
-        // A slice's claims are ordered by candidate, so the counting sort
-        // puts a point claimed by two slices of one candidate (one on the
-        // side between their blocks) twice in a row: kept once.
-        let mut claims = by_point_then_candidate(
+        // Each slice reports a point at most once, and two slices of a
+        // candidate never the same point ([`for_near_in`]): no duplicate.
+        let claims = by_point_then_candidate(
             cloud.points().len(),
             per_slice,
             |c| c.0,
             |c, (i, d)| (i, c, d),
         );
-        claims.dedup_by_key(|c| (c.0, c.1));
         Claims(claims)
     }
 
@@ -137,10 +135,12 @@ impl Sharing {
     /// The (point, candidate) pairs of [`Claims::of`].
     fn of(cands: &[Candidate], cloud: &Cloud<'_>, normals: Option<&[[f32; 3]]>) -> Self {
         let per_slice = claim_slices(cands, cloud, normals, |i, _| i);
-        let mut pairs =
-            by_point_then_candidate(cloud.points().len(), per_slice, |&p| p, |c, p| (p, c));
-        pairs.dedup();
-        Sharing(pairs)
+        Sharing(by_point_then_candidate(
+            cloud.points().len(),
+            per_slice,
+            |&p| p,
+            |c, p| (p, c),
+        ))
     }
 
     /// [`Claims::shared`] of the same candidates.
@@ -176,16 +176,13 @@ fn slices_of(blocks: &[usize]) -> Vec<(usize, usize, usize)> {
 /// blocks), each claim made by `make(point, distance)`, with the
 /// candidate of each slice: in parallel over the slices (so
 /// that one large candidate, a scan's ground, is shared between threads),
-/// each range of slices with its own stamps. Two slices of a candidate
-/// report the same point only when it lies on the side between their
-/// blocks ([`for_near_in`]).
+/// each point once ([`for_near_in`]).
 fn claim_slices<T: Send>(
     cands: &[Candidate],
     cloud: &Cloud<'_>,
     normals: Option<&[[f32; 3]]>,
     make: impl Fn(u32, f64) -> T + Sync,
 ) -> Vec<(u32, Vec<T>)> {
-    let points = cloud.points();
     // Counted first, each slice's boxes made by its own task: the boxes
     // of every candidate at once were the largest buffer of the claims.
     let counts: Vec<usize> = cands
@@ -195,8 +192,8 @@ fn claim_slices<T: Send>(
     let slices = slices_of(&counts);
     map_ranges(
         slices.len(),
-        || Stamps::new(points.len()),
-        |stamp, k| {
+        || (),
+        |_, k| {
             let (ci, from, to) = slices[k];
             let c = &cands[ci];
             let agrees = normal_agreement(&c.fit, normals);
@@ -206,7 +203,6 @@ fn claim_slices<T: Send>(
                 &c.foot,
                 c.tau,
                 cloud.index(),
-                stamp,
                 &c.foot.near_blocks_in(c.tau, (from, to)),
                 &mut |i, d| {
                     if agrees(i) {

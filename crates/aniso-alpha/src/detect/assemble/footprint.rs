@@ -7,6 +7,7 @@
 use super::super::detection::Primitive;
 use crate::geometry::kdtree::{KdTree, OrientedBox};
 use crate::geometry::{cross, dot, normalize, sub};
+use crate::par::map_ranges;
 
 /// The cells a candidate covers on its plane (2D) or along its line (1D).
 #[derive(Debug, Clone)]
@@ -133,14 +134,21 @@ impl Footprint {
     }
 
     /// Whether `p`'s projection falls in a covered cell.
+    #[cfg(test)]
     pub(super) fn contains(&self, p: &[f64; 3]) -> bool {
+        self.cell_of(p).is_some()
+    }
+
+    /// The covered cell (row, column of the grid) under `p`'s projection.
+    fn cell_of(&self, p: &[f64; 3]) -> Option<[usize; 2]> {
         let c = self.coords(p);
         let (a, b) = (c[0] - self.lo[0], c[1] - self.lo[1]);
-        a >= 0
+        let inside = a >= 0
             && b >= 0
             && (a as usize) < self.dims[0]
             && (b as usize) < self.dims[1]
-            && self.bits[a as usize * self.dims[1] + b as usize]
+            && self.bits[a as usize * self.dims[1] + b as usize];
+        inside.then_some([a as usize, b as usize])
     }
 
     /// Number of covered cells.
@@ -153,7 +161,7 @@ impl Footprint {
     /// primitive over it: the block's rectangle on the plane and `radius`
     /// either side (along a line: the block's interval and `radius` across
     /// both ways).
-    fn blocks(&self, b: usize, radius: f64) -> impl Iterator<Item = OrientedBox> + '_ {
+    fn blocks(&self, b: usize, radius: f64) -> impl Iterator<Item = Block> + '_ {
         let planar = self.axes[1] != [0.0; 3];
         let bj = if planar { b } else { self.dims[1] };
         let axes = self.box_axes();
@@ -175,7 +183,11 @@ impl Footprint {
                 } else {
                     [hu, radius, radius]
                 };
-                Some(OrientedBox::new(centre, axes, half))
+                Some(Block {
+                    region: OrientedBox::new(centre, axes, half),
+                    rows: (i0, i1),
+                    columns: (j0, j1),
+                })
             })
         })
     }
@@ -198,50 +210,71 @@ impl Footprint {
     }
 }
 
-/// Per-point marks that tell whether a query already reported a point,
-/// without clearing between queries.
-pub(super) struct Stamps {
-    v: Vec<u32>,
-    mark: u32,
+/// A block of a footprint's cells ([`Footprint::near_blocks`]): the box
+/// of the points within a radius of the primitive over it, and its rows
+/// and columns of the footprint's grid.
+#[derive(Debug, Clone)]
+pub(super) struct Block {
+    region: OrientedBox,
+    rows: (usize, usize),
+    columns: (usize, usize),
 }
 
-impl Stamps {
-    /// Marks for `n` points.
-    pub(super) fn new(n: usize) -> Self {
-        Stamps {
-            v: vec![0; n],
-            mark: 0,
-        }
-    }
-    /// A mark no point carries yet.
-    fn next(&mut self) -> u32 {
-        if self.mark == u32::MAX {
-            self.v.iter_mut().for_each(|x| *x = 0);
-            self.mark = 0;
-        }
-        self.mark += 1;
-        self.mark
+impl Block {
+    /// Whether the grid cell `c` is one of the block's.
+    fn owns(&self, c: [usize; 2]) -> bool {
+        (self.rows.0..self.rows.1).contains(&c[0])
+            && (self.columns.0..self.columns.1).contains(&c[1])
     }
 }
 
 /// Calls `f(point, distance)` for every point of `index` within `radius`
-/// of the primitive `fit` and over its footprint `foot` (each once).
+/// of the primitive `fit` and over its footprint `foot`, once, block after
+/// block ([`for_near_in`]).
 pub(super) fn for_near(
     fit: &Primitive,
     foot: &Footprint,
     radius: f64,
     index: &KdTree,
-    stamps: &mut Stamps,
     f: &mut dyn FnMut(u32, f64),
 ) {
     let blocks = foot.near_blocks(radius);
-    for_near_in(fit, foot, radius, index, stamps, &blocks, f);
+    for_near_in(fit, foot, radius, index, &blocks, f);
+}
+
+/// Blocks from which [`near_points`] cuts its query into slices for the
+/// threads: 16, each of 8 × 8 cells or more ([`BLOCK_CELLS`]).
+const PARALLEL_BLOCKS: usize = 16;
+
+/// The (point, distance) pairs [`for_near`] reports, in its order; the
+/// blocks in slices on the pool's threads from [`PARALLEL_BLOCKS`] blocks
+/// (a scan's ground, a depth frame's table).
+pub(super) fn near_points(
+    fit: &Primitive,
+    foot: &Footprint,
+    radius: f64,
+    index: &KdTree,
+) -> Vec<(u32, f64)> {
+    let blocks = foot.near_blocks(radius);
+    let gather = |slice: &[Block]| {
+        let mut out = Vec::new();
+        for_near_in(fit, foot, radius, index, slice, &mut |i, d| {
+            out.push((i, d))
+        });
+        out
+    };
+    if blocks.len() < PARALLEL_BLOCKS {
+        return gather(&blocks);
+    }
+    let size = blocks.len().div_ceil(4 * crate::par::threads()).max(1);
+    let slices: Vec<&[Block]> = blocks.chunks(size).collect();
+    map_ranges(slices.len(), || (), |_, k| gather(slices[k])).concat()
 }
 
 impl Footprint {
     /// The boxes [`for_near`] queries for `radius`: one per block of
     /// cells about 2·radius wide, and [`BLOCK_CELLS`] wide at least.
-    pub(super) fn near_blocks(&self, radius: f64) -> Vec<OrientedBox> {
+    pub(super) fn near_blocks(&self, radius: f64) -> Vec<Block> {
         self.blocks(self.block_cells(radius), radius).collect()
     }
 
@@ -252,11 +285,7 @@ impl Footprint {
 
     /// Boxes `from..to` of [`Self::near_blocks`] for `radius`, without
     /// holding the others.
-    pub(super) fn near_blocks_in(
-        &self,
-        radius: f64,
-        (from, to): (usize, usize),
-    ) -> Vec<OrientedBox> {
+    pub(super) fn near_blocks_in(&self, radius: f64, (from, to): (usize, usize)) -> Vec<Block> {
         self.blocks(self.block_cells(radius), radius)
             .skip(from)
             .take(to.saturating_sub(from))
@@ -271,31 +300,23 @@ impl Footprint {
 }
 
 /// [`for_near`] over some of the footprint's [`Footprint::near_blocks`]:
-/// each point of those blocks' boxes within `radius` and over the
-/// footprint, once. A point within `radius` over a covered cell lies in
-/// that cell's block's box, so slices of the blocks report the same point
-/// only when it lies on the side between two blocks, within the boxes'
-/// padding (the claims of a large candidate are gathered slice by slice,
-/// in parallel).
+/// each point within `radius` and over a covered cell of those blocks,
+/// once. A point within `radius` over a covered cell lies in that cell's
+/// block's box, and is reported there only (boxes overlap by their
+/// padding), so disjoint slices of the blocks report disjoint points (the
+/// claims of a large candidate are gathered slice by slice, in parallel).
 pub(super) fn for_near_in(
     fit: &Primitive,
     foot: &Footprint,
     radius: f64,
     index: &KdTree,
-    stamps: &mut Stamps,
-    blocks: &[OrientedBox],
+    blocks: &[Block],
     f: &mut dyn FnMut(u32, f64),
 ) {
-    let mark = stamps.next();
-    let stamp = &mut stamps.v;
     for b in blocks {
-        index.within_box(b, |i, p| {
-            if stamp[i as usize] == mark {
-                return;
-            }
+        index.within_box(&b.region, |i, p| {
             let d = fit.distance(p);
-            if d <= radius && foot.contains(p) {
-                stamp[i as usize] = mark;
+            if d <= radius && foot.cell_of(p).is_some_and(|c| b.owns(c)) {
                 f(i, d);
             }
         });
@@ -375,7 +396,6 @@ mod tests {
             })
             .collect();
         let index = KdTree::new(&pts, None);
-        let mut stamps = Stamps::new(pts.len());
         for (seeds, line) in [(&seeds_plane, false), (&seeds_line, true)] {
             let fit = if line {
                 Primitive::Line(fit_line_indices(&pts, seeds).unwrap())
@@ -385,9 +405,9 @@ mod tests {
             let foot = Footprint::new(&fit, &pts, seeds, 0.3).unwrap();
             for radius in [0.03, 0.1, 0.3, 0.7, 1.5, 3.0] {
                 let mut got = Vec::new();
-                for_near(&fit, &foot, radius, &index, &mut stamps, &mut |i, d| {
-                    got.push((i, d))
-                });
+                for_near(&fit, &foot, radius, &index, &mut |i, d| got.push((i, d)));
+                // The parallel gathering reports the same, in the same order.
+                assert_eq!(near_points(&fit, &foot, radius, &index), got);
                 got.sort_by_key(|a| a.0);
                 let want: Vec<(u32, f64)> = (0..pts.len() as u32)
                     .filter_map(|i| {
@@ -398,22 +418,15 @@ mod tests {
                     .collect();
                 assert_eq!(got, want, "line {line}, radius {radius}");
                 // Slices of the blocks, as the claims take them: together
-                // the same points, each slice's own once.
+                // the same points, each once (no duplicate to remove).
                 let blocks = foot.near_blocks(radius);
                 let mut sliced = Vec::new();
                 for slice in blocks.chunks(2) {
-                    for_near_in(
-                        &fit,
-                        &foot,
-                        radius,
-                        &index,
-                        &mut stamps,
-                        slice,
-                        &mut |i, d| sliced.push((i, d)),
-                    );
+                    for_near_in(&fit, &foot, radius, &index, slice, &mut |i, d| {
+                        sliced.push((i, d))
+                    });
                 }
                 sliced.sort_by_key(|a| a.0);
-                sliced.dedup();
                 assert_eq!(sliced, want, "sliced: line {line}, radius {radius}");
                 // (not vacuous: from 0.3 on, dozens of points at least)
                 assert!(radius < 0.3 || want.len() > 20, "{}", want.len());

@@ -7,7 +7,7 @@ use super::super::cloud::Cloud;
 use super::super::detection::Primitive;
 use super::super::fit::LineFit;
 use super::super::significance::{log10_n_tests, part_log10_nfa};
-use super::footprint::{for_near, Stamps};
+use super::footprint::for_near;
 use super::{Candidate, Draft, Footprint, Shape};
 use crate::geometry::{normalize, sub};
 use crate::par::map_ranges;
@@ -19,8 +19,7 @@ pub(super) const SHELL_RATIO: f64 = 4.0;
 /// Sets each part's log₁₀ NFA and drops the parts above `log10_epsilon`;
 /// how many went. The background density is that of the points outside
 /// every part over the cloud's bounding box, or the local one around a
-/// part if higher. Parts in parallel, each range of them with its own
-/// stamps.
+/// part if higher. Parts in parallel.
 pub(super) fn reject<S: Shape>(
     parts: &mut Vec<Draft>,
     cands: &[Candidate],
@@ -32,10 +31,10 @@ pub(super) fn reject<S: Shape>(
     let log10_tests = log10_n_tests(cloud.distinct_count(), S::K);
     let nfas = map_ranges(
         parts.len(),
-        || Stamps::new(cloud.points().len()),
-        |stamp, pi| {
+        || (),
+        |_, pi| {
             let p = &parts[pi];
-            part_nfa::<S>(p, &cands[p.cand], cloud, stamp, rho_global, log10_tests)
+            part_nfa::<S>(p, &cands[p.cand], cloud, rho_global, log10_tests)
         },
     );
     for (p, nfa) in parts.iter_mut().zip(nfas) {
@@ -61,7 +60,6 @@ fn part_nfa<S: Shape>(
     p: &Draft,
     c: &Candidate,
     cloud: &Cloud<'_>,
-    stamp: &mut Stamps,
     rho_global: f64,
     log10_tests: f64,
 ) -> Option<f64> {
@@ -80,7 +78,7 @@ fn part_nfa<S: Shape>(
     // Local density in the shell (τ, 4τ] over the footprint.
     let outer = SHELL_RATIO * tau;
     let mut shell = 0usize;
-    for_near(&p.fit, &foot, outer, cloud.index(), stamp, &mut |_, d| {
+    for_near(&p.fit, &foot, outer, cloud.index(), &mut |_, d| {
         if d > tau {
             shell += 1;
         }

@@ -13,7 +13,7 @@ use super::super::cloud::Cloud;
 use super::super::detection::Primitive;
 use super::super::fit::fit_line_indices;
 use super::super::significance::{log10_n_tests, part_log10_nfa};
-use super::footprint::{for_near, Footprint, Stamps};
+use super::footprint::{near_points, Footprint};
 use super::significance::SHELL_RATIO;
 use super::{Candidate, Shape};
 use crate::par::map_ranges;
@@ -39,15 +39,15 @@ const WIDEN_GAIN: f64 = 1.0;
 pub(super) const MAX_WIDEN_BACKGROUND: f64 = 1.0;
 
 /// Sets each candidate's claim radius (module doc). Candidates in
-/// parallel, each range of them with its own stamps.
+/// parallel, and a large candidate's near points too ([`near_points`]).
 pub(super) fn claim_radii<S: Shape>(cands: &mut [Candidate], cloud: &Cloud<'_>) {
     let rho_global = cloud.distinct_count() as f64 / cloud.volume();
     let log10_tests =
         log10_n_tests(cloud.distinct_count(), S::K) + (CLAIM_RADII.len() as f64).log10();
     let taus = map_ranges(
         cands.len(),
-        || Stamps::new(cloud.points().len()),
-        |stamp, ci| best_radius::<S>(&cands[ci], cloud, stamp, rho_global, log10_tests),
+        || (),
+        |_, ci| best_radius::<S>(&cands[ci], cloud, rho_global, log10_tests),
     );
     for (c, (tau, fit)) in cands.iter_mut().zip(taus) {
         c.tau = tau;
@@ -68,7 +68,6 @@ pub(super) fn claim_radii<S: Shape>(cands: &mut [Candidate], cloud: &Cloud<'_>) 
 fn best_radius<S: Shape>(
     c: &Candidate,
     cloud: &Cloud<'_>,
-    stamp: &mut Stamps,
     rho_global: f64,
     log10_tests: f64,
 ) -> (f64, Option<Primitive>) {
@@ -83,10 +82,7 @@ fn best_radius<S: Shape>(
     // One pass over the points near the candidate, out to the widest
     // radius's shell; each radius then counts its own.
     let reach = SHELL_RATIO * radii.last().copied().unwrap_or(base);
-    let mut near_pts: Vec<(u32, f64)> = Vec::new();
-    for_near(&c.fit, &c.foot, reach, cloud.index(), stamp, &mut |i, d| {
-        near_pts.push((i, d))
-    });
+    let near_pts = near_points(&c.fit, &c.foot, reach, cloud.index());
     let mut best = (f64::INFINITY, base, None);
     for &r in &radii {
         // A line as it would claim at r: fitted again on its points within
@@ -97,7 +93,10 @@ fn best_radius<S: Shape>(
         // and inside a tube of the line through all of them. A plane's
         // candidate spans a patch both ways, and is not fitted again.
         let fit_r = if S::K == 1 && r > base {
-            let within: Vec<u32> = near_pts.iter().filter(|x| x.1 <= r).map(|x| x.0).collect();
+            // In index order: the fit of a set, whatever order the
+            // kd-tree's boxes reported it in.
+            let mut within: Vec<u32> = near_pts.iter().filter(|x| x.1 <= r).map(|x| x.0).collect();
+            within.sort_unstable();
             fit_line_indices(points, &within).ok().map(Primitive::Line)
         } else {
             None
