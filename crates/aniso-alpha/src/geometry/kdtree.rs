@@ -90,52 +90,120 @@ fn box_d2(q: &[f64; 3], b: &([f64; 3], [f64; 3])) -> f64 {
     s
 }
 
+/// Points from which [`KdTree::new`] splits a level's nodes on the
+/// pool's threads: 2^15. Smaller trees (a tile's, a subsample's) are
+/// built while other threads build theirs.
+pub const PARALLEL_POINTS: usize = 1 << 15;
+
+/// The nodes' ranges of a tree of `n` points: node `i`'s children are
+/// `2i + 1` and `2i + 2`, a range holding more than [`LEAF`] points is
+/// cut at its middle, and an absent child is `(0, 0)`.
+fn shape(n: usize) -> Vec<(u32, u32)> {
+    let mut range: Vec<(u32, u32)> = vec![(0, n as u32)];
+    let mut node = 0;
+    while node < range.len() {
+        let (s, e) = range[node];
+        if (e - s) as usize > LEAF && ((s, e) != (0, 0) || node == 0) {
+            let mid = s + (e - s) / 2;
+            range.resize((2 * node + 1).max(range.len()), (0, 0));
+            range.push((s, mid));
+            range.push((mid, e));
+        }
+        node += 1;
+    }
+    range
+}
+
+/// Each node's bounding box, with its points split at their median
+/// along the box's widest axis when they are more than [`LEAF`] (the
+/// smaller index first among equal coordinates).
+fn split_node(points: &[[f64; 3]], slice: &mut [u32]) -> ([f64; 3], [f64; 3]) {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for &i in slice.iter() {
+        let p = points[i as usize];
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    if slice.len() > LEAF {
+        let axis = (0..3)
+            .max_by(|&a, &b| (hi[a] - lo[a]).total_cmp(&(hi[b] - lo[b])))
+            .unwrap_or(0);
+        let mid = slice.len() / 2;
+        slice.select_nth_unstable_by(mid, |&a, &b| {
+            points[a as usize][axis]
+                .total_cmp(&points[b as usize][axis])
+                .then(a.cmp(&b))
+        });
+    }
+    (lo, hi)
+}
+
+/// [`split_node`] of each node of a level, on the pool's threads when
+/// `parallel`.
+#[allow(clippy::type_complexity)]
+fn split_level(
+    points: &[[f64; 3]],
+    level: Vec<(usize, &mut [u32])>,
+    parallel: bool,
+) -> Vec<(usize, ([f64; 3], [f64; 3]))> {
+    #[cfg(feature = "parallel")]
+    if parallel {
+        use rayon::prelude::*;
+        return level
+            .into_par_iter()
+            .map(|(node, slice)| (node, split_node(points, slice)))
+            .collect();
+    }
+    let _ = parallel;
+    level
+        .into_iter()
+        .map(|(node, slice)| (node, split_node(points, slice)))
+        .collect()
+}
+
 impl KdTree {
     /// A tree over `points[ids[..]]` (every point when `ids` is `None`).
+    ///
+    /// The tree's shape follows from the number of points alone, so the
+    /// nodes of one level, whose ranges are disjoint, are split at once:
+    /// on the pool's threads from [`PARALLEL_POINTS`] points. Each node's
+    /// split is the same as one node after the other would make it.
     pub fn new(points: &[[f64; 3]], ids: Option<Vec<u32>>) -> Self {
-        let mut ids = ids.unwrap_or_else(|| (0..points.len() as u32).collect());
-        let n = ids.len();
-        // Nodes of the implicit tree: split until ranges hold ≤ LEAF points.
-        let mut range: Vec<(u32, u32)> = vec![(0, n as u32)];
-        let mut bbox: Vec<([f64; 3], [f64; 3])> = Vec::new();
-        let mut node = 0;
-        while node < range.len() {
-            let (s, e) = range[node];
-            let slice = &mut ids[s as usize..e as usize];
-            let mut lo = [f64::INFINITY; 3];
-            let mut hi = [f64::NEG_INFINITY; 3];
-            for &i in slice.iter() {
-                let p = points[i as usize];
-                for k in 0..3 {
-                    lo[k] = lo[k].min(p[k]);
-                    hi[k] = hi[k].max(p[k]);
+        let ids = ids.unwrap_or_else(|| (0..points.len() as u32).collect());
+        let parallel = ids.len() >= PARALLEL_POINTS;
+        Self::build(points, ids, parallel)
+    }
+
+    /// [`Self::new`], its levels on the pool's threads when `parallel`.
+    fn build(points: &[[f64; 3]], mut ids: Vec<u32>, parallel: bool) -> Self {
+        let range = shape(ids.len());
+        let mut bbox: Vec<([f64; 3], [f64; 3])> =
+            vec![([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]); range.len()];
+        let mut first = 0usize;
+        while first < range.len() {
+            // The level's nodes: first..=2·first (the root's level is 0..1).
+            let end = (2 * first + 1).min(range.len());
+            let mut rest: &mut [u32] = &mut ids;
+            let mut at = 0u32;
+            let mut level: Vec<(usize, &mut [u32])> = Vec::new();
+            for (node, &(s, e)) in range.iter().enumerate().take(end).skip(first) {
+                if (s, e) == (0, 0) && node != 0 {
+                    continue;
                 }
+                let (_, tail) = rest.split_at_mut((s - at) as usize);
+                let (mine, tail) = tail.split_at_mut((e - s) as usize);
+                rest = tail;
+                at = e;
+                level.push((node, mine));
             }
-            bbox.push((lo, hi));
-            if slice.len() > LEAF {
-                let axis = (0..3)
-                    .max_by(|&a, &b| (hi[a] - lo[a]).total_cmp(&(hi[b] - lo[b])))
-                    .unwrap_or(0);
-                let mid = slice.len() / 2;
-                slice.select_nth_unstable_by(mid, |&a, &b| {
-                    points[a as usize][axis]
-                        .total_cmp(&points[b as usize][axis])
-                        .then(a.cmp(&b))
-                });
-                // Children 2·node + 1 and 2·node + 2 (ranges pushed in
-                // node order keep the implicit layout).
-                while range.len() < 2 * node + 1 {
-                    range.push((0, 0));
-                }
-                range.push((s, s + mid as u32));
-                range.push((s + mid as u32, e));
+            let boxes = split_level(points, level, parallel);
+            for (node, b) in boxes {
+                bbox[node] = b;
             }
-            node += 1;
-            // Skip the placeholders of absent children (leaves' children).
-            while node < range.len() && range[node] == (0, 0) && node != 0 {
-                bbox.push(([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]));
-                node += 1;
-            }
+            first = end;
         }
         let pts = ids.iter().map(|&i| points[i as usize]).collect();
         Self {
@@ -542,6 +610,28 @@ mod tests {
         let mut got = Vec::new();
         tree.within_box(&b, |i, _| got.push(i));
         assert!(!got.is_empty() && got.iter().any(|&i| !moved.holds(&pts[i as usize])));
+    }
+
+    #[test]
+    fn a_tree_built_in_parallel_is_the_one_built_in_sequence() {
+        let pts = cloud(PARALLEL_POINTS + 5000, 13);
+        let serial = KdTree::build(&pts, (0..pts.len() as u32).collect(), false);
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(4).build().unwrap();
+        let parallel = pool.install(|| KdTree::new(&pts, None));
+        assert_eq!(serial.ids, parallel.ids);
+        assert_eq!(serial.range, parallel.range);
+        assert_eq!(serial.bbox, parallel.bbox);
+        // Every node holds what its box says, and splits at its median.
+        for (node, &(s, e)) in serial.range.iter().enumerate() {
+            let (lo, hi) = serial.bbox[node];
+            for p in &serial.pts[s as usize..e as usize] {
+                assert!((0..3).all(|k| lo[k] <= p[k] && p[k] <= hi[k]));
+            }
+        }
+        // (The comparison can fail: another leaf order differs.)
+        let mut other = serial.ids.clone();
+        other.swap(0, 1);
+        assert_ne!(other, parallel.ids);
     }
 
     #[test]
