@@ -33,6 +33,37 @@ pub(crate) fn map_ranges<T: Send, S>(
     }
 }
 
+/// `f(i)` for `i` in `0..n`, collected in order, each index a task of its
+/// own that any thread may take: for items of very unequal cost (the
+/// components, candidates or parts of a detection, where one, a scan's
+/// ground, can outweigh all the others), which [`map_ranges`]' fixed
+/// ranges would leave to the thread that drew the large one together
+/// with its neighbours.
+pub(crate) fn map_each<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+    #[cfg(feature = "parallel")]
+    {
+        use rayon::prelude::*;
+        (0..n).into_par_iter().map(&f).collect()
+    }
+    #[cfg(not(feature = "parallel"))]
+    {
+        (0..n).map(f).collect()
+    }
+}
+
+/// Sorts `v` (unstable), on the pool's threads from 2^16 elements. The
+/// result is the same for any thread count when equal elements are
+/// indistinguishable (a total order on whole values, as on tuples).
+pub(crate) fn sort_unstable<T: Ord + Send>(v: &mut [T]) {
+    #[cfg(feature = "parallel")]
+    if v.len() >= 1 << 16 {
+        use rayon::slice::ParallelSliceMut;
+        v.par_sort_unstable();
+        return;
+    }
+    v.sort_unstable();
+}
+
 /// The threads of the current pool (1 without the `parallel` feature).
 pub(crate) fn threads() -> usize {
     #[cfg(feature = "parallel")]

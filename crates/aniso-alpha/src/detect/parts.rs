@@ -106,11 +106,25 @@ fn check_points<S: Simplex + AsRef<[u32]>>(
     Ok(())
 }
 
+/// Simplices from which [`grow`] computes their axes and supports on the
+/// pool's threads: 2^14 (a depth frame's table, a scan's ground).
+const PARALLEL_SIMPLICES: usize = 1 << 14;
+
+/// `f(i)` for `i` in `0..n`, in order; on the pool's threads from
+/// [`PARALLEL_SIMPLICES`].
+fn map_large<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+    if n < PARALLEL_SIMPLICES {
+        (0..n).map(f).collect()
+    } else {
+        crate::par::map_ranges(n, || (), |_, i| f(i))
+    }
+}
+
 /// Region growing over unique simplices with axis `axis[s]` (None =
 /// degenerate), returning a part id per input simplex.
-fn grow<S: Simplex>(
+fn grow<S: Simplex + Sync>(
     simplices: &[S],
-    axes: impl Fn(&S) -> Option<[f64; 3]>,
+    axes: impl Fn(&S) -> Option<[f64; 3]> + Sync,
     max_angle_deg: f64,
 ) -> Result<Vec<u32>, PartsError> {
     if !(0.0..=90.0).contains(&max_angle_deg) {
@@ -120,24 +134,23 @@ fn grow<S: Simplex>(
     let n = inc.n;
     // Each unique simplex's axis, NaN where it has none: 24 bytes, not
     // an `Option`'s 32 (a NaN axis is alike to none, as `None` was).
-    let axis: Vec<[f64; 3]> = inc
-        .unique_to_input
-        .iter()
-        .map(|&i| axes(&simplices[i as usize]).unwrap_or([f64::NAN; 3]))
-        .collect();
+    let axis: Vec<[f64; 3]> = map_large(n, |u| {
+        axes(&simplices[inc.unique_to_input[u] as usize]).unwrap_or([f64::NAN; 3])
+    });
     let cos_tol = max_angle_deg.to_radians().cos();
     let alike = |a: usize, b: usize| dot(axis[a], axis[b]).abs() >= cos_tol;
     // Like-oriented neighbour counts (through faces).
-    let mut support = vec![0u32; n];
-    for (s, sup) in support.iter_mut().enumerate() {
+    let support: Vec<u32> = map_large(n, |s| {
+        let mut sup = 0u32;
         for &f in inc.faces_of(s) {
             for &t in inc.face(f as usize) {
                 if t as usize != s && alike(s, t as usize) {
-                    *sup += 1;
+                    sup += 1;
                 }
             }
         }
-    }
+        sup
+    });
     let mut order: Vec<u32> = (0..n as u32).collect();
     order.sort_by(|&a, &b| {
         support[b as usize]

@@ -10,7 +10,7 @@ use super::super::filter::{components, FilterError};
 use super::super::regime::Regime;
 use super::super::scan::{Face, LINE_SCAN_MIN};
 use super::{Candidate, Footprint, Settings};
-use crate::par::map_ranges;
+use crate::par::{map_each, map_ranges};
 
 /// At most this many pieces of a component (the largest) give a
 /// candidate besides the whole component's fit.
@@ -36,34 +36,30 @@ pub(super) fn find<S: Face>(
         settings.min_vertices
     };
     // Components are independent: extracted in parallel, in order.
-    let per_component = map_ranges(
-        comps.len(),
-        || (),
-        |_, k| {
-            let (g, ss) = &comps[k];
-            let scale = settings.scales[*g as usize];
-            let local: Vec<S> = ss.iter().map(|&s| kept[s as usize]).collect();
-            extract(points, &local, scale.tau, seed_min, settings.part_angle_deg)
-                .into_iter()
-                .filter_map(|(seeds, fit)| {
-                    let foot = Footprint::new(&fit, points, &seeds, scale.cell)?;
-                    Some(Candidate {
-                        fit,
-                        tau: scale.tau,
-                        cell: scale.cell,
-                        seeds,
-                        foot,
-                    })
+    let per_component = map_each(comps.len(), |k| {
+        let (g, ss) = &comps[k];
+        let scale = settings.scales[*g as usize];
+        let local: Vec<S> = ss.iter().map(|&s| kept[s as usize]).collect();
+        extract(points, &local, scale.tau, seed_min, settings.part_angle_deg)
+            .into_iter()
+            .filter_map(|(seeds, fit)| {
+                let foot = Footprint::new(&fit, points, &seeds, scale.cell)?;
+                Some(Candidate {
+                    fit,
+                    tau: scale.tau,
+                    cell: scale.cell,
+                    seeds,
+                    foot,
                 })
-                .collect::<Vec<Candidate>>()
-        },
-    );
+            })
+            .collect::<Vec<Candidate>>()
+    });
     Ok(per_component.into_iter().flatten().collect())
 }
 
 /// The connected components of each group's simplices: (group, indices
 /// into `kept`), group by group, components in the order
-/// [`components`] numbers them.
+/// [`components`] numbers them. Groups on the pool's threads.
 fn group_components<S: Face>(
     kept: &[S],
     group: &[u32],
@@ -73,10 +69,10 @@ fn group_components<S: Face>(
     for (s, &g) in group.iter().enumerate() {
         by_group[g as usize].push(s as u32);
     }
-    let mut out: Vec<(u32, Vec<u32>)> = Vec::new();
-    for (g, ss) in by_group.iter().enumerate() {
+    let per_group = map_each(n_groups, |g| -> Result<Vec<(u32, Vec<u32>)>, FilterError> {
+        let ss = &by_group[g];
         if ss.is_empty() {
-            continue;
+            return Ok(Vec::new());
         }
         let local: Vec<S> = ss.iter().map(|&s| kept[s as usize]).collect();
         let comp = components(&local)?;
@@ -85,7 +81,11 @@ fn group_components<S: Face>(
         for (k, &c) in comp.iter().enumerate() {
             parts[c as usize].push(ss[k]);
         }
-        out.extend(parts.into_iter().map(|p| (g as u32, p)));
+        Ok(parts.into_iter().map(|p| (g as u32, p)).collect())
+    });
+    let mut out = Vec::new();
+    for g in per_group {
+        out.extend(g?);
     }
     Ok(out)
 }
@@ -202,7 +202,7 @@ fn count_each(
     if verts.len() < CHUNKED_VERTICES {
         return cands.iter().map(count).collect();
     }
-    map_ranges(cands.len(), || (), |_, ci| count(&cands[ci]))
+    map_each(cands.len(), |ci| count(&cands[ci]))
 }
 
 /// The candidate primitives of a component with the vertices `verts`: the
@@ -232,12 +232,17 @@ fn piece_fits<S: Face>(
         })
         .collect();
     by_size.sort_unstable_by(|a, b| b.0.cmp(&a.0).then(a.1.cmp(&b.1)));
-    let mut cands: Vec<Primitive> = by_size
+    let fitted: Vec<usize> = by_size
         .iter()
         .take(MAX_PIECES)
         .filter(|&&(sz, _)| sz >= S::K + 2)
-        .map(|&(_, i)| S::fit(points, &pv[i]))
+        .map(|&(_, i)| i)
         .collect();
+    let mut cands: Vec<Primitive> = if verts.len() < CHUNKED_VERTICES {
+        fitted.iter().map(|&i| S::fit(points, &pv[i])).collect()
+    } else {
+        map_each(fitted.len(), |k| S::fit(points, &pv[fitted[k]]))
+    };
     cands.push(S::fit(points, verts));
     cands
 }

@@ -26,7 +26,7 @@ use super::footprint::for_near_in;
 use super::moments::Moments;
 use super::same::{absorbed, Piece};
 use super::{Candidate, Draft, Footprint, Shape};
-use crate::par::map_ranges;
+use crate::par::map_each;
 use crate::unionfind::UnionFind;
 use std::collections::HashSet;
 
@@ -190,31 +190,27 @@ fn claim_slices<T: Send>(
         .map(|c| c.foot.near_block_count(c.tau))
         .collect();
     let slices = slices_of(&counts);
-    map_ranges(
-        slices.len(),
-        || (),
-        |_, k| {
-            let (ci, from, to) = slices[k];
-            let c = &cands[ci];
-            let agrees = normal_agreement(&c.fit, normals);
-            let mut claims = Vec::new();
-            for_near_in(
-                &c.fit,
-                &c.foot,
-                c.tau,
-                cloud.index(),
-                &c.foot.near_blocks_in(c.tau, (from, to)),
-                &mut |i, d| {
-                    if agrees(i) {
-                        claims.push(make(i, d));
-                    }
-                },
-            );
-            // Held until every slice is done: no growth slack.
-            claims.shrink_to_fit();
-            (ci as u32, claims)
-        },
-    )
+    map_each(slices.len(), |k| {
+        let (ci, from, to) = slices[k];
+        let c = &cands[ci];
+        let agrees = normal_agreement(&c.fit, normals);
+        let mut claims = Vec::new();
+        for_near_in(
+            &c.fit,
+            &c.foot,
+            c.tau,
+            cloud.index(),
+            &c.foot.near_blocks_in(c.tau, (from, to)),
+            &mut |i, d| {
+                if agrees(i) {
+                    claims.push(make(i, d));
+                }
+            },
+        );
+        // Held until every slice is done: no growth slack.
+        claims.shrink_to_fit();
+        (ci as u32, claims)
+    })
 }
 
 /// The distinct pairs (a < b) of what `of` maps two candidates of one

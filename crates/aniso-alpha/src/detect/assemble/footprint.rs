@@ -7,7 +7,7 @@
 use super::super::detection::Primitive;
 use crate::geometry::kdtree::{KdTree, OrientedBox};
 use crate::geometry::{cross, dot, normalize, sub};
-use crate::par::map_ranges;
+use crate::par::map_each;
 
 /// The cells a candidate covers on its plane (2D) or along its line (1D).
 #[derive(Debug, Clone)]
@@ -268,7 +268,7 @@ pub(super) fn near_points(
     }
     let size = blocks.len().div_ceil(4 * crate::par::threads()).max(1);
     let slices: Vec<&[Block]> = blocks.chunks(size).collect();
-    map_ranges(slices.len(), || (), |_, k| gather(slices[k])).concat()
+    map_each(slices.len(), |k| gather(slices[k])).concat()
 }
 
 impl Footprint {

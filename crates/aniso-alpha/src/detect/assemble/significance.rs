@@ -10,7 +10,7 @@ use super::super::significance::{log10_n_tests, part_log10_nfa};
 use super::footprint::for_near;
 use super::{Candidate, Draft, Footprint, Shape};
 use crate::geometry::{normalize, sub};
-use crate::par::map_ranges;
+use crate::par::map_each;
 
 /// Ratio of the outer to the inner radius of the shell in which the local
 /// background density around a part is measured.
@@ -29,14 +29,10 @@ pub(super) fn reject<S: Shape>(
     let in_parts: usize = parts.iter().map(|p| p.members.len()).sum();
     let rho_global = cloud.distinct_count().saturating_sub(in_parts) as f64 / cloud.volume();
     let log10_tests = log10_n_tests(cloud.distinct_count(), S::K);
-    let nfas = map_ranges(
-        parts.len(),
-        || (),
-        |_, pi| {
-            let p = &parts[pi];
-            part_nfa::<S>(p, &cands[p.cand], cloud, rho_global, log10_tests)
-        },
-    );
+    let nfas = map_each(parts.len(), |pi| {
+        let p = &parts[pi];
+        part_nfa::<S>(p, &cands[p.cand], cloud, rho_global, log10_tests)
+    });
     for (p, nfa) in parts.iter_mut().zip(nfas) {
         if let Some(nfa) = nfa {
             p.log10_nfa = nfa;

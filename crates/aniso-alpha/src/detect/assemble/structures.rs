@@ -14,7 +14,7 @@ use super::super::StructureKind;
 use super::claims::Claims;
 use super::shape::crosses;
 use super::{Candidate, Draft, Shape};
-use crate::par::map_ranges;
+use crate::par::map_each;
 use crate::unionfind::UnionFind;
 
 /// The detection of `parts` (module doc); `claims` are the candidates'
@@ -46,18 +46,14 @@ pub(super) fn detection<S: Shape>(
     // Each part's outline and mesh, or segment, the parts in parallel;
     // then the union's simplices into the structures.
     let numbered: Vec<&Part> = structures.iter().flat_map(|st| &st.parts).collect();
-    let shapes = map_ranges(
-        numbered.len(),
-        || (),
-        |_, k| {
-            S::outline(
-                &numbered[k].primitive,
-                &numbered[k].vertices,
-                cells[k],
-                points,
-            )
-        },
-    );
+    let shapes = map_each(numbered.len(), |k| {
+        S::outline(
+            &numbered[k].primitive,
+            &numbered[k].vertices,
+            cells[k],
+            points,
+        )
+    });
     let parts = structures.iter_mut().flat_map(|st| st.parts.iter_mut());
     for (part, (outline, mesh)) in parts.zip(shapes) {
         (part.outline, part.mesh) = (outline, mesh);

@@ -16,7 +16,7 @@ use super::super::significance::{log10_n_tests, part_log10_nfa};
 use super::footprint::{near_points, Footprint};
 use super::significance::SHELL_RATIO;
 use super::{Candidate, Shape};
-use crate::par::map_ranges;
+use crate::par::map_each;
 
 /// Claim radii tried for a candidate, in units of its τ: a line whose
 /// points are jittered by σ per coordinate has its distances to the line
@@ -44,11 +44,9 @@ pub(super) fn claim_radii<S: Shape>(cands: &mut [Candidate], cloud: &Cloud<'_>) 
     let rho_global = cloud.distinct_count() as f64 / cloud.volume();
     let log10_tests =
         log10_n_tests(cloud.distinct_count(), S::K) + (CLAIM_RADII.len() as f64).log10();
-    let taus = map_ranges(
-        cands.len(),
-        || (),
-        |_, ci| best_radius::<S>(&cands[ci], cloud, rho_global, log10_tests),
-    );
+    let taus = map_each(cands.len(), |ci| {
+        best_radius::<S>(&cands[ci], cloud, rho_global, log10_tests)
+    });
     for (c, (tau, fit)) in cands.iter_mut().zip(taus) {
         c.tau = tau;
         if let Some(fit) = fit {
