@@ -319,7 +319,7 @@ pub(crate) fn position_key(p: &[f64; 3]) -> [u64; 3] {
 /// The number of distinct positions among `points` ([`position_key`]).
 pub(crate) fn distinct_count(points: &[[f64; 3]]) -> usize {
     let mut keys: Vec<[u64; 3]> = points.iter().map(position_key).collect();
-    keys.sort_unstable();
+    crate::par::sort_unstable(&mut keys);
     keys.dedup();
     keys.len()
 }

@@ -616,7 +616,10 @@ mod tests {
     fn a_tree_built_in_parallel_is_the_one_built_in_sequence() {
         let pts = cloud(PARALLEL_POINTS + 5000, 13);
         let serial = KdTree::build(&pts, (0..pts.len() as u32).collect(), false);
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(4).build().unwrap();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(4)
+            .build()
+            .unwrap();
         let parallel = pool.install(|| KdTree::new(&pts, None));
         assert_eq!(serial.ids, parallel.ids);
         assert_eq!(serial.range, parallel.range);

@@ -551,7 +551,7 @@ pub(crate) fn union<S: Face>(per_job: Vec<(u32, Vec<S>)>) -> (Vec<S>, Vec<u32>) 
         .into_iter()
         .flat_map(|(g, faces)| faces.into_iter().map(move |f| (f, g)))
         .collect();
-    all.sort_unstable();
+    crate::par::sort_unstable(&mut all);
     all.dedup_by(|b, a| a.0 == b.0);
     all.into_iter().unzip()
 }
