@@ -906,29 +906,45 @@ fn mode_members(
     kind: StructureKind,
     shapes: &[LocalShape],
     found: &[Mode],
-    off: &dyn Fn(usize) -> bool,
+    off: &(dyn Fn(usize) -> bool + Sync),
 ) -> Vec<Vec<u32>> {
     let cos_cone = CONE_DEG.to_radians().cos();
     let margin = MARGIN_DEG.to_radians();
-    let mut member_of: Vec<Vec<u32>> = vec![Vec::new(); found.len()];
-    let mut ang: Vec<f64> = vec![0.0; found.len()];
-    for i in 0..shapes.len() as u32 {
-        if off(i as usize) {
-            continue;
-        }
-        let a = axis64(&shapes[i as usize], kind);
-        let mut best = f64::INFINITY;
-        for (k, m) in found.iter().enumerate() {
-            ang[k] = dot(a, m.axis).abs().min(1.0).acos();
-            best = best.min(ang[k]);
-        }
-        for k in 0..found.len() {
-            if ang[k].cos() >= cos_cone && ang[k] <= best + margin {
-                member_of[k].push(i);
+    // Chunks of points on the pool's threads, their lists joined in order.
+    const CHUNK: usize = 1 << 13;
+    let n = shapes.len();
+    let per_chunk = crate::par::map_ranges(
+        n.div_ceil(CHUNK),
+        || vec![0.0f64; found.len()],
+        |ang, c| {
+            let mut member_of: Vec<Vec<u32>> = vec![Vec::new(); found.len()];
+            for i in (c * CHUNK) as u32..n.min((c + 1) * CHUNK) as u32 {
+                if off(i as usize) {
+                    continue;
+                }
+                let a = axis64(&shapes[i as usize], kind);
+                let mut best = f64::INFINITY;
+                for (k, m) in found.iter().enumerate() {
+                    ang[k] = dot(a, m.axis).abs().min(1.0).acos();
+                    best = best.min(ang[k]);
+                }
+                for k in 0..found.len() {
+                    if ang[k].cos() >= cos_cone && ang[k] <= best + margin {
+                        member_of[k].push(i);
+                    }
+                }
             }
-        }
-    }
-    member_of
+            member_of
+        },
+    );
+    (0..found.len())
+        .map(|k| {
+            per_chunk
+                .iter()
+                .flat_map(|m| m[k].iter().copied())
+                .collect()
+        })
+        .collect()
 }
 
 /// The scan of mode `m` over its `members`, of spacing d and noise σ
