@@ -50,7 +50,7 @@ mod sealed {
 }
 
 /// An edge `[u32; 2]` or a triangle `[u32; 3]`. Sealed.
-pub trait Simplex: Copy + Ord + sealed::Sealed {
+pub trait Simplex: Copy + Ord + Send + Sync + sealed::Sealed {
     /// Number of vertices (= number of faces): 2 or 3.
     const VERTICES: usize;
     /// The simplex with its vertices sorted ascending, or `None` if a vertex
@@ -153,32 +153,82 @@ fn half_faces_by_key<S: Simplex>(unique: &[S]) -> Vec<u32> {
     let k = S::VERTICES;
     let m = unique.len() * k;
     let key = |h: usize| unique[h / k].face_key(h % k);
-    let lead = |h: usize| (key(h) >> S::LEAD_SHIFT) as usize;
-    let top = (0..m).map(lead).max().unwrap_or(0);
+    let lead: Vec<u32> = (0..m).map(|h| (key(h) >> S::LEAD_SHIFT) as u32).collect();
+    let top = lead.iter().copied().max().unwrap_or(0) as usize;
     if top >= m {
+        drop(lead);
         let mut pairs: Vec<(u64, u32)> = (0..m).map(|h| (key(h), h as u32)).collect();
         pairs.sort_unstable();
         return pairs.into_iter().map(|(_, h)| h).collect();
     }
     let mut start = vec![0u32; top + 2];
-    for h in 0..m {
-        start[lead(h) + 1] += 1;
+    for &v in &lead {
+        start[v as usize + 1] += 1;
     }
     for v in 0..=top {
         start[v + 1] += start[v];
     }
     let mut half = vec![0u32; m];
     let mut next = start.clone();
-    for h in 0..m {
-        let slot = &mut next[lead(h)];
+    for (h, &v) in lead.iter().enumerate() {
+        let slot = &mut next[v as usize];
         half[*slot as usize] = h as u32;
         *slot += 1;
     }
     drop(next);
-    for w in start.windows(2) {
-        half[w[0] as usize..w[1] as usize].sort_unstable_by_key(|&h| (key(h as usize), h));
-    }
+    drop(lead);
+    // Each vertex's few half-faces by key: in chunks of whole vertices on
+    // the pool's threads when they are many.
+    let sort_vertices = |half: &mut [u32], from: usize, to: usize| {
+        let base = start[from] as usize;
+        for w in start[from..=to].windows(2) {
+            half[w[0] as usize - base..w[1] as usize - base]
+                .sort_unstable_by_key(|&h| (key(h as usize), h));
+        }
+    };
+    sort_by_vertex_chunks(&mut half, &start, top + 1, &sort_vertices);
     half
+}
+
+/// Half-faces from which [`half_faces_by_key`] sorts its vertices' lists
+/// on the pool's threads: 2^16.
+const PARALLEL_HALF_FACES: usize = 1 << 16;
+
+/// `sort(chunk, from, to)` over chunks of `half` holding the lists of
+/// vertices `from..to` (`start`: each vertex's first half-face, and the
+/// end), about four chunks a thread from [`PARALLEL_HALF_FACES`].
+fn sort_by_vertex_chunks(
+    half: &mut [u32],
+    start: &[u32],
+    vertices: usize,
+    sort: &(dyn Fn(&mut [u32], usize, usize) + Sync),
+) {
+    let threads = crate::par::threads();
+    if half.len() < PARALLEL_HALF_FACES || threads < 2 {
+        sort(half, 0, vertices);
+        return;
+    }
+    // Vertex bounds of about equal numbers of half-faces.
+    let pieces = 4 * threads;
+    let mut bounds = vec![0usize];
+    for p in 1..pieces {
+        let target = (half.len() * p / pieces) as u32;
+        let v = start.partition_point(|&s| s < target).min(vertices);
+        if v > *bounds.last().unwrap_or(&0) {
+            bounds.push(v);
+        }
+    }
+    bounds.push(vertices);
+    bounds.dedup();
+    let mut chunks: Vec<(&mut [u32], usize, usize)> = Vec::new();
+    let mut rest = half;
+    for w in bounds.windows(2) {
+        let len = (start[w[1]] - start[w[0]]) as usize;
+        let (mine, tail) = rest.split_at_mut(len);
+        rest = tail;
+        chunks.push((mine, w[0], w[1]));
+    }
+    crate::par::for_each_mut(chunks, |(chunk, from, to)| sort(chunk, from, to));
 }
 
 impl Incidence {
@@ -191,9 +241,15 @@ impl Incidence {
         for (index, &s) in simplices.iter().enumerate() {
             canon.push(s.canonical().ok_or(FilterError::RepeatedVertex { index })?);
         }
-        // Merge repeated simplices.
+        // Merge repeated simplices. The lists the detection passes (the
+        // union and its subsets) are sorted and distinct already: then
+        // the order is the input's, without a sort.
         let mut order: Vec<u32> = (0..canon.len() as u32).collect();
-        order.sort_unstable_by(|&a, &b| canon[a as usize].cmp(&canon[b as usize]).then(a.cmp(&b)));
+        if !canon.windows(2).all(|w| w[0] < w[1]) {
+            order.sort_unstable_by(|&a, &b| {
+                canon[a as usize].cmp(&canon[b as usize]).then(a.cmp(&b))
+            });
+        }
         let mut input_to_unique = vec![0u32; canon.len()];
         let mut unique_to_input: Vec<u32> = Vec::with_capacity(canon.len());
         let mut last: Option<S> = None;

@@ -352,3 +352,45 @@ fn half_faces_sorted_by_key_dense_and_sparse() {
     let identity: Vec<u32> = (0..150).collect();
     assert_ne!(identity, half_faces_naive(&tris));
 }
+
+/// From `PARALLEL_HALF_FACES` half-faces the vertices' lists are sorted
+/// in chunks on the threads: the same order as the oracle's, on four
+/// threads and on one.
+#[test]
+fn half_faces_sorted_in_parallel_chunks() {
+    let mut rng = crate::rng::SplitMix64::new(17);
+    let count = super::PARALLEL_HALF_FACES / 3 + 1000;
+    let tris = random_simplices(&mut rng, count, 20_000, 0, <[u32; 3] as Simplex>::canonical);
+    let want = half_faces_naive(&tris);
+    for threads in [1, 4] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        assert_eq!(pool.install(|| half_faces_by_key(&tris)), want, "{threads}");
+    }
+}
+
+/// Sorted distinct simplices skip the merge's sort; unsorted ones with
+/// repeats are merged as before: the same incidence either way.
+#[test]
+fn an_incidence_of_sorted_simplices_is_that_of_any_order() {
+    let mut rng = crate::rng::SplitMix64::new(23);
+    let mut tris = random_simplices(&mut rng, 3000, 400, 0, <[u32; 3] as Simplex>::canonical);
+    tris.sort_unstable();
+    tris.dedup();
+    let sorted = Incidence::new(&tris).unwrap();
+    let mut shuffled = tris.clone();
+    shuffled.reverse();
+    shuffled.push(shuffled[0]);
+    let other = Incidence::new(&shuffled).unwrap();
+    assert_eq!(sorted.n, other.n);
+    assert_eq!(sorted.num_faces(), other.num_faces());
+    for u in 0..sorted.n {
+        let faces = |inc: &Incidence, u: usize| -> Vec<Vec<u32>> {
+            inc.faces_of(u).iter().map(|&f| inc.face(f as usize).to_vec()).collect()
+        };
+        assert_eq!(faces(&sorted, u), faces(&other, u));
+    }
+    assert_eq!(sorted.unique_to_input, (0..tris.len() as u32).collect::<Vec<_>>());
+}
