@@ -389,7 +389,7 @@ fn raw_faces_at<S: Face>(
     Ok((faces, triangulated))
 }
 
-/// Points per tile of a large job ([`tile_grid`]): 2^14. One
+/// Points per tile of a large job ([`tile_grid`]): 2^13. One
 /// triangulation holds about 7 cells of 32 bytes a point besides its
 /// points, so a job of 72,000 points (the table of a depth frame) held
 /// 18 MB at once, as much as CGAL's Efficient RANSAC's whole process on
@@ -398,11 +398,17 @@ fn raw_faces_at<S: Face>(
 /// at a time"; 2 threads, tiles of 2^14 / 2^15 / 2^16 / never): mOSD
 /// learn 5 peak 35 / 37 / 38 / 40 MB, scan 0.12 / 0.13 / 0.19 / 0.19 s;
 /// the simulated house 5.2 / 4.9 / 4.9 / 5.9 s; the room and the AHN
-/// tile alike within 0.03 s. On one thread a tile's own costs (its halo,
-/// its points from the kd-tree, its first tetrahedron) cost the house's
-/// scan 18%.
+/// tile alike within 0.03 s. Then 2^13 against 2^14 (train, 2 threads,
+/// two runs each): the AHN tile 20.1–21.4 against 22.6–23.4 MB, the
+/// simulated airborne block 21.5–21.7 against 22.4–22.9 MB, mOSD learn 5,
+/// learn 17, the room, the halls, CGAL's building and the house within
+/// a run's spread (±1.5 MB), and the same wall times (the house 3.75–3.82
+/// s on two threads, 5.98–6.20 s on one, either size). On one thread a
+/// tile's own costs (its halo, its points from the kd-tree, its first
+/// tetrahedron) cost the house's scan 18% at 2^14 against one
+/// triangulation.
 #[cfg(not(test))]
-const TILE_POINTS: usize = 1 << 14;
+const TILE_POINTS: usize = 1 << 13;
 /// A few hundred points in the tests, so that small clouds take the path.
 #[cfg(test)]
 const TILE_POINTS: usize = 1 << 8;
