@@ -457,21 +457,18 @@ fn faces_in_tiles<S: Face>(
     tiles.sort_unstable();
     tiles.dedup();
     let index = crate::geometry::kdtree::KdTree::new(points, Some(map.to_vec()));
-    let per_tile = crate::par::map_ranges(
-        tiles.len(),
-        || (),
-        |_, k| {
-            let t = tiles[k];
-            let sub = tile_points(points, &index, grid.bounds(t), h);
-            // `map` is ascending: a kept point's transform is at its rank.
-            let sub_q: Vec<[f64; 3]> = sub
-                .iter()
-                .map(|i| q[map.binary_search(i).expect("a kept point")])
-                .collect();
-            let owned = |v: u32| cell(&points[v as usize]) == t;
-            faces_at::<S>(sub_q, &sub, alphas, &owned)
-        },
-    );
+    // Each tile a task: tiles hold from a few points to a full tile's.
+    let per_tile = crate::par::map_each(tiles.len(), |k| {
+        let t = tiles[k];
+        let sub = tile_points(points, &index, grid.bounds(t), h);
+        // `map` is ascending: a kept point's transform is at its rank.
+        let sub_q: Vec<[f64; 3]> = sub
+            .iter()
+            .map(|i| q[map.binary_search(i).expect("a kept point")])
+            .collect();
+        let owned = |v: u32| cell(&points[v as usize]) == t;
+        faces_at::<S>(sub_q, &sub, alphas, &owned)
+    });
     let mut faces: Vec<Vec<S>> = vec![Vec::new(); alphas.len()];
     for tile in per_tile {
         for (all, f) in faces.iter_mut().zip(tile?) {
