@@ -388,9 +388,15 @@ fn an_incidence_of_sorted_simplices_is_that_of_any_order() {
     assert_eq!(sorted.num_faces(), other.num_faces());
     for u in 0..sorted.n {
         let faces = |inc: &Incidence, u: usize| -> Vec<Vec<u32>> {
-            inc.faces_of(u).iter().map(|&f| inc.face(f as usize).to_vec()).collect()
+            inc.faces_of(u)
+                .iter()
+                .map(|&f| inc.face(f as usize).to_vec())
+                .collect()
         };
         assert_eq!(faces(&sorted, u), faces(&other, u));
     }
-    assert_eq!(sorted.unique_to_input, (0..tris.len() as u32).collect::<Vec<_>>());
+    assert_eq!(
+        sorted.unique_to_input,
+        (0..tris.len() as u32).collect::<Vec<_>>()
+    );
 }
