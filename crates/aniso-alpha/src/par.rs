@@ -1,5 +1,6 @@
-//! Order-preserving parallel maps: rayon with the `parallel` feature, a
-//! plain loop without. The result never depends on the thread count.
+//! Order-preserving parallel maps, a parallel sort and loop: rayon with
+//! the `parallel` feature, a plain loop (or sort) without. The result
+//! never depends on the thread count.
 
 /// `f(state, i)` for `i` in `0..n`, collected in order. The indices are cut
 /// into contiguous ranges, about four per thread, and each range runs on
@@ -113,7 +114,40 @@ pub(crate) fn spawn_workers(copies: usize, worker: impl Fn() + Sync) {
 
 #[cfg(test)]
 mod tests {
-    use super::map_ranges;
+    use super::{for_each_mut, map_each, map_ranges, sort_unstable};
+
+    #[test]
+    fn map_each_sort_and_loop_do_not_depend_on_the_threads() {
+        let mut rng = crate::rng::SplitMix64::new(5);
+        let values: Vec<(u32, u32)> = (0..100_000)
+            .map(|_| (rng.below(1000) as u32, rng.below(7) as u32))
+            .collect();
+        let mut want = values.clone();
+        want.sort_unstable();
+        for threads in [1, 4] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                for n in [0, 1, 7, 1001] {
+                    assert_eq!(
+                        map_each(n, |i| i * i),
+                        (0..n).map(|i| i * i).collect::<Vec<_>>()
+                    );
+                }
+                let mut got = values.clone();
+                sort_unstable(&mut got);
+                assert_eq!(got, want);
+                let mut buf = vec![0u32; 1000];
+                let chunks: Vec<(usize, &mut [u32])> = buf.chunks_mut(100).enumerate().collect();
+                for_each_mut(chunks, |(k, c)| c.iter_mut().for_each(|x| *x = k as u32));
+                assert!(buf.iter().enumerate().all(|(i, &x)| x as usize == i / 100));
+            });
+        }
+        // (The comparison can fail: the unsorted values are not sorted.)
+        assert_ne!(values, want);
+    }
 
     #[test]
     fn in_order_with_a_state_per_range() {
