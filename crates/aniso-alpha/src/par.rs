@@ -3,9 +3,11 @@
 //! never depends on the thread count.
 
 /// `f(state, i)` for `i` in `0..n`, collected in order. The indices are cut
-/// into contiguous ranges, about four per thread, and each range runs on
-/// one worker with one state from `init` (a scratch buffer): at most about
-/// 4·threads states live at once, so a state may be as large as the input.
+/// into contiguous ranges of at least n/(4·threads) indices, and each range
+/// runs on one worker with one state from `init` (a scratch buffer): at
+/// most about 4·threads states are made, one a thread at a time, so a
+/// state may be as large as the input. The results are written in place
+/// into the one output vector (no per-range vectors joined after).
 pub(crate) fn map_ranges<T: Send, S>(
     n: usize,
     init: impl Fn() -> S + Sync,
@@ -16,16 +18,11 @@ pub(crate) fn map_ranges<T: Send, S>(
         use rayon::prelude::*;
         let ranges = 4 * rayon::current_num_threads().max(1);
         let size = n.div_ceil(ranges).max(1);
-        let per: Vec<Vec<T>> = (0..n.div_ceil(size))
+        (0..n)
             .into_par_iter()
-            .map(|r| {
-                let mut state = init();
-                (r * size..((r + 1) * size).min(n))
-                    .map(|i| f(&mut state, i))
-                    .collect()
-            })
-            .collect();
-        per.into_iter().flatten().collect()
+            .with_min_len(size)
+            .map_init(&init, |state, i| f(state, i))
+            .collect()
     }
     #[cfg(not(feature = "parallel"))]
     {
