@@ -122,7 +122,7 @@ fn map_large<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
 
 /// Region growing over unique simplices with axis `axis[s]` (None =
 /// degenerate), returning a part id per input simplex.
-fn grow<S: Simplex + Sync>(
+fn grow<S: Simplex>(
     simplices: &[S],
     axes: impl Fn(&S) -> Option<[f64; 3]> + Sync,
     max_angle_deg: f64,

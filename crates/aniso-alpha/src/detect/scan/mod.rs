@@ -277,11 +277,7 @@ pub(crate) fn halo_width(job: &Job<'_>) -> f64 {
 
 /// The tile (integer cell of side `side`) that owns a point.
 pub(crate) fn tile_cell(p: &[f64; 3], side: f64) -> [i64; 3] {
-    TileGrid {
-        side,
-        origin: [0.0; 3],
-    }
-    .cell(p)
+    TileGrid::from_origin(side).cell(p)
 }
 
 /// The cubes a large job is cut into ([`tile_grid`]): side `side`, corner
@@ -293,6 +289,16 @@ struct TileGrid {
 }
 
 impl TileGrid {
+    /// The cubes of side `side` from the origin: the tiles a user asks for
+    /// (`--tile`) and those of the distributed split, which separate runs
+    /// must agree on.
+    fn from_origin(side: f64) -> Self {
+        TileGrid {
+            side,
+            origin: [0.0; 3],
+        }
+    }
+
     /// The cube that owns point `p`.
     fn cell(&self, p: &[f64; 3]) -> [i64; 3] {
         [0, 1, 2].map(|k| ((p[k] - self.origin[k]) / self.side).floor() as i64)
@@ -355,10 +361,7 @@ fn raw_faces_at<S: Face>(
     };
     // Tiles: integer cells of side `side`; halo `h` around each.
     let h = halo_width(job);
-    let grid = TileGrid {
-        side,
-        origin: [0.0; 3],
-    };
+    let grid = TileGrid::from_origin(side);
     let cell = |p: &[f64; 3]| -> [i64; 3] { grid.cell(p) };
     let mut keyed: Vec<([i64; 3], u32)> = ids
         .iter()
@@ -606,10 +609,7 @@ mod tests {
             .collect();
         assert_eq!(layers.len(), 1, "{layers:?}");
         // The oracle tells a grid from the origin apart.
-        let from_origin = TileGrid {
-            origin: [0.0; 3],
-            ..grid
-        };
+        let from_origin = TileGrid::from_origin(grid.side);
         assert!(pts
             .iter()
             .any(|p| from_origin.cell(p)[2] != grid.cell(p)[2]));
