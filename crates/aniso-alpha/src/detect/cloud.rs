@@ -80,6 +80,9 @@ pub(crate) struct Cloud<'a> {
     copies: &'a Copies,
     volume: f64,
     index: OnceLock<KdTree>,
+    /// Set by [`Self::release_index`]: a query after it is a bug (the
+    /// tree would be built twice), caught in debug builds.
+    released: bool,
 }
 
 impl<'a> Cloud<'a> {
@@ -91,6 +94,7 @@ impl<'a> Cloud<'a> {
             copies,
             volume: (0..3).map(|k| (hi[k] - lo[k]).max(1e-300)).product(),
             index: OnceLock::new(),
+            released: false,
         }
     }
 
@@ -117,8 +121,17 @@ impl<'a> Cloud<'a> {
 
     /// A kd-tree of the distinct points (built on the first call).
     pub(crate) fn index(&self) -> &KdTree {
+        debug_assert!(!self.released, "the kd-tree queried after its release");
         self.index
             .get_or_init(|| KdTree::new(self.points, Some(self.copies.distinct.clone())))
+    }
+
+    /// Frees the kd-tree (a copy of the points and their order, 36 bytes
+    /// a point): the assembly's last stages, where a large part's outline
+    /// peaks, do not query it (debug builds assert that nothing does).
+    pub(crate) fn release_index(&mut self) {
+        self.index = OnceLock::new();
+        self.released = true;
     }
 }
 

@@ -128,10 +128,11 @@ impl std::error::Error for FilterError {}
 
 /// Flat incidence structure of a simplex set.
 pub(crate) struct Incidence {
-    /// Input position → unique simplex.
-    pub(crate) input_to_unique: Vec<u32>,
-    /// Unique simplex → its first input position.
-    pub(crate) unique_to_input: Vec<u32>,
+    /// Input position → unique simplex, and unique simplex → its first
+    /// input position; `None` where the input is sorted and distinct (as
+    /// the union and its subsets are): both are the identity then, and
+    /// the 8 bytes a simplex are not spent.
+    maps: Option<(Vec<u32>, Vec<u32>)>,
     /// Number of unique simplices.
     pub(crate) n: usize,
     /// Faces of unique simplex s: `simplex_faces[s*K .. s*K+K]`.
@@ -242,29 +243,31 @@ impl Incidence {
             canon.push(s.canonical().ok_or(FilterError::RepeatedVertex { index })?);
         }
         // Merge repeated simplices. The lists the detection passes (the
-        // union and its subsets) are sorted and distinct already: then
-        // the order is the input's, without a sort.
-        let mut order: Vec<u32> = (0..canon.len() as u32).collect();
-        if !canon.windows(2).all(|w| w[0] < w[1]) {
+        // union and its subsets) are sorted and distinct already: they
+        // are their own unique simplices, without a sort or maps.
+        let (unique, maps) = if canon.windows(2).all(|w| w[0] < w[1]) {
+            (canon, None)
+        } else {
+            let mut order: Vec<u32> = (0..canon.len() as u32).collect();
             order.sort_unstable_by(|&a, &b| {
                 canon[a as usize].cmp(&canon[b as usize]).then(a.cmp(&b))
             });
-        }
-        let mut input_to_unique = vec![0u32; canon.len()];
-        let mut unique_to_input: Vec<u32> = Vec::with_capacity(canon.len());
-        let mut last: Option<S> = None;
-        for &i in &order {
-            let s = canon[i as usize];
-            if last != Some(s) {
-                last = Some(s);
-                unique_to_input.push(i);
+            let mut input_to_unique = vec![0u32; canon.len()];
+            let mut unique_to_input: Vec<u32> = Vec::with_capacity(canon.len());
+            let mut last: Option<S> = None;
+            for &i in &order {
+                let s = canon[i as usize];
+                if last != Some(s) {
+                    last = Some(s);
+                    unique_to_input.push(i);
+                }
+                input_to_unique[i as usize] = (unique_to_input.len() - 1) as u32;
             }
-            input_to_unique[i as usize] = (unique_to_input.len() - 1) as u32;
-        }
-        drop(order);
-        unique_to_input.shrink_to_fit();
-        let unique: Vec<S> = unique_to_input.iter().map(|&i| canon[i as usize]).collect();
-        drop(canon);
+            drop(order);
+            unique_to_input.shrink_to_fit();
+            let unique: Vec<S> = unique_to_input.iter().map(|&i| canon[i as usize]).collect();
+            (unique, Some((input_to_unique, unique_to_input)))
+        };
         let k = S::VERTICES;
         let n = unique.len();
         let key = |h: u32| unique[h as usize / k].face_key(h as usize % k);
@@ -291,14 +294,32 @@ impl Incidence {
         face_start.shrink_to_fit();
         let face_simplices = half;
         Ok(Self {
-            input_to_unique,
-            unique_to_input,
+            maps,
             n,
             simplex_faces,
             face_start,
             face_simplices,
             k,
         })
+    }
+
+    /// The unique simplex of input position `i`.
+    #[cfg(test)]
+    pub(crate) fn unique_of(&self, i: usize) -> u32 {
+        self.maps.as_ref().map_or(i as u32, |m| m.0[i])
+    }
+
+    /// The first input position of unique simplex `u`.
+    pub(crate) fn input_of(&self, u: usize) -> u32 {
+        self.maps.as_ref().map_or(u as u32, |m| m.1[u])
+    }
+
+    /// `f(unique simplex)` for each input position, in input order.
+    pub(crate) fn per_input<T>(&self, f: impl FnMut(u32) -> T) -> Vec<T> {
+        match &self.maps {
+            Some((to_unique, _)) => to_unique.iter().copied().map(f).collect(),
+            None => (0..self.n as u32).map(f).collect(),
+        }
     }
 
     pub(crate) fn num_faces(&self) -> usize {
@@ -346,17 +367,14 @@ impl Incidence {
     fn label_input(&self, uf: &mut UnionFind) -> Vec<u32> {
         let mut id_of_root = vec![u32::MAX; self.n];
         let mut next = 0u32;
-        self.input_to_unique
-            .iter()
-            .map(|&u| {
-                let r = uf.find(u) as usize;
-                if id_of_root[r] == u32::MAX {
-                    id_of_root[r] = next;
-                    next += 1;
-                }
-                id_of_root[r]
-            })
-            .collect()
+        self.per_input(|u| {
+            let r = uf.find(u) as usize;
+            if id_of_root[r] == u32::MAX {
+                id_of_root[r] = next;
+                next += 1;
+            }
+            id_of_root[r]
+        })
     }
 }
 
@@ -387,11 +405,7 @@ pub fn filter_mask<S: Simplex>(simplices: &[S], nb_c: u32) -> Result<Vec<bool>, 
     let mut uf = UnionFind::new(0);
     inc.unite(&alive, &degree, true, &mut uf);
     if nb_c <= 1 || n == 0 {
-        return Ok(inc
-            .input_to_unique
-            .iter()
-            .map(|&u| alive[u as usize])
-            .collect());
+        return Ok(inc.per_input(|u| alive[u as usize]));
     }
     let top = nb_c as usize; // lengths 1 ..= nb_c − 1 can be deleted
                              // Members of each path (linked lists through `next`, by root).
@@ -475,11 +489,7 @@ pub fn filter_mask<S: Simplex>(simplices: &[S], nb_c: u32) -> Result<Vec<bool>, 
             }
         }
     }
-    Ok(inc
-        .input_to_unique
-        .iter()
-        .map(|&u| alive[u as usize])
-        .collect())
+    Ok(inc.per_input(|u| alive[u as usize]))
 }
 
 /// The simplices kept by [`filter_mask`], in input order.
@@ -536,11 +546,7 @@ pub fn component_size_mask<S: Simplex>(
     let alive = vec![true; inc.n];
     let mut uf = UnionFind::new(0);
     inc.unite(&alive, &[], false, &mut uf);
-    Ok(inc
-        .input_to_unique
-        .iter()
-        .map(|&u| uf.size_of(u) >= min_size)
-        .collect())
+    Ok(inc.per_input(|u| uf.size_of(u) >= min_size))
 }
 
 #[cfg(test)]

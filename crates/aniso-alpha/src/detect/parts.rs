@@ -120,6 +120,12 @@ fn map_large<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
     }
 }
 
+/// How far the dot product of two unit axes held in f32 may be from that
+/// of the f64 axes: each component is rounded by at most 2^-24 of itself,
+/// so the products' sum moves by at most 2·2^-24 ≈ 1.2e-7 (plus the f64
+/// sum's rounding). 2^-16 leaves a factor of 100.
+const AXIS_MARGIN: f64 = 1.0 / 65536.0;
+
 /// Region growing over unique simplices with axis `axis[s]` (None =
 /// degenerate), returning a part id per input simplex.
 fn grow<S: Simplex>(
@@ -132,13 +138,21 @@ fn grow<S: Simplex>(
     }
     let inc = Incidence::new(simplices)?;
     let n = inc.n;
-    // Each unique simplex's axis, NaN where it has none: 24 bytes, not
-    // an `Option`'s 32 (a NaN axis is alike to none, as `None` was).
-    let axis: Vec<[f64; 3]> = map_large(n, |u| {
-        axes(&simplices[inc.unique_to_input[u] as usize]).unwrap_or([f64::NAN; 3])
-    });
+    // Each unique simplex's axis, NaN where it has none (alike to none).
+    let exact = |u: usize| axes(&simplices[inc.input_of(u) as usize]).unwrap_or([f64::NAN; 3]);
+    // Held in f32, 12 bytes a simplex: a filter in front of the f64 test,
+    // which decides alone (the f64 axes recomputed) where the two could
+    // differ ([`AXIS_MARGIN`]); NaN stays NaN.
+    let axis: Vec<[f32; 3]> = map_large(n, |u| exact(u).map(|x| x as f32));
     let cos_tol = max_angle_deg.to_radians().cos();
-    let alike = |a: usize, b: usize| dot(axis[a], axis[b]).abs() >= cos_tol;
+    let alike = |a: usize, b: usize| {
+        let d = dot(axis[a].map(f64::from), axis[b].map(f64::from)).abs();
+        if (d - cos_tol).abs() > AXIS_MARGIN {
+            d >= cos_tol
+        } else {
+            dot(exact(a), exact(b)).abs() >= cos_tol
+        }
+    };
     // Like-oriented neighbour counts (through faces).
     let support: Vec<u32> = map_large(n, |s| {
         let mut sup = 0u32;
@@ -155,7 +169,7 @@ fn grow<S: Simplex>(
     order.sort_by(|&a, &b| {
         support[b as usize]
             .cmp(&support[a as usize])
-            .then(inc.unique_to_input[a as usize].cmp(&inc.unique_to_input[b as usize]))
+            .then(inc.input_of(a as usize).cmp(&inc.input_of(b as usize)))
     });
     let mut part = vec![u32::MAX; n];
     let mut next = 0u32;
@@ -182,11 +196,7 @@ fn grow<S: Simplex>(
             }
         }
     }
-    Ok(inc
-        .input_to_unique
-        .iter()
-        .map(|&u| part[u as usize])
-        .collect())
+    Ok(inc.per_input(|u| part[u as usize]))
 }
 
 /// Splits triangles into planar parts (module docs); returns a part id per
@@ -321,6 +331,38 @@ mod tests {
             }
         }
         t
+    }
+
+    #[test]
+    fn hinges_at_the_tolerance_follow_the_f64_axes() {
+        // Two triangles on the edge (0,0,0)-(0,1,0), folded by angles
+        // within 1e-6 rad of the 10° tolerance: the f32 axes cannot tell
+        // these apart, the f64 test decides each one.
+        let tol = 10f64.to_radians();
+        let mut both = [false, false];
+        for k in -50..=50 {
+            let theta = tol + f64::from(k) * 2e-8;
+            let p = [
+                [0.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [-1.0, 0.5, 0.0],
+                [theta.cos(), 0.5, theta.sin()],
+            ];
+            let t = [[0, 1, 2], [0, 1, 3]];
+            let normal = |t: [u32; 3]| {
+                let [a, b, c] = t.map(|v| p[v as usize]);
+                normalize(cross(
+                    [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
+                    [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
+                ))
+                .unwrap()
+            };
+            let want = dot(normal(t[0]), normal(t[1])).abs() >= tol.cos();
+            let parts = planar_parts(&p, &t, 10.0).unwrap();
+            assert_eq!(parts[0] == parts[1], want, "k = {k}");
+            both[usize::from(want)] = true;
+        }
+        assert_eq!(both, [true, true]);
     }
 
     #[test]

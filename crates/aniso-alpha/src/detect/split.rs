@@ -378,7 +378,7 @@ impl Plan {
             }
         }
         drop(outputs);
-        let cloud = Cloud::new(points, &self.copies);
+        let mut cloud = Cloud::new(points, &self.copies);
         let sf = self.detector.scan_filters(&cloud, &self.regime, jobs.len());
         let one = |(mut faces, job): (Vec<S>, &SplitJob)| -> Result<(usize, Vec<S>), DetectError> {
             faces.sort_unstable();
@@ -410,7 +410,7 @@ impl Plan {
         }
         let (_, scales) = self.detector.scan_jobs(self.detector.modes())?;
         self.detector
-            .finish_k(&cloud, &self.regime, found, scales, stats, &sf)
+            .finish_k(&mut cloud, &self.regime, found, scales, stats, &sf)
     }
 }
 

@@ -102,9 +102,14 @@ fn extract<S: Face>(
     angle: f64,
 ) -> Vec<(Vec<u32>, Primitive)> {
     let mut out = Vec::new();
-    let mut verts: Vec<u32> = local.iter().flat_map(|s| s.as_ref().to_vec()).collect();
-    verts.sort_unstable();
+    let mut verts: Vec<u32> = local
+        .iter()
+        .flat_map(|s| s.as_ref().iter().copied())
+        .collect();
+    crate::par::sort_unstable(&mut verts);
     verts.dedup();
+    // Held through the extraction: a vertex is in about six triangles.
+    verts.shrink_to_fit();
     if verts.len() < min_vertices {
         return out;
     }

@@ -230,9 +230,10 @@ pub(crate) fn level<S: Shape>(
 
 /// Stages 5–6 of the assembly over the `levels` of a run: the parts kept
 /// across levels (the most significant first, `select`), one part per
-/// primitive, structures, outlines and labels.
+/// primitive, structures, outlines and labels. The cloud's kd-tree is
+/// freed once the levels are selected: nothing after queries it.
 pub(crate) fn finish<S: Shape>(
-    cloud: &Cloud<'_>,
+    cloud: &mut Cloud<'_>,
     regime: &Regime,
     mut levels: Vec<Level<S>>,
     settings: &Settings,
@@ -250,6 +251,8 @@ pub(crate) fn finish<S: Shape>(
             select::across_levels::<S>(levels, cloud, regime, settings.min_vertices)
         })
     };
+    cloud.release_index();
+    let cloud = &*cloud;
     let clock = &settings.clock;
     // 5. One primitive, one part.
     clock.time(Stage::Merge, || {

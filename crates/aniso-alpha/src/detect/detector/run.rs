@@ -80,14 +80,15 @@ impl Detector {
         copies: Copies,
     ) -> Result<Detection, DetectError> {
         if !copies.any() {
-            return self.run_cloud(&Cloud::new(points, &copies), regime, self.modes());
+            return self.run_cloud(&mut Cloud::new(points, &copies), regime, self.modes());
         }
         let distinct = copies.distinct();
         let sub: Vec<[f64; 3]> = distinct.iter().map(|&i| points[i as usize]).collect();
         let none = Copies::none(sub.len());
         let modes = modes_on_distinct(self.modes(), &copies);
         let on_distinct = self.ladder_on_distinct(&copies);
-        let det = on_distinct.run_cloud(&Cloud::new(&sub, &none), &regime.on(distinct), &modes)?;
+        let det =
+            on_distinct.run_cloud(&mut Cloud::new(&sub, &none), &regime.on(distinct), &modes)?;
         Ok(expand_distinct(det, copies))
     }
 
@@ -95,7 +96,7 @@ impl Detector {
     /// the explicit rotations over every point).
     fn run_cloud(
         &self,
-        cloud: &Cloud<'_>,
+        cloud: &mut Cloud<'_>,
         regime: &Regime,
         modes: &[ModeScan],
     ) -> Result<Detection, DetectError> {
@@ -109,7 +110,7 @@ impl Detector {
     /// [`Self::finish_k`].
     fn scan<S: Shape>(
         &self,
-        cloud: &Cloud<'_>,
+        cloud: &mut Cloud<'_>,
         regime: &Regime,
         modes: &[ModeScan],
     ) -> Result<Detection, DetectError> {
@@ -344,7 +345,7 @@ impl Detector {
     /// (`assemble::finish`). `stats` holds the scan's figures.
     pub(crate) fn finish_k<S: Shape>(
         &self,
-        cloud: &Cloud<'_>,
+        cloud: &mut Cloud<'_>,
         regime: &Regime,
         found: Vec<(u32, Vec<S>)>,
         scales: Vec<Scale>,

@@ -371,8 +371,9 @@ fn half_faces_sorted_in_parallel_chunks() {
     }
 }
 
-/// Sorted distinct simplices skip the merge's sort; unsorted ones with
-/// repeats are merged as before: the same incidence either way.
+/// Sorted distinct simplices skip the merge's sort and its maps (the
+/// identity); unsorted ones with repeats are merged: the same incidence
+/// either way.
 #[test]
 fn an_incidence_of_sorted_simplices_is_that_of_any_order() {
     let mut rng = crate::rng::SplitMix64::new(23);
@@ -395,8 +396,19 @@ fn an_incidence_of_sorted_simplices_is_that_of_any_order() {
         };
         assert_eq!(faces(&sorted, u), faces(&other, u));
     }
-    assert_eq!(
-        sorted.unique_to_input,
-        (0..tris.len() as u32).collect::<Vec<_>>()
+    assert!(sorted.maps.is_none());
+    assert!(
+        (0..tris.len()).all(|i| sorted.input_of(i) == i as u32 && sorted.unique_of(i) == i as u32)
     );
+    // The shuffled list with a repeat maps each input to its unique
+    // simplex, and each unique simplex to its first input.
+    assert!(other.maps.is_some());
+    for i in 0..shuffled.len() {
+        let u = other.unique_of(i) as usize;
+        assert_eq!(
+            shuffled[i].canonical(),
+            shuffled[other.input_of(u) as usize].canonical()
+        );
+        assert!(other.input_of(u) as usize <= i);
+    }
 }
