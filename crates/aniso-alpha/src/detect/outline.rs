@@ -46,24 +46,64 @@ pub struct Outline {
 /// triangle at its own radius (`outline`).
 const OUTLINE_DOUBLINGS: usize = 6;
 
-fn circumradius2(a: Point2<f64>, b: Point2<f64>, c: Point2<f64>) -> f64 {
-    let (bx, by) = (b.x - a.x, b.y - a.y);
-    let (cx, cy) = (c.x - a.x, c.y - a.y);
-    let d = 2.0 * (bx * cy - by * cx);
-    if d == 0.0 {
-        return f64::INFINITY;
-    }
-    let b2 = bx * bx + by * by;
-    let c2 = cx * cx + cy * cy;
-    let ux = (cy * b2 - by * c2) / d;
-    let uy = (bx * c2 - cx * b2) / d;
-    ux * ux + uy * uy
+/// Points of a part from which its 2D α-shape is cut into strips
+/// ([`strips_of`]): 2^15 (one strip per [`STRIP_POINTS`] besides). A
+/// depth frame's table (79,000 points) or a tiling's ground was one
+/// triangulation on one thread while the other parts were long done.
+#[cfg(not(test))]
+const STRIPPED_POINTS: usize = 1 << 15;
+/// A few hundred points in the tests, so that small parts take the path.
+#[cfg(test)]
+const STRIPPED_POINTS: usize = 1 << 9;
+
+/// Points in one strip of a large part, besides its halo: 2^14.
+#[cfg(not(test))]
+const STRIP_POINTS: usize = 1 << 14;
+/// A hundred-odd points in the tests.
+#[cfg(test)]
+const STRIP_POINTS: usize = 1 << 7;
+
+/// The halo of a strip, in radii: 4 (3 would do, module doc of
+/// [`strips_of`]; the fourth covers the rounding of circumcentres).
+const HALO_RADII: f64 = 4.0;
+
+/// A strip of a large part's projected points (sorted by x): its core,
+/// the x range whose triangles it owns (a triangle by its circumcentre),
+/// and the range of points it triangulates (the core and a halo).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Strip {
+    core: (f64, f64),
+    points: (usize, usize),
 }
 
 /// The 2D α-shape of `points[ids[..]]` on `plane` with radius `r` (module
 /// doc). Points projecting onto one 2D position are merged (the first
-/// index is kept).
+/// index is kept). A large part is triangulated in strips on the pool's
+/// threads ([`strips_of`]), with the same result as one triangulation.
 pub fn outline(points: &[[f64; 3]], ids: &[u32], plane: &PlaneFit, r: f64) -> Outline {
+    let [a0, a1] = plane.axes;
+    let c = plane.centroid;
+    let verts = projected(points, ids, plane);
+    if verts.len() < 3 {
+        return Outline::default();
+    }
+    let strips = strips_of(&verts, r);
+    let Some((mut triangles, mut edges)) = kept_in_strips(&verts, &strips, r) else {
+        return Outline::default();
+    };
+    crate::par::sort_unstable(&mut triangles);
+    edges.sort_unstable_by_key(|e| (e.0, e.1));
+    let polygon = largest_loop(&edges)
+        .iter()
+        .map(|p| [0, 1, 2].map(|k| c[k] + p.x * a0[k] + p.y * a1[k]))
+        .collect();
+    Outline { triangles, polygon }
+}
+
+/// The points `ids` on the plane's axes, sorted by (x, y, index), those
+/// at one 2D position merged into the first (the smallest index), the
+/// non-finite left out.
+fn projected(points: &[[f64; 3]], ids: &[u32], plane: &PlaneFit) -> Vec<V> {
     let [a0, a1] = plane.axes;
     let c = plane.centroid;
     let uv = |p: &[f64; 3]| -> Point2<f64> {
@@ -82,53 +122,150 @@ pub fn outline(points: &[[f64; 3]], ids: &[u32], plane: &PlaneFit, r: f64) -> Ou
             })
             .filter(|v| v.p.x.is_finite() && v.p.y.is_finite()),
     );
-    // Merge equal 2D positions (keep the smallest index).
     verts.sort_by(|a, b| {
         (a.p.x, a.p.y, a.id)
             .partial_cmp(&(b.p.x, b.p.y, b.id))
             .unwrap_or(std::cmp::Ordering::Equal)
     });
     verts.dedup_by(|b, a| a.p == b.p);
-    if verts.len() < 3 {
-        return Outline::default();
-    }
-    let Ok(tri) = DelaunayTriangulation::<V>::bulk_load(verts) else {
-        return Outline::default();
+    verts
+}
+
+/// The strips of `verts` (sorted by x) for radius `r`: one below
+/// [`STRIPPED_POINTS`]; otherwise cores of about [`STRIP_POINTS`] points
+/// cut at points' x, each triangulated with the points within
+/// [`HALO_RADII`]·r of it in x, and no narrower than two halos.
+///
+/// Why the strips give the α-shape of one triangulation: a triangle with
+/// circumradius ρ ≤ r whose circumcentre lies in a core has its disc
+/// within r of the core in x, so the strip holds every point that could
+/// lie in the disc: the triangle is Delaunay in the strip exactly when it
+/// is in the whole part. A neighbour across one of its edges with ρ ≤ r
+/// has its centre within 2r of the core and its disc within 3r, so
+/// whether that neighbour is kept, which makes the edge a boundary edge or
+/// not, is read in the strip as well. (In general position; where four
+/// points are cocircular, the two triangulations may cut their circle
+/// along different diagonals, two triangles of one circumradius either
+/// way.)
+fn strips_of(verts: &[V], r: f64) -> Vec<Strip> {
+    let n = verts.len();
+    let whole = Strip {
+        core: (f64::NEG_INFINITY, f64::INFINITY),
+        points: (0, n),
     };
-    // Kept triangles (spade's faces are counter-clockwise in (u, v), and
-    // (a0, a1, normal) is right-handed, so they are counter-clockwise seen
-    // from the normal). A part too sparse for radius r (a strip one or two
-    // points wide, claimed along a fitted plane) has no triangle at r: the
-    // radius doubles until one is kept, up to the convex hull (r = ∞), so
-    // every planar part of three non-collinear points has an outline.
-    let mut triangles: Vec<[u32; 3]> = Vec::with_capacity(tri.num_inner_faces());
+    let halo = HALO_RADII * r;
+    let extent = verts[n - 1].p.x - verts[0].p.x;
+    if n < STRIPPED_POINTS || !halo.is_finite() || halo <= 0.0 {
+        return vec![whole];
+    }
+    let by_count = n.div_ceil(STRIP_POINTS);
+    let by_width = (extent / (2.0 * halo)).floor();
+    let m = if by_width < by_count as f64 {
+        by_width as usize
+    } else {
+        by_count
+    };
+    if m < 2 {
+        return vec![whole];
+    }
+    let mut cuts: Vec<f64> = (1..m).map(|k| verts[k * n / m].p.x).collect();
+    cuts.dedup();
+    let mut bounds = vec![f64::NEG_INFINITY];
+    bounds.extend(cuts);
+    bounds.push(f64::INFINITY);
+    bounds
+        .windows(2)
+        .map(|w| {
+            let from = verts.partition_point(|v| v.p.x < w[0] - halo);
+            let to = verts.partition_point(|v| v.p.x < w[1] + halo);
+            Strip {
+                core: (w[0], w[1]),
+                points: (from, to),
+            }
+        })
+        .collect()
+}
+
+/// A boundary edge of the kept triangles: (from, to, position of from),
+/// counter-clockwise around the kept region.
+type Edge = (u32, u32, Point2<f64>);
+
+/// The kept triangles of each strip and their boundary edges
+/// ([`kept_in_strip`]), strips on the pool's threads, joined; `None`
+/// where fewer than three points remain. A part too sparse for radius r
+/// (a strip one or two points wide, claimed along a fitted plane) has no
+/// triangle at r: then the radius doubles, in one triangulation, until
+/// one is kept, up to the convex hull (r = ∞), so that every planar part
+/// of three non-collinear points has an outline.
+fn kept_in_strips(verts: &[V], strips: &[Strip], r: f64) -> Option<(Vec<[u32; 3]>, Vec<Edge>)> {
+    // r, 2r, 4r, … 32r, then ∞.
+    let ladder: Vec<f64> = (0..=OUTLINE_DOUBLINGS)
+        .map(|k| match k {
+            OUTLINE_DOUBLINGS => f64::INFINITY,
+            _ => r * r * 4f64.powi(k as i32),
+        })
+        .collect();
+    let whole = Strip {
+        core: (f64::NEG_INFINITY, f64::INFINITY),
+        points: (0, verts.len()),
+    };
+    if strips.len() < 2 {
+        return kept_in_strip(verts, whole, &ladder);
+    }
+    let pieces = crate::par::map_each(strips.len(), |k| {
+        kept_in_strip(verts, strips[k], &ladder[..1])
+    });
+    let mut triangles = Vec::with_capacity(pieces.iter().flatten().map(|p| p.0.len()).sum());
+    let mut edges = Vec::new();
+    for (t, e) in pieces.into_iter().flatten() {
+        triangles.extend(t);
+        edges.extend(e);
+    }
+    if triangles.is_empty() {
+        return kept_in_strip(verts, whole, &ladder[1..]);
+    }
+    Some((triangles, edges))
+}
+
+/// The triangles of `strip`'s triangulation with circumradius² at most
+/// the first of `r2s` that keeps any, whose circumcentre lies in its core,
+/// each from its smallest index, counter-clockwise in (u, v) (spade's
+/// order; (a0, a1, normal) is right-handed, so counter-clockwise seen from
+/// the normal); and their edges whose other side is no kept triangle
+/// (another face, or the outer one), read off the triangulation's
+/// topology. `None` for fewer than three points.
+fn kept_in_strip(verts: &[V], strip: Strip, r2s: &[f64]) -> Option<(Vec<[u32; 3]>, Vec<Edge>)> {
+    let mine = &verts[strip.points.0..strip.points.1];
+    if mine.len() < 3 {
+        return None;
+    }
+    let tri = DelaunayTriangulation::<V>::bulk_load(mine.to_vec()).ok()?;
+    let owned = |t: [V; 3]| {
+        strip.core == (f64::NEG_INFINITY, f64::INFINITY)
+            || (strip.core.0..strip.core.1).contains(&circumcentre_x(t))
+    };
     // Per face index of the triangulation: kept.
     let mut kept = vec![false; tri.num_all_faces()];
-    let mut r2 = r * r;
-    for attempt in 0..=OUTLINE_DOUBLINGS {
-        if attempt == OUTLINE_DOUBLINGS {
-            r2 = f64::INFINITY;
-        }
+    let mut triangles: Vec<[u32; 3]> = Vec::new();
+    for &r2 in r2s {
         for f in tri.inner_faces() {
-            let [a, b, cc] = f.vertices();
-            let (pa, pb, pc) = (a.data().p, b.data().p, cc.data().p);
-            if circumradius2(pa, pb, pc) <= r2 {
+            let t = from_smallest(f.vertices().map(|v| *v.data()));
+            if circumradius2(t) <= r2 {
                 kept[f.fix().index()] = true;
-                triangles.push([a.data().id, b.data().id, cc.data().id]);
+                if owned(t) {
+                    triangles.push(t.map(|v| v.id));
+                }
             }
         }
         if !triangles.is_empty() {
             break;
         }
-        r2 *= 4.0;
     }
-    triangles.sort_unstable();
-    // Boundary: the directed edges of kept triangles whose other side is
-    // not kept (another face or the outer one), read off the
-    // triangulation's topology in one pass; with the position of their
-    // first vertex. Sorted, they are few (the outline's length).
-    let mut edges: Vec<(u32, u32, Point2<f64>)> = Vec::new();
+    let mut edges: Vec<Edge> = Vec::new();
     for f in tri.inner_faces().filter(|f| kept[f.fix().index()]) {
+        if !owned(from_smallest(f.vertices().map(|v| *v.data()))) {
+            continue;
+        }
         for e in f.adjacent_edges() {
             let other = e.rev().face();
             if !other.as_inner().is_some_and(|g| kept[g.fix().index()]) {
@@ -136,14 +273,52 @@ pub fn outline(points: &[[f64; 3]], ids: &[u32], plane: &PlaneFit, r: f64) -> Ou
             }
         }
     }
-    edges.sort_unstable_by_key(|e| (e.0, e.1));
+    Some((triangles, edges))
+}
+
+/// The triangle `t` (counter-clockwise) turned to start at its smallest
+/// index, still counter-clockwise: the same numbers for a triangle
+/// whichever strip, and whichever of its vertices, spade gives it from.
+fn from_smallest(t: [V; 3]) -> [V; 3] {
+    let k = (0..3).min_by_key(|&k| t[k].id).unwrap_or(0);
+    [t[k], t[(k + 1) % 3], t[(k + 2) % 3]]
+}
+
+/// The squared circumradius of a triangle (∞ for a degenerate one).
+fn circumradius2(t: [V; 3]) -> f64 {
+    circumcentre_offset(t).map_or(f64::INFINITY, |(ux, uy)| ux * ux + uy * uy)
+}
+
+/// The x of a triangle's circumcentre (∞ for a degenerate one).
+fn circumcentre_x(t: [V; 3]) -> f64 {
+    circumcentre_offset(t).map_or(f64::INFINITY, |(ux, _)| t[0].p.x + ux)
+}
+
+/// The circumcentre of a triangle less its first vertex, or `None` for a
+/// degenerate triangle.
+fn circumcentre_offset(t: [V; 3]) -> Option<(f64, f64)> {
+    let [a, b, c] = t.map(|v| v.p);
+    let (bx, by) = (b.x - a.x, b.y - a.y);
+    let (cx, cy) = (c.x - a.x, c.y - a.y);
+    let d = 2.0 * (bx * cy - by * cx);
+    if d == 0.0 {
+        return None;
+    }
+    let b2 = bx * bx + by * by;
+    let c2 = cx * cx + cy * cy;
+    Some(((cy * b2 - by * c2) / d, (bx * c2 - cx * b2) / d))
+}
+
+/// The boundary loop of largest area (counter-clockwise) among the
+/// boundary `edges` (sorted by (from, to)), as the positions of its
+/// vertices: each boundary vertex may start several edges (a pinch),
+/// taken in order and marked used.
+fn largest_loop(edges: &[Edge]) -> Vec<Point2<f64>> {
     let at = |v: u32| -> Point2<f64> {
         let k = edges.partition_point(|e| e.0 < v);
         edges[k].2
     };
     let boundary: Vec<(u32, u32)> = edges.iter().map(|e| (e.0, e.1)).collect();
-    // Chain into loops: each boundary vertex may start several edges (a
-    // pinch); take them in order and mark used.
     let mut used = vec![false; boundary.len()];
     let start_of = |v: u32| boundary.partition_point(|e| e.0 < v);
     let mut best: (f64, Vec<u32>) = (0.0, Vec::new());
@@ -183,15 +358,7 @@ pub fn outline(points: &[[f64; 3]], ids: &[u32], plane: &PlaneFit, r: f64) -> Ou
             best = (area, loop_v);
         }
     }
-    let polygon = best
-        .1
-        .iter()
-        .map(|&v| {
-            let p = at(v);
-            [0, 1, 2].map(|k| c[k] + p.x * a0[k] + p.y * a1[k])
-        })
-        .collect();
-    Outline { triangles, polygon }
+    best.1.iter().map(|&v| at(v)).collect()
 }
 
 #[cfg(test)]
@@ -276,6 +443,69 @@ mod tests {
                 assert!((p[0] - q[0]).abs() < 1e-9 && (p[1] - q[1]).abs() < 1e-9);
             }
         }
+    }
+
+    #[test]
+    fn strips_give_the_triangles_and_boundary_of_one_triangulation() {
+        // Random points (general position) with a hole, cut into strips
+        // at several radii: the kept triangles and the boundary edges
+        // equal those of one triangulation. Strips without their halo do
+        // not: the comparison can fail.
+        let mut rng = crate::rng::SplitMix64::new(41);
+        for (n, r) in [(700, 0.3), (3000, 0.2), (3000, 0.08), (6000, 0.05)] {
+            let mut pts = Vec::new();
+            while pts.len() < n {
+                let (x, y) = (10.0 * rng.uniform(), 4.0 * rng.uniform());
+                if (x - 5.0).powi(2) + (y - 2.0).powi(2) > 1.0 {
+                    pts.push([x, y, 0.5 * x]);
+                }
+            }
+            let ids: Vec<u32> = (0..pts.len() as u32).collect();
+            let plane = fit_plane_indices(&pts, &ids).unwrap();
+            let verts = projected(&pts, &ids, &plane);
+            let strips = strips_of(&verts, r);
+            assert!(strips.len() >= 3, "n {n} r {r}: {} strips", strips.len());
+            let whole = [Strip {
+                core: (f64::NEG_INFINITY, f64::INFINITY),
+                points: (0, verts.len()),
+            }];
+            let sorted = |strips: &[Strip]| {
+                let (mut t, mut e) = kept_in_strips(&verts, strips, r).unwrap();
+                t.sort_unstable();
+                e.sort_unstable_by_key(|e| (e.0, e.1));
+                (t, e.iter().map(|e| (e.0, e.1)).collect::<Vec<_>>())
+            };
+            let want = sorted(&whole);
+            assert!(want.0.len() > n / 10, "n {n} r {r}: {}", want.0.len());
+            assert_eq!(sorted(&strips), want, "n {n} r {r}");
+            let bare: Vec<Strip> = strips
+                .iter()
+                .map(|s| {
+                    let from = verts.partition_point(|v| v.p.x < s.core.0);
+                    let to = verts.partition_point(|v| v.p.x < s.core.1);
+                    Strip {
+                        core: s.core,
+                        points: (from, to),
+                    }
+                })
+                .collect();
+            assert_ne!(sorted(&bare), want, "n {n} r {r}");
+        }
+    }
+
+    #[test]
+    fn a_wide_halo_leaves_one_strip() {
+        // Strips no narrower than two halos: at a radius near the
+        // part's width, one triangulation.
+        let pts: Vec<[f64; 3]> = (0..2000)
+            .map(|k| [f64::from(k % 50), f64::from(k / 50), 0.0])
+            .collect();
+        let ids: Vec<u32> = (0..pts.len() as u32).collect();
+        let plane = fit_plane_indices(&pts, &ids).unwrap();
+        let verts = projected(&pts, &ids, &plane);
+        assert!(strips_of(&verts, 1.0).len() > 2);
+        assert_eq!(strips_of(&verts, 10.0).len(), 1);
+        assert_eq!(strips_of(&verts[..100], 1.0).len(), 1);
     }
 
     #[test]
