@@ -62,6 +62,22 @@ pub(crate) fn sort_unstable<T: Ord + Send>(v: &mut [T]) {
     v.sort_unstable();
 }
 
+/// Sorts `v` (unstable) by `cmp`, on the pool's threads from 2^16
+/// elements: the same order for any thread count when `cmp` is a total
+/// order in which no two elements are equal (ties broken by a unique key).
+pub(crate) fn sort_unstable_by<T: Send>(
+    v: &mut [T],
+    cmp: impl Fn(&T, &T) -> std::cmp::Ordering + Sync,
+) {
+    #[cfg(feature = "parallel")]
+    if v.len() >= 1 << 16 {
+        use rayon::slice::ParallelSliceMut;
+        v.par_sort_unstable_by(cmp);
+        return;
+    }
+    v.sort_unstable_by(cmp);
+}
+
 /// `f(item)` for each item, on the pool's threads (items that own
 /// disjoint parts of a buffer).
 pub(crate) fn for_each_mut<T: Send>(items: Vec<T>, f: impl Fn(T) + Sync) {
@@ -111,7 +127,7 @@ pub(crate) fn spawn_workers(copies: usize, worker: impl Fn() + Sync) {
 
 #[cfg(test)]
 mod tests {
-    use super::{for_each_mut, map_each, map_ranges, sort_unstable};
+    use super::{for_each_mut, map_each, map_ranges, sort_unstable, sort_unstable_by};
 
     #[test]
     fn map_each_sort_and_loop_do_not_depend_on_the_threads() {
@@ -136,6 +152,14 @@ mod tests {
                 let mut got = values.clone();
                 sort_unstable(&mut got);
                 assert_eq!(got, want);
+                // By a comparator: descending, ties by position (unique).
+                let mut by: Vec<u32> = (0..values.len() as u32).collect();
+                sort_unstable_by(&mut by, |&a, &b| {
+                    values[b as usize].cmp(&values[a as usize]).then(a.cmp(&b))
+                });
+                let mut stable: Vec<u32> = (0..values.len() as u32).collect();
+                stable.sort_by(|&a, &b| values[b as usize].cmp(&values[a as usize]));
+                assert_eq!(by, stable);
                 let mut buf = vec![0u32; 1000];
                 let chunks: Vec<(usize, &mut [u32])> = buf.chunks_mut(100).enumerate().collect();
                 for_each_mut(chunks, |(k, c)| c.iter_mut().for_each(|x| *x = k as u32));

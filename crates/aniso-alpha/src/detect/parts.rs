@@ -165,8 +165,9 @@ fn grow<S: Simplex>(
         }
         sup
     });
+    // Best supported first; ties by input position, which is unique.
     let mut order: Vec<u32> = (0..n as u32).collect();
-    order.sort_by(|&a, &b| {
+    crate::par::sort_unstable_by(&mut order, |&a, &b| {
         support[b as usize]
             .cmp(&support[a as usize])
             .then(inc.input_of(a as usize).cmp(&inc.input_of(b as usize)))

@@ -18,6 +18,21 @@ pub use linear::{
 };
 pub use predicates::{Point3, Sign};
 
+/// `x.floor() as i64`, bit for bit for every `x` (NaN gives 0, values
+/// beyond i64 saturate), without the call to the software `floor` that
+/// the x86-64 baseline makes (no SSE4.1 rounding): truncate, then step
+/// down where truncation went up. A footprint's or a tile's cell of
+/// every point it tests; 1.5% of a depth frame's run was in `floor`.
+#[inline]
+pub(crate) fn floor_i64(x: f64) -> i64 {
+    let t = x as i64;
+    if (t as f64) > x {
+        t.saturating_sub(1)
+    } else {
+        t
+    }
+}
+
 /// The axis-aligned bounding box `(lo, hi)` of `points`; for an empty slice
 /// `lo` is `+∞` and `hi` is `−∞` on every axis.
 ///
@@ -51,4 +66,45 @@ pub(crate) fn bounding_box_of(points: &[Point3], ids: &[u32]) -> (Point3, Point3
         }
     }
     (lo, hi)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::floor_i64;
+
+    #[test]
+    fn floor_i64_is_floor_as_i64() {
+        // Special values, integers and their neighbours, the ends of i64
+        // and of exact integers, then random values at every scale.
+        let mut xs = vec![
+            0.0,
+            -0.0,
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::MIN_POSITIVE,
+            -f64::MIN_POSITIVE,
+            f64::MAX,
+            f64::MIN,
+            9.223_372_036_854_776e18,
+            -9.223_372_036_854_776e18,
+            -9.223_372_036_854_778e18,
+            9_007_199_254_740_993.0,
+            -9_007_199_254_740_993.0,
+        ];
+        for k in -5i32..=5 {
+            let x = f64::from(k);
+            xs.extend([x, x.next_up(), x.next_down(), x + 0.5]);
+        }
+        let mut rng = crate::rng::SplitMix64::new(3);
+        for _ in 0..100_000 {
+            let scale = 10f64.powi((rng.uniform() * 40.0) as i32 - 20);
+            xs.push((rng.uniform() - 0.5) * scale);
+        }
+        for x in xs {
+            assert_eq!(floor_i64(x), x.floor() as i64, "{x:e}");
+        }
+        // The comparison can fail: truncation is not the floor.
+        assert_ne!(-0.5f64 as i64, (-0.5f64).floor() as i64);
+    }
 }

@@ -6,7 +6,7 @@
 
 use super::super::detection::Primitive;
 use crate::geometry::kdtree::{KdTree, OrientedBox};
-use crate::geometry::{cross, dot, normalize, sub};
+use crate::geometry::{cross, dot, floor_i64, normalize, sub};
 use crate::par::map_each;
 
 /// The cells a candidate covers on its plane (2D) or along its line (1D).
@@ -57,8 +57,8 @@ impl Footprint {
     fn coords(&self, p: &[f64; 3]) -> [i64; 2] {
         let w = sub(*p, self.origin);
         [
-            (dot(w, self.axes[0]) / self.cell).floor() as i64,
-            (dot(w, self.axes[1]) / self.cell).floor() as i64,
+            floor_i64(dot(w, self.axes[0]) / self.cell),
+            floor_i64(dot(w, self.axes[1]) / self.cell),
         ]
     }
 

@@ -42,7 +42,7 @@ use super::super::local::any_orthogonal;
 use super::shape::span;
 use super::{Candidate, Draft};
 use crate::aniso::Mat3;
-use crate::geometry::{cross, dot, sub};
+use crate::geometry::{cross, dot, floor_i64, sub};
 use std::collections::HashSet;
 
 /// Rows of points a plane holds across, at least: the long diameter of
@@ -110,8 +110,8 @@ fn covered_area(members: &[u32], points: &[[f64; 3]], f: &PlaneFit, cell: f64) -
         .map(|&v| {
             let d = sub(points[v as usize], f.centroid);
             (
-                (dot(d, f.axes[0]) / cell).floor() as i64,
-                (dot(d, f.axes[1]) / cell).floor() as i64,
+                floor_i64(dot(d, f.axes[0]) / cell),
+                floor_i64(dot(d, f.axes[1]) / cell),
             )
         })
         .collect();

@@ -8,6 +8,7 @@
 
 use super::{REGIONS_ABOVE, REGION_POINTS};
 use crate::detect::DetectError;
+use crate::geometry::floor_i64;
 use std::collections::{BTreeMap, BTreeSet};
 
 /// The first margin, as a fraction of the side (a region's run is widened
@@ -80,8 +81,8 @@ impl RegionGrid {
     /// The cell (column indices in x and y) of point `p`.
     pub fn cell(&self, p: &[f64; 3]) -> (i64, i64) {
         (
-            ((p[0] - self.origin[0]) / self.side).floor() as i64,
-            ((p[1] - self.origin[1]) / self.side).floor() as i64,
+            floor_i64((p[0] - self.origin[0]) / self.side),
+            floor_i64((p[1] - self.origin[1]) / self.side),
         )
     }
 

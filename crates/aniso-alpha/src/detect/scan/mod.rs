@@ -45,6 +45,7 @@ use super::parts::{linear_parts, planar_parts, PartsError};
 use super::prune::{non_isolated, CandidatePairs};
 use crate::aniso::Anisotropy;
 use crate::delaunay::{DelaunayError, Triangulation};
+use crate::geometry::floor_i64;
 
 /// Relative inflation of the pruning and halo radii, so that rounding in
 /// the two ways of computing a distance never drops a point at exactly 2α.
@@ -301,7 +302,7 @@ impl TileGrid {
 
     /// The cube that owns point `p`.
     fn cell(&self, p: &[f64; 3]) -> [i64; 3] {
-        [0, 1, 2].map(|k| ((p[k] - self.origin[k]) / self.side).floor() as i64)
+        [0, 1, 2].map(|k| floor_i64((p[k] - self.origin[k]) / self.side))
     }
 
     /// The lower and upper corners of cube `t`.
