@@ -47,11 +47,15 @@ pub struct Outline {
 const OUTLINE_DOUBLINGS: usize = 6;
 
 /// Points of a part from which its 2D α-shape is cut into strips
-/// ([`strips_of`]): 2^15 (one strip per [`STRIP_POINTS`] besides). A
+/// ([`strips_of`]): 2^16 (one strip per [`STRIP_POINTS`] besides). A
 /// depth frame's table (79,000 points) or a tiling's ground was one
-/// triangulation on one thread while the other parts were long done.
+/// triangulation on one thread while the other parts were long done. At
+/// 2^15, the simulated room's parts of 30,000–52,000 points, outlined in
+/// parallel with each other already, were cut too, for nothing on two
+/// threads (train scans, "Peaks of the claims, the parts and the
+/// outlines" in BENCHMARKS.md).
 #[cfg(not(test))]
-const STRIPPED_POINTS: usize = 1 << 15;
+const STRIPPED_POINTS: usize = 1 << 16;
 /// A few hundred points in the tests, so that small parts take the path.
 #[cfg(test)]
 const STRIPPED_POINTS: usize = 1 << 9;
@@ -240,20 +244,24 @@ fn kept_in_strip(verts: &[V], strip: Strip, r2s: &[f64]) -> Option<(Vec<[u32; 3]
         return None;
     }
     let tri = DelaunayTriangulation::<V>::bulk_load(mine.to_vec()).ok()?;
-    let owned = |t: [V; 3]| {
-        strip.core == (f64::NEG_INFINITY, f64::INFINITY)
-            || (strip.core.0..strip.core.1).contains(&circumcentre_x(t))
-    };
-    // Per face index of the triangulation: kept.
+    let whole = strip.core == (f64::NEG_INFINITY, f64::INFINITY);
+    let core = strip.core.0..strip.core.1;
+    // Per face index of the triangulation: kept, and (in a strip's core,
+    // or anywhere for the whole part) owned.
     let mut kept = vec![false; tri.num_all_faces()];
-    let mut triangles: Vec<[u32; 3]> = Vec::new();
+    let mut owned = Vec::new();
+    let mut triangles: Vec<[u32; 3]> =
+        Vec::with_capacity(if whole { tri.num_inner_faces() } else { 0 });
     for &r2 in r2s {
         for f in tri.inner_faces() {
             let t = from_smallest(f.vertices().map(|v| *v.data()));
             if circumradius2(t) <= r2 {
                 kept[f.fix().index()] = true;
-                if owned(t) {
+                if whole {
                     triangles.push(t.map(|v| v.id));
+                } else if core.contains(&circumcentre_x(t)) {
+                    triangles.push(t.map(|v| v.id));
+                    owned.push(f.fix());
                 }
             }
         }
@@ -262,15 +270,22 @@ fn kept_in_strip(verts: &[V], strip: Strip, r2s: &[f64]) -> Option<(Vec<[u32; 3]
         }
     }
     let mut edges: Vec<Edge> = Vec::new();
-    for f in tri.inner_faces().filter(|f| kept[f.fix().index()]) {
-        if !owned(from_smallest(f.vertices().map(|v| *v.data()))) {
-            continue;
-        }
-        for e in f.adjacent_edges() {
-            let other = e.rev().face();
-            if !other.as_inner().is_some_and(|g| kept[g.fix().index()]) {
-                edges.push((e.from().data().id, e.to().data().id, e.from().data().p));
+    let mut boundary_of =
+        |f: spade::handles::FaceHandle<'_, spade::handles::InnerTag, V, (), (), ()>| {
+            for e in f.adjacent_edges() {
+                let other = e.rev().face();
+                if !other.as_inner().is_some_and(|g| kept[g.fix().index()]) {
+                    edges.push((e.from().data().id, e.to().data().id, e.from().data().p));
+                }
             }
+        };
+    if whole {
+        for f in tri.inner_faces().filter(|f| kept[f.fix().index()]) {
+            boundary_of(f);
+        }
+    } else {
+        for f in owned {
+            boundary_of(tri.face(f));
         }
     }
     Some((triangles, edges))
@@ -279,9 +294,14 @@ fn kept_in_strip(verts: &[V], strip: Strip, r2s: &[f64]) -> Option<(Vec<[u32; 3]
 /// The triangle `t` (counter-clockwise) turned to start at its smallest
 /// index, still counter-clockwise: the same numbers for a triangle
 /// whichever strip, and whichever of its vertices, spade gives it from.
-fn from_smallest(t: [V; 3]) -> [V; 3] {
-    let k = (0..3).min_by_key(|&k| t[k].id).unwrap_or(0);
-    [t[k], t[(k + 1) % 3], t[(k + 2) % 3]]
+fn from_smallest([a, b, c]: [V; 3]) -> [V; 3] {
+    if a.id < b.id && a.id < c.id {
+        [a, b, c]
+    } else if b.id < c.id {
+        [b, c, a]
+    } else {
+        [c, a, b]
+    }
 }
 
 /// The squared circumradius of a triangle (∞ for a degenerate one).
