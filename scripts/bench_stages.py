@@ -14,7 +14,13 @@ whose cores share one memory bus the fractions are lower bounds of what
 the code allows.
 
     python3 scripts/bench_stages.py [--bin target/release/aniso-alpha] [--threads 2] [--reps 5]
-        [--md OUT.md] [--json OUT.json] SCAN.ply [SCAN.ply ...]
+        [--against OTHER_BIN] [--md OUT.md] [--json OUT.json] SCAN.ply [SCAN.ply ...]
+
+With `--against`, a second build runs in the same loop (each repetition
+runs both builds, on 1 and N threads each), so that a drift of the
+machine's speed over the minutes of a run falls on both alike; its rows
+go under `"against"` in the JSON and after the first build's in the
+Markdown.
 """
 import argparse
 import json
@@ -52,11 +58,19 @@ def fraction(t1, tn, n):
     return max(0.0, min(1.0, (1 - 1 / s) / (1 - 1 / n)))
 
 
-def bench(binary, scan, n, reps):
-    runs = {1: [], n: []}
+def bench(binaries, scan, n, reps):
+    """Per build of `binaries`, the rows of `scan`: each phase's and
+    stage's median on 1 and `n` threads and its parallel fraction, the
+    builds' runs interleaved."""
+    runs = [{1: [], n: []} for _ in binaries]
     for _ in range(reps):
-        for t in (1, n):
-            runs[t].append(flat(timings(binary, scan, t)))
+        for b, r in zip(binaries, runs):
+            for t in (1, n):
+                r[t].append(flat(timings(b, scan, t)))
+    return [rows_of(r, n) for r in runs]
+
+
+def rows_of(runs, n):
     keys = [k for k in runs[1][0] if all(k in r for r in runs[1] + runs[n])]
     med = {t: {k: statistics.median(r[k] for r in runs[t]) for k in keys} for t in (1, n)}
     rows = []
@@ -69,8 +83,10 @@ def bench(binary, scan, n, reps):
     return rows
 
 
-def table(scan, rows, n):
+def table(scan, rows, n, build=None):
     name = os.path.splitext(os.path.basename(scan))[0]
+    if build:
+        name += f" (`{build}`)"
     total = next((r["t1"] for r in rows if r["what"] == "total"), None)
     out = [f"**{name}**", "", f"| phase / stage | 1 thread s | {n} threads s | share of 1-thread total | "
            f"speed-up | parallel fraction |", "|---|---:|---:|---:|---:|---:|"]
@@ -89,19 +105,27 @@ def main():
     ap.add_argument("--bin", default=os.path.join(ROOT, "target/release/aniso-alpha"))
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--reps", type=int, default=5)
+    ap.add_argument("--against", help="a second build, run in the same loop")
     ap.add_argument("--md")
     ap.add_argument("--json")
     a = ap.parse_args()
     if a.threads < 2:
         sys.exit("--threads: at least 2 (the comparison is against one thread)")
+    builds = [a.bin] + ([a.against] if a.against else [])
+    names = " against ".join(f"`{os.path.basename(b)}`" for b in builds)
     text = [f"`detect --structure planes` on 1 and {a.threads} threads, median of {a.reps} interleaved runs "
-            f"each (`{os.path.basename(a.bin)}`)", ""]
+            f"each ({names})", ""]
     payload = {"bin": a.bin, "threads": a.threads, "reps": a.reps, "scans": {}}
+    if a.against:
+        payload.update({"against_bin": a.against, "against": {}})
     for scan in a.scans:
-        rows = bench(a.bin, scan, a.threads, a.reps)
-        payload["scans"][scan] = rows
-        text.append(table(scan, rows, a.threads))
-        print(text[-1], flush=True)
+        per_build = bench(builds, scan, a.threads, a.reps)
+        payload["scans"][scan] = per_build[0]
+        if a.against:
+            payload["against"][scan] = per_build[1]
+        for b, rows in zip(builds, per_build):
+            text.append(table(scan, rows, a.threads, os.path.basename(b) if a.against else None))
+            print(text[-1], flush=True)
     if a.md:
         with open(a.md, "w") as f:
             f.write("\n".join(text))
