@@ -266,6 +266,7 @@ impl Incidence {
             drop(order);
             unique_to_input.shrink_to_fit();
             let unique: Vec<S> = unique_to_input.iter().map(|&i| canon[i as usize]).collect();
+            drop(canon);
             (unique, Some((input_to_unique, unique_to_input)))
         };
         let k = S::VERTICES;

@@ -685,8 +685,8 @@ mod tests {
     #[test]
     fn the_trie_finds_each_points_set_of_candidates() {
         // 40 candidates claiming random subsets of 300 points (fixed seed),
-        // a candidate's claims split in up to three lists, points
-        // scrambled within a list; against the sets by brute force.
+        // a candidate's claims cut in two lists at a random place, points
+        // in descending order; against the sets by brute force.
         let mut rng = crate::rng::SplitMix64::new(0x7e1e);
         let mut lists: Vec<(u32, Vec<u32>)> = Vec::new();
         let mut sets: Vec<Vec<u32>> = vec![Vec::new(); 300];
