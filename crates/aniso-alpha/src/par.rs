@@ -53,13 +53,7 @@ pub(crate) fn map_each<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync) -> Vec<
 /// result is the same for any thread count when equal elements are
 /// indistinguishable (a total order on whole values, as on tuples).
 pub(crate) fn sort_unstable<T: Ord + Send>(v: &mut [T]) {
-    #[cfg(feature = "parallel")]
-    if v.len() >= 1 << 16 {
-        use rayon::slice::ParallelSliceMut;
-        v.par_sort_unstable();
-        return;
-    }
-    v.sort_unstable();
+    sort_unstable_by(v, T::cmp);
 }
 
 /// Sorts `v` (unstable) by `cmp`, on the pool's threads from 2^16

@@ -80,6 +80,21 @@ struct Strip {
     points: (usize, usize),
 }
 
+impl Strip {
+    /// All `n` points, owning every triangle: one triangulation.
+    fn whole(n: usize) -> Self {
+        Strip {
+            core: (f64::NEG_INFINITY, f64::INFINITY),
+            points: (0, n),
+        }
+    }
+
+    /// Whether this is [`Strip::whole`]'s strip.
+    fn is_whole(&self) -> bool {
+        self.core == (f64::NEG_INFINITY, f64::INFINITY)
+    }
+}
+
 /// The 2D α-shape of `points[ids[..]]` on `plane` with radius `r` (module
 /// doc). Points projecting onto one 2D position are merged (the first
 /// index is kept). A large part is triangulated in strips on the pool's
@@ -153,10 +168,7 @@ fn projected(points: &[[f64; 3]], ids: &[u32], plane: &PlaneFit) -> Vec<V> {
 /// way.)
 fn strips_of(verts: &[V], r: f64) -> Vec<Strip> {
     let n = verts.len();
-    let whole = Strip {
-        core: (f64::NEG_INFINITY, f64::INFINITY),
-        points: (0, n),
-    };
+    let whole = Strip::whole(n);
     let halo = HALO_RADII * r;
     let extent = verts[n - 1].p.x - verts[0].p.x;
     if n < STRIPPED_POINTS || !halo.is_finite() || halo <= 0.0 {
@@ -209,10 +221,7 @@ fn kept_in_strips(verts: &[V], strips: &[Strip], r: f64) -> Option<(Vec<[u32; 3]
             _ => r * r * 4f64.powi(k as i32),
         })
         .collect();
-    let whole = Strip {
-        core: (f64::NEG_INFINITY, f64::INFINITY),
-        points: (0, verts.len()),
-    };
+    let whole = Strip::whole(verts.len());
     if strips.len() < 2 {
         return kept_in_strip(verts, whole, &ladder);
     }
@@ -244,7 +253,7 @@ fn kept_in_strip(verts: &[V], strip: Strip, r2s: &[f64]) -> Option<(Vec<[u32; 3]
         return None;
     }
     let tri = DelaunayTriangulation::<V>::bulk_load(mine.to_vec()).ok()?;
-    let whole = strip.core == (f64::NEG_INFINITY, f64::INFINITY);
+    let whole = strip.is_whole();
     let core = strip.core.0..strip.core.1;
     // Per face index of the triangulation: kept, and (in a strip's core,
     // or anywhere for the whole part) owned.
@@ -255,11 +264,12 @@ fn kept_in_strip(verts: &[V], strip: Strip, r2s: &[f64]) -> Option<(Vec<[u32; 3]
     for &r2 in r2s {
         for f in tri.inner_faces() {
             let t = from_smallest(f.vertices().map(|v| *v.data()));
-            if circumradius2(t) <= r2 {
+            let (rho2, centre_x) = circle(t);
+            if rho2 <= r2 {
                 kept[f.fix().index()] = true;
                 if whole {
                     triangles.push(t.map(|v| v.id));
-                } else if core.contains(&circumcentre_x(t)) {
+                } else if core.contains(&centre_x) {
                     triangles.push(t.map(|v| v.id));
                     owned.push(f.fix());
                 }
@@ -304,29 +314,20 @@ fn from_smallest([a, b, c]: [V; 3]) -> [V; 3] {
     }
 }
 
-/// The squared circumradius of a triangle (∞ for a degenerate one).
-fn circumradius2(t: [V; 3]) -> f64 {
-    circumcentre_offset(t).map_or(f64::INFINITY, |(ux, uy)| ux * ux + uy * uy)
-}
-
-/// The x of a triangle's circumcentre (∞ for a degenerate one).
-fn circumcentre_x(t: [V; 3]) -> f64 {
-    circumcentre_offset(t).map_or(f64::INFINITY, |(ux, _)| t[0].p.x + ux)
-}
-
-/// The circumcentre of a triangle less its first vertex, or `None` for a
-/// degenerate triangle.
-fn circumcentre_offset(t: [V; 3]) -> Option<(f64, f64)> {
+/// The squared circumradius of a triangle and the x of its circumcentre
+/// (both ∞ for a degenerate triangle).
+fn circle(t: [V; 3]) -> (f64, f64) {
     let [a, b, c] = t.map(|v| v.p);
     let (bx, by) = (b.x - a.x, b.y - a.y);
     let (cx, cy) = (c.x - a.x, c.y - a.y);
     let d = 2.0 * (bx * cy - by * cx);
     if d == 0.0 {
-        return None;
+        return (f64::INFINITY, f64::INFINITY);
     }
     let b2 = bx * bx + by * by;
     let c2 = cx * cx + cy * cy;
-    Some(((cy * b2 - by * c2) / d, (bx * c2 - cx * b2) / d))
+    let (ux, uy) = ((cy * b2 - by * c2) / d, (bx * c2 - cx * b2) / d);
+    (ux * ux + uy * uy, a.x + ux)
 }
 
 /// The boundary loop of largest area (counter-clockwise) among the
@@ -485,10 +486,7 @@ mod tests {
             let verts = projected(&pts, &ids, &plane);
             let strips = strips_of(&verts, r);
             assert!(strips.len() >= 3, "n {n} r {r}: {} strips", strips.len());
-            let whole = [Strip {
-                core: (f64::NEG_INFINITY, f64::INFINITY),
-                points: (0, verts.len()),
-            }];
+            let whole = [Strip::whole(verts.len())];
             let sorted = |strips: &[Strip]| {
                 let (mut t, mut e) = kept_in_strips(&verts, strips, r).unwrap();
                 t.sort_unstable();
