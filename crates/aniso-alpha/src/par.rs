@@ -49,6 +49,20 @@ pub(crate) fn map_each<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync) -> Vec<
     }
 }
 
+/// `f(item)` for each of `items`, collected in order, each item a task of
+/// its own (as [`map_each`]) that owns its item.
+pub(crate) fn map_owned<T: Send, U: Send>(items: Vec<T>, f: impl Fn(T) -> U + Sync) -> Vec<U> {
+    #[cfg(feature = "parallel")]
+    {
+        use rayon::prelude::*;
+        items.into_par_iter().map(&f).collect()
+    }
+    #[cfg(not(feature = "parallel"))]
+    {
+        items.into_iter().map(f).collect()
+    }
+}
+
 /// Sorts `v` (unstable), on the pool's threads from 2^16 elements. The
 /// result is the same for any thread count when equal elements are
 /// indistinguishable (a total order on whole values, as on tuples).

@@ -6,7 +6,7 @@
 //! edge.
 
 use super::super::detection::Primitive;
-use super::super::filter::{components, FilterError};
+use super::super::filter::{components_on, FilterError, Incidence};
 use super::super::regime::Regime;
 use super::super::scan::{Face, LINE_SCAN_MIN};
 use super::{Candidate, Footprint, Settings};
@@ -26,7 +26,8 @@ pub(super) fn find<S: Face>(
     settings: &Settings,
     regime: &Regime,
 ) -> Result<Vec<Candidate>, FilterError> {
-    let comps = group_components(kept, group, settings.scales.len())?;
+    let angle = settings.part_angle_deg;
+    let comps = group_components(points, kept, group, settings.scales.len(), angle)?;
     // Short lines start from the scan's shortest pieces (three points);
     // a part still needs min_vertices points once its claims have joined
     // its pieces.
@@ -37,19 +38,33 @@ pub(super) fn find<S: Face>(
     };
     // Components are independent: extracted in parallel, in order.
     let per_component = map_each(comps.len(), |k| {
-        let (g, ss) = &comps[k];
-        let scale = settings.scales[*g as usize];
-        let local: Vec<S> = ss.iter().map(|&s| kept[s as usize]).collect();
-        extract(points, &local, scale.tau, seed_min, settings.part_angle_deg)
+        let c = &comps[k];
+        let scale = settings.scales[c.group as usize];
+        let local: Vec<S> = c.simplices.iter().map(|&s| kept[s as usize]).collect();
+        let parts = c.parts.as_deref();
+        let extracted = extract(points, &local, parts, scale.tau, seed_min, angle);
+        let footprint = |k: usize| {
+            let (seeds, fit) = &extracted[k];
+            Footprint::new(fit, points, seeds, scale.cell)
+        };
+        // A large component's footprints on the pool's threads too (a
+        // depth frame's table gives a dozen candidates of 50k points).
+        let seeds: usize = extracted.iter().map(|e| e.0.len()).sum();
+        let feet = if seeds < CHUNKED_VERTICES {
+            (0..extracted.len()).map(footprint).collect()
+        } else {
+            map_each(extracted.len(), footprint)
+        };
+        extracted
             .into_iter()
-            .filter_map(|(seeds, fit)| {
-                let foot = Footprint::new(&fit, points, &seeds, scale.cell)?;
+            .zip(feet)
+            .filter_map(|((seeds, fit), foot)| {
                 Some(Candidate {
                     fit,
                     tau: scale.tau,
                     cell: scale.cell,
                     seeds,
-                    foot,
+                    foot: foot?,
                 })
             })
             .collect::<Vec<Candidate>>()
@@ -57,31 +72,78 @@ pub(super) fn find<S: Face>(
     Ok(per_component.into_iter().flatten().collect())
 }
 
-/// The connected components of each group's simplices: (group, indices
-/// into `kept`), group by group, components in the order
-/// [`components`] numbers them. Groups on the pool's threads.
+/// A connected component of one group's simplices.
+struct Component {
+    /// The group.
+    group: u32,
+    /// Its simplices, as indices into the union.
+    simplices: Vec<u32>,
+    /// Its simplices' straight or flat parts ([`Face::parts`]), numbered
+    /// within it; `None` where the group's could not be made (a NaN
+    /// point): [`extract`] then makes the component's own.
+    parts: Option<Vec<u32>>,
+}
+
+/// The connected components of each group's simplices, group by group,
+/// components in the order [`components_on`] numbers them, with their
+/// parts: one incidence of a group's simplices serves both (a part grows
+/// through shared faces, so it never leaves its component, see
+/// [`Face::parts_on`]). Groups on the pool's threads.
 fn group_components<S: Face>(
+    points: &[[f64; 3]],
     kept: &[S],
     group: &[u32],
     n_groups: usize,
-) -> Result<Vec<(u32, Vec<u32>)>, FilterError> {
+    angle: f64,
+) -> Result<Vec<Component>, FilterError> {
     let mut by_group: Vec<Vec<u32>> = vec![Vec::new(); n_groups];
     for (s, &g) in group.iter().enumerate() {
         by_group[g as usize].push(s as u32);
     }
-    let per_group = map_each(n_groups, |g| -> Result<Vec<(u32, Vec<u32>)>, FilterError> {
+    let per_group = map_each(n_groups, |g| -> Result<Vec<Component>, FilterError> {
         let ss = &by_group[g];
         if ss.is_empty() {
             return Ok(Vec::new());
         }
         let local: Vec<S> = ss.iter().map(|&s| kept[s as usize]).collect();
-        let comp = components(&local)?;
+        let inc = Incidence::new(&local)?;
+        let comp = components_on(&inc);
+        let part = S::parts_on(points, &local, &inc, angle).ok();
+        drop(inc);
         let n_comp = comp.iter().map(|&c| c as usize + 1).max().unwrap_or(0);
-        let mut parts: Vec<Vec<u32>> = vec![Vec::new(); n_comp];
+        // Each part's number within its component: the parts in the
+        // order they were made, counted per component.
+        let within = part.as_ref().map(|part| {
+            let n_parts = part.iter().map(|&p| p as usize + 1).max().unwrap_or(0);
+            let mut comp_of = vec![0u32; n_parts];
+            for (&p, &c) in part.iter().zip(&comp) {
+                comp_of[p as usize] = c;
+            }
+            let mut next = vec![0u32; n_comp];
+            comp_of
+                .iter()
+                .map(|&c| {
+                    let id = next[c as usize];
+                    next[c as usize] += 1;
+                    id
+                })
+                .collect::<Vec<u32>>()
+        });
+        let mut out: Vec<Component> = (0..n_comp)
+            .map(|_| Component {
+                group: g as u32,
+                simplices: Vec::new(),
+                parts: within.as_ref().map(|_| Vec::new()),
+            })
+            .collect();
         for (k, &c) in comp.iter().enumerate() {
-            parts[c as usize].push(ss[k]);
+            let o = &mut out[c as usize];
+            o.simplices.push(ss[k]);
+            if let (Some(parts), Some(part), Some(within)) = (&mut o.parts, &part, &within) {
+                parts.push(within[part[k] as usize]);
+            }
         }
-        Ok(parts.into_iter().map(|p| (g as u32, p)).collect())
+        Ok(out)
     });
     let mut out = Vec::new();
     for g in per_group {
@@ -93,10 +155,12 @@ fn group_components<S: Face>(
 /// Greedy extraction of straight/flat primitives from one connected
 /// component `local` (module doc of `assemble`, step 1): their inlier
 /// vertices (within `tol`) and fits, while the best candidate covers at
-/// least `min_vertices` new vertices.
+/// least `min_vertices` new vertices. `parts`: the simplices' parts when
+/// the caller has them (made here otherwise).
 fn extract<S: Face>(
     points: &[[f64; 3]],
     local: &[S],
+    parts: Option<&[u32]>,
     tol: f64,
     min_vertices: usize,
     angle: f64,
@@ -113,7 +177,7 @@ fn extract<S: Face>(
     if verts.len() < min_vertices {
         return out;
     }
-    let mut cands = piece_fits(points, local, &verts, angle);
+    let mut cands = piece_fits(points, local, parts, &verts, angle);
     let inside = |c: &Primitive, v: u32| c.distance(&points[v as usize]) <= tol;
     let inliers = |fit: &Primitive| -> Vec<u32> { filter_chunks(&verts, |v| inside(fit, v)) };
     // Each candidate's count of uncovered vertices within `tol`, counted
@@ -213,29 +277,27 @@ fn count_each(
 /// The candidate primitives of a component with the vertices `verts`: the
 /// fits of its pieces of like-oriented simplices ([`Face::parts`]) with at
 /// least two simplices' worth of points, the largest [`MAX_PIECES`], and
-/// the fit of the whole component. (A failure of the pieces, which needs a
-/// NaN point, leaves the component in one piece.)
+/// the fit of the whole component. The pieces are `parts` where given;
+/// made here otherwise, where a failure (which needs a NaN point) leaves
+/// the component in one piece.
 fn piece_fits<S: Face>(
     points: &[[f64; 3]],
     local: &[S],
+    parts: Option<&[u32]>,
     verts: &[u32],
     angle: f64,
 ) -> Vec<Primitive> {
-    let part = S::parts(points, local, angle).unwrap_or_else(|_| vec![0; local.len()]);
+    let own;
+    let part = match parts {
+        Some(p) => p,
+        None => {
+            own = S::parts(points, local, angle).unwrap_or_else(|_| vec![0; local.len()]);
+            &own
+        }
+    };
     let n_parts = part.iter().map(|&p| p as usize + 1).max().unwrap_or(0);
-    let mut pv: Vec<Vec<u32>> = vec![Vec::new(); n_parts];
-    for (s, &p) in local.iter().zip(&part) {
-        pv[p as usize].extend_from_slice(s.as_ref());
-    }
-    let mut by_size: Vec<(usize, usize)> = pv
-        .iter_mut()
-        .enumerate()
-        .map(|(i, v)| {
-            v.sort_unstable();
-            v.dedup();
-            (v.len(), i)
-        })
-        .collect();
+    let pv = part_vertices(points.len(), local, part, n_parts, verts.len());
+    let mut by_size: Vec<(usize, usize)> = pv.iter().map(Vec::len).zip(0..).collect();
     by_size.sort_unstable_by(|a, b| b.0.cmp(&a.0).then(a.1.cmp(&b.1)));
     let fitted: Vec<usize> = by_size
         .iter()
@@ -250,6 +312,47 @@ fn piece_fits<S: Face>(
     };
     cands.push(S::fit(points, verts));
     cands
+}
+
+/// The vertices of each of the `n_parts` parts (`part`: each simplex's)
+/// of a component's simplices `local`, sorted and distinct. A large
+/// component (`n_verts` vertices) on the pool's threads: a vertex is in
+/// about six triangles, mostly of one part, and a stamp of the last part
+/// that listed it (one per point of the cloud's `n_points`) leaves few
+/// repeats to sort away.
+fn part_vertices<S: AsRef<[u32]>>(
+    n_points: usize,
+    local: &[S],
+    part: &[u32],
+    n_parts: usize,
+    n_verts: usize,
+) -> Vec<Vec<u32>> {
+    let mut pv: Vec<Vec<u32>> = vec![Vec::new(); n_parts];
+    if n_verts < CHUNKED_VERTICES {
+        for (s, &p) in local.iter().zip(part) {
+            pv[p as usize].extend_from_slice(s.as_ref());
+        }
+        for v in &mut pv {
+            v.sort_unstable();
+            v.dedup();
+        }
+        return pv;
+    }
+    let mut last = vec![u32::MAX; n_points];
+    for (s, &p) in local.iter().zip(part) {
+        for &v in s.as_ref() {
+            if last[v as usize] != p {
+                last[v as usize] = p;
+                pv[p as usize].push(v);
+            }
+        }
+    }
+    drop(last);
+    crate::par::for_each_mut(pv.iter_mut().collect(), |v| {
+        crate::par::sort_unstable(v);
+        v.dedup();
+    });
+    pv
 }
 
 #[cfg(test)]
@@ -274,7 +377,7 @@ mod tests {
     #[test]
     fn an_l_gives_its_two_legs() {
         let (pts, edges) = l_shape();
-        let legs = extract(&pts, &edges[..20], 0.1, 5, 10.0);
+        let legs = extract(&pts, &edges[..20], None, 0.1, 5, 10.0);
         assert_eq!(legs.len(), 2);
         // Each leg's inliers: its eleven points (the corner in both).
         let mut sizes: Vec<usize> = legs.iter().map(|(s, _)| s.len()).collect();
@@ -282,7 +385,7 @@ mod tests {
         assert_eq!(sizes, [11, 11]);
         assert!(legs.iter().all(|(_, f)| f.rms() < 1e-9));
         // Too few vertices: nothing.
-        assert!(extract(&pts, &edges[..3], 0.1, 5, 10.0).is_empty());
+        assert!(extract(&pts, &edges[..3], None, 0.1, 5, 10.0).is_empty());
     }
 
     #[test]
@@ -324,5 +427,83 @@ mod tests {
         assert!(find(&pts, &three, &[1, 1], &settings, &regime)
             .unwrap()
             .is_empty());
+    }
+
+    /// Triangles of `m` folded sheets, each a strip of squares whose
+    /// halves alternate between two planes 40° apart (planar parts of
+    /// 10°), jittered: several components of several parts each, in one
+    /// group, listed sorted as the union lists them.
+    fn folded_sheets(m: u32, seed: u64) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+        let mut rng = crate::rng::SplitMix64::new(seed);
+        let mut pts = Vec::new();
+        let mut tris = Vec::new();
+        for sheet in 0..m {
+            let base = pts.len() as u32;
+            let n = 6 + sheet * 3;
+            for i in 0..=n {
+                for j in 0..=3u32 {
+                    let x = f64::from(i);
+                    let fold = if (i / 3) % 2 == 0 { 0.0 } else { 0.8 };
+                    let z = fold * f64::from(j) + 0.01 * rng.uniform();
+                    pts.push([x + 100.0 * f64::from(sheet), f64::from(j), z]);
+                }
+            }
+            let id = |i: u32, j: u32| base + i * 4 + j;
+            for i in 0..n {
+                for j in 0..3 {
+                    tris.push(<[u32; 3]>::sorted(
+                        [id(i, j), id(i + 1, j), id(i + 1, j + 1)].into_iter(),
+                    ));
+                    tris.push(<[u32; 3]>::sorted(
+                        [id(i, j), id(i + 1, j + 1), id(i, j + 1)].into_iter(),
+                    ));
+                }
+            }
+        }
+        tris.sort_unstable();
+        (pts, tris)
+    }
+
+    #[test]
+    fn a_groups_parts_restricted_to_a_component_are_its_own() {
+        let (pts, tris) = folded_sheets(4, 7);
+        let group = vec![0u32; tris.len()];
+        let comps = group_components(&pts, &tris, &group, 1, 10.0).unwrap();
+        assert_eq!(comps.len(), 4);
+        let mut total_parts = 0;
+        for c in &comps {
+            let local: Vec<[u32; 3]> = c.simplices.iter().map(|&s| tris[s as usize]).collect();
+            let own = <[u32; 3]>::parts(&pts, &local, 10.0).unwrap();
+            assert_eq!(c.parts.as_deref(), Some(&own[..]));
+            total_parts += own.iter().max().map_or(0, |&p| p as usize + 1);
+        }
+        // Each sheet has several parts: the test compares numberings.
+        assert!(total_parts >= 4 * 3, "{total_parts}");
+        // A NaN point: no group parts, and each component makes its own.
+        let mut bad = pts.clone();
+        bad[0] = [f64::NAN; 3];
+        let comps = group_components(&bad, &tris, &group, 1, 10.0).unwrap();
+        assert!(comps.iter().all(|c| c.parts.is_none()));
+    }
+
+    #[test]
+    fn part_vertices_are_each_parts_sorted_distinct_vertices() {
+        let (pts, tris) = folded_sheets(3, 9);
+        let part = <[u32; 3]>::parts(&pts, &tris, 10.0).unwrap();
+        let n_parts = part.iter().map(|&p| p as usize + 1).max().unwrap();
+        let mut want: Vec<Vec<u32>> = vec![Vec::new(); n_parts];
+        for (t, &p) in tris.iter().zip(&part) {
+            want[p as usize].extend_from_slice(t);
+        }
+        for w in &mut want {
+            w.sort_unstable();
+            w.dedup();
+        }
+        // Both ways: the plain lists, and the stamped ones of a large
+        // component.
+        for n_verts in [0, CHUNKED_VERTICES] {
+            let got = part_vertices(pts.len(), &tris, &part, n_parts, n_verts);
+            assert_eq!(got, want, "{n_verts}");
+        }
     }
 }

@@ -360,6 +360,7 @@ pub(super) fn settle<S: Shape>(
     angle_deg: f64,
 ) -> (Vec<Candidate>, Claims) {
     let points = cloud.points();
+    cloud.build_index();
     // The merging rounds ask only which candidates share points.
     let mut sharing = Sharing::of(&cands, cloud, normals);
     while let Some(groups) = duplicates::<S>(&cands, &sharing, angle_deg, points) {
@@ -527,25 +528,31 @@ impl SoFar {
 /// cell of the candidates not absorbed (dropped if it has no footprint).
 fn merged<S: Shape>(cands: Vec<Candidate>, groups: &Groups, points: &[[f64; 3]]) -> Vec<Candidate> {
     let mut old: Vec<Option<Candidate>> = cands.into_iter().map(Some).collect();
-    let mut next: Vec<Candidate> = Vec::new();
-    for g in groups.sets.iter().filter(|g| !g.is_empty()) {
-        let group: Vec<(Candidate, bool)> = g
-            .iter()
-            .filter_map(|&c| {
-                old[c as usize]
-                    .take()
-                    .map(|x| (x, groups.absorbed[c as usize]))
-            })
-            .collect();
+    let sets: Vec<Vec<(Candidate, bool)>> = groups
+        .sets
+        .iter()
+        .filter(|g| !g.is_empty())
+        .map(|g| {
+            g.iter()
+                .filter_map(|&c| {
+                    old[c as usize]
+                        .take()
+                        .map(|x| (x, groups.absorbed[c as usize]))
+                })
+                .collect()
+        })
+        .collect();
+    drop(old);
+    // Groups are independent: on the pool's threads, in order.
+    crate::par::map_owned(sets, |mut group| {
         if group.len() == 1 {
-            next.extend(group.into_iter().map(|(c, _)| c));
-            continue;
+            return group.pop().map(|(c, _)| c);
         }
         let mut seeds: Vec<u32> = group
             .iter()
             .flat_map(|(c, _)| c.seeds.iter().copied())
             .collect();
-        seeds.sort_unstable();
+        crate::par::sort_unstable(&mut seeds);
         seeds.dedup();
         let widest = |of: fn(&Candidate) -> f64| {
             group
@@ -555,18 +562,20 @@ fn merged<S: Shape>(cands: Vec<Candidate>, groups: &Groups, points: &[[f64; 3]])
                 .fold(0.0, f64::max)
         };
         let (tau, cell) = (widest(|c| c.tau), widest(|c| c.cell));
+        drop(group);
         let fit = S::fit(points, &seeds);
-        if let Some(foot) = Footprint::new(&fit, points, &seeds, cell) {
-            next.push(Candidate {
-                fit,
-                tau,
-                cell,
-                seeds,
-                foot,
-            });
-        }
-    }
-    next
+        let foot = Footprint::new(&fit, points, &seeds, cell)?;
+        Some(Candidate {
+            fit,
+            tau,
+            cell,
+            seeds,
+            foot,
+        })
+    })
+    .into_iter()
+    .flatten()
+    .collect()
 }
 
 /// Refits each candidate with more than k members on them (its footprint

@@ -42,6 +42,7 @@ pub(super) const MAX_WIDEN_BACKGROUND: f64 = 1.0;
 /// parallel, and a large candidate's near points too ([`near_points`]).
 pub(super) fn claim_radii<S: Shape>(cands: &mut [Candidate], cloud: &Cloud<'_>) {
     let rho_global = cloud.distinct_count() as f64 / cloud.volume();
+    cloud.build_index();
     let log10_tests =
         log10_n_tests(cloud.distinct_count(), S::K) + (CLAIM_RADII.len() as f64).log10();
     let taus = map_each(cands.len(), |ci| {
