@@ -9,6 +9,9 @@ use super::super::detection::Primitive;
 use super::super::filter::{components_on, FilterError, Incidence};
 use super::super::regime::Regime;
 use super::super::scan::{Face, LINE_SCAN_MIN};
+use super::moments::Moments;
+use super::same::{mostly_within, Piece};
+use super::shape::Shape;
 use super::{Candidate, Footprint, Settings};
 use crate::par::{map_each, map_ranges};
 
@@ -19,7 +22,7 @@ const MAX_PIECES: usize = 64;
 /// The candidates of the cleaned union `kept`, whose simplices were found
 /// by the groups `group`: per component of each group, the greedy
 /// extraction ([`extract`]) at the group's scale, with footprints.
-pub(super) fn find<S: Face>(
+pub(super) fn find<S: Shape>(
     points: &[[f64; 3]],
     kept: &[S],
     group: &[u32],
@@ -157,7 +160,7 @@ fn group_components<S: Face>(
 /// vertices (within `tol`) and fits, while the best candidate covers at
 /// least `min_vertices` new vertices. `parts`: the simplices' parts when
 /// the caller has them (made here otherwise).
-fn extract<S: Face>(
+fn extract<S: Shape>(
     points: &[[f64; 3]],
     local: &[S],
     parts: Option<&[u32]>,
@@ -165,7 +168,7 @@ fn extract<S: Face>(
     min_vertices: usize,
     angle: f64,
 ) -> Vec<(Vec<u32>, Primitive)> {
-    let mut out = Vec::new();
+    let mut out: Vec<Extracted> = Vec::new();
     let mut verts: Vec<u32> = local
         .iter()
         .flat_map(|s| s.as_ref().iter().copied())
@@ -175,7 +178,7 @@ fn extract<S: Face>(
     // Held through the extraction: a vertex is in about six triangles.
     verts.shrink_to_fit();
     if verts.len() < min_vertices {
-        return out;
+        return Vec::new();
     }
     let mut cands = piece_fits(points, local, parts, &verts, angle);
     let inside = |c: &Primitive, v: u32| c.distance(&points[v as usize]) <= tol;
@@ -227,9 +230,129 @@ fn extract<S: Face>(
         if gained < min_vertices || inl.len() < min_vertices {
             break;
         }
-        out.push((inl, fit));
+        // An earlier candidate found again (most of this one's inliers
+        // within τ of its primitive, the two one primitive): the merge the
+        // claims would make of the two (stage 3), made now.
+        match out
+            .iter()
+            .position(|e| e.found_again::<S>(&fit, &inl, tol, angle, points))
+        {
+            Some(k) => out[k].join::<S>(&inl, points),
+            None => out.push(Extracted {
+                seeds: inl,
+                fit,
+                joined: None,
+            }),
+        }
     }
-    out
+    out.into_iter().map(|e| e.finish::<S>(points)).collect()
+}
+
+/// A candidate extracted from a component ([`extract`]): its inliers and
+/// fit, and once later extractions have joined it, the moments of its
+/// inliers (its fit is then theirs, fitted again from the points at the
+/// end).
+struct Extracted {
+    seeds: Vec<u32>,
+    fit: Primitive,
+    joined: Option<Moments>,
+}
+
+impl Extracted {
+    /// Whether the primitive `fit` with the inliers `inl` is this
+    /// candidate found again: one primitive with it ([`Shape::same`] at
+    /// the component's τ), most of `inl` ([`mostly_within`]) within τ of
+    /// its primitive, and some of them its own.
+    fn found_again<S: Shape>(
+        &self,
+        fit: &Primitive,
+        inl: &[u32],
+        tau: f64,
+        angle: f64,
+        points: &[[f64; 3]],
+    ) -> bool {
+        let piece = |fit, seeds| Piece { fit, tau, seeds };
+        let (this, other) = (piece(&self.fit, &self.seeds), piece(fit, inl));
+        S::same(this, other, angle, points)
+            && mostly_within(other, this, points)
+            && shares(&self.seeds, inl)
+    }
+
+    /// The inliers `inl` joined to this candidate; its fit becomes that of
+    /// the moments of the union.
+    fn join<S: Shape>(&mut self, inl: &[u32], points: &[[f64; 3]]) {
+        let (seeds, new) = union(&self.seeds, inl);
+        let moments = self
+            .joined
+            .unwrap_or_else(|| Moments::of(&self.seeds, points))
+            .join(&Moments::of(&new, points));
+        let joint = if S::K == 1 {
+            moments.line()
+        } else {
+            moments.plane()
+        };
+        if !matches!(joint, Primitive::None) {
+            self.fit = joint;
+        }
+        self.seeds = seeds;
+        self.joined = Some(moments);
+    }
+
+    /// The inliers and the fit: a joined candidate fitted again on its
+    /// points (the fit every candidate has, extent included).
+    fn finish<S: Shape>(self, points: &[[f64; 3]]) -> (Vec<u32>, Primitive) {
+        let fit = match self.joined {
+            Some(_) => match S::fit(points, &self.seeds) {
+                Primitive::None => self.fit,
+                joint => joint,
+            },
+            None => self.fit,
+        };
+        (self.seeds, fit)
+    }
+}
+
+/// Whether the sorted lists `a` and `b` have an element in common.
+fn shares(a: &[u32], b: &[u32]) -> bool {
+    let (mut i, mut j) = (0, 0);
+    while i < a.len() && j < b.len() {
+        match a[i].cmp(&b[j]) {
+            std::cmp::Ordering::Less => i += 1,
+            std::cmp::Ordering::Greater => j += 1,
+            std::cmp::Ordering::Equal => return true,
+        }
+    }
+    false
+}
+
+/// The union of the sorted, distinct lists `a` and `b`, sorted and
+/// distinct, and the elements of `b` not in `a`.
+fn union(a: &[u32], b: &[u32]) -> (Vec<u32>, Vec<u32>) {
+    let mut out = Vec::with_capacity(a.len() + b.len());
+    let mut new = Vec::new();
+    let (mut i, mut j) = (0, 0);
+    while i < a.len() && j < b.len() {
+        match a[i].cmp(&b[j]) {
+            std::cmp::Ordering::Less => {
+                out.push(a[i]);
+                i += 1;
+            }
+            std::cmp::Ordering::Greater => {
+                out.push(b[j]);
+                new.push(b[j]);
+                j += 1;
+            }
+            std::cmp::Ordering::Equal => {
+                out.push(a[i]);
+                i += 1;
+                j += 1;
+            }
+        }
+    }
+    out.extend_from_slice(&a[i..]);
+    out.extend_from_slice(&b[j..]);
+    new.extend_from_slice(&b[j..]);
+    (out, new)
 }
 
 /// Vertices from which one component's passes over its vertices are cut
@@ -359,7 +482,9 @@ fn part_vertices<S: AsRef<[u32]>>(
 mod tests {
     use super::*;
     use crate::detect::assemble::Scale;
+    use crate::detect::fit::fit_plane_indices;
     use crate::detect::StructureKind;
+    use crate::geometry::dot;
 
     /// Edges along two perpendicular lines meeting at the origin (an L),
     /// eleven points each, and a separate chain of four points far away.
@@ -505,5 +630,74 @@ mod tests {
             let got = part_vertices(pts.len(), &tris, &part, n_parts, n_verts);
             assert_eq!(got, want, "{n_verts}");
         }
+    }
+
+    /// A noisy sheet (41 × 11 points, 0.5 apart, heights Gaussian of
+    /// σ = 0.015) and a flat strip 0.6 above it, joined to it along one
+    /// side: one component, whose sheet no plane holds within τ = 0.02.
+    fn noisy_sheet_and_shelf() -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+        let mut rng = crate::rng::SplitMix64::new(5);
+        let mut pts = Vec::new();
+        let (nx, ny) = (41u32, 11u32);
+        for i in 0..nx {
+            for j in 0..ny {
+                let x = 0.5 * f64::from(i) - 10.0;
+                let (u, v) = (rng.uniform().max(1e-12), rng.uniform());
+                let gauss = (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos();
+                pts.push([x, 0.5 * f64::from(j), 0.015 * gauss]);
+            }
+        }
+        let shelf = pts.len() as u32;
+        for i in 0..nx {
+            for j in 0..4u32 {
+                pts.push([0.5 * f64::from(i) - 10.0, 5.0 + 0.5 * f64::from(j), 0.6]);
+            }
+        }
+        let mut tris = Vec::new();
+        let sheet = |i: u32, j: u32| i * ny + j;
+        let top = |i: u32, j: u32| shelf + i * 4 + j;
+        for i in 0..nx - 1 {
+            for j in 0..ny - 1 {
+                tris.push([sheet(i, j), sheet(i + 1, j), sheet(i + 1, j + 1)]);
+                tris.push([sheet(i, j), sheet(i + 1, j + 1), sheet(i, j + 1)]);
+            }
+            for j in 0..3 {
+                tris.push([top(i, j), top(i + 1, j), top(i + 1, j + 1)]);
+                tris.push([top(i, j), top(i + 1, j + 1), top(i, j + 1)]);
+            }
+            // The bridge between the sheet's last row and the shelf.
+            tris.push([sheet(i, ny - 1), sheet(i + 1, ny - 1), top(i + 1, 0)]);
+            tris.push([sheet(i, ny - 1), top(i + 1, 0), top(i, 0)]);
+        }
+        let mut tris: Vec<[u32; 3]> = tris
+            .into_iter()
+            .map(|t| <[u32; 3]>::sorted(t.into_iter()))
+            .collect();
+        tris.sort_unstable();
+        (pts, tris)
+    }
+
+    #[test]
+    fn a_candidate_found_again_joins_the_first_and_a_parallel_shelf_does_not() {
+        let (pts, tris) = noisy_sheet_and_shelf();
+        let cands = extract(&pts, &tris, None, 0.02, 4, 10.0);
+        let on_sheet = |c: &(Vec<u32>, Primitive)| c.0.iter().all(|&v| v < 41 * 11);
+        // The sheet's slabs, the later ones mostly the first one's points,
+        // are one candidate (two without the rule); the shelf, parallel
+        // to it and 0.6 above, is another.
+        let sizes: Vec<usize> = cands.iter().map(|c| c.0.len()).collect();
+        let sheets: Vec<&(Vec<u32>, Primitive)> = cands.iter().filter(|c| on_sheet(c)).collect();
+        assert_eq!(sheets.len(), 1, "{sizes:?}");
+        assert!(sheets[0].0.len() > 41 * 11 * 2 / 3, "{sizes:?}");
+        assert!(cands
+            .iter()
+            .any(|c| c.0.len() == 41 * 4 && c.0.iter().all(|&v| v >= 41 * 11)));
+        // Its fit is the plane of all its points.
+        let Primitive::Plane(joint) = &sheets[0].1 else {
+            panic!("not a plane")
+        };
+        let all = fit_plane_indices(&pts, &sheets[0].0).unwrap();
+        assert!((dot(joint.normal, all.normal).abs() - 1.0).abs() < 1e-12);
+        assert!((joint.rms_residual - all.rms_residual).abs() < 1e-12);
     }
 }

@@ -71,7 +71,7 @@ fn big_and_small<'a>(a: Piece<'a>, b: Piece<'a>) -> (Piece<'a>, Piece<'a>) {
 
 /// Whether most of `small`'s seeds ([`SAME_SHARE`]) lie within `big`'s
 /// claim radius of `big`'s primitive.
-fn mostly_within(small: Piece, big: Piece, points: &[[f64; 3]]) -> bool {
+pub(super) fn mostly_within(small: Piece, big: Piece, points: &[[f64; 3]]) -> bool {
     let near = small
         .seeds
         .iter()
