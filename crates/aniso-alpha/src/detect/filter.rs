@@ -523,15 +523,11 @@ pub fn paths<S: Simplex>(simplices: &[S]) -> Result<Vec<u32>, FilterError> {
 /// assert_eq!(components(&s).unwrap(), vec![0, 1, 0, 0]);
 /// ```
 pub fn components<S: Simplex>(simplices: &[S]) -> Result<Vec<u32>, FilterError> {
-    Ok(components_on(&Incidence::new(simplices)?))
-}
-
-/// [`components`] of the simplices whose incidence is `inc`.
-pub(crate) fn components_on(inc: &Incidence) -> Vec<u32> {
+    let inc = Incidence::new(simplices)?;
     let alive = vec![true; inc.n];
     let mut uf = UnionFind::new(0);
     inc.unite(&alive, &[], false, &mut uf);
-    inc.label_input(&mut uf)
+    Ok(inc.label_input(&mut uf))
 }
 
 /// Keeps the simplices of connected components ([`components`]) holding at

@@ -137,23 +137,6 @@ fn grow<S: Simplex>(
         return Err(PartsError::BadAngle(max_angle_deg));
     }
     let inc = Incidence::new(simplices)?;
-    grow_on(&inc, simplices, axes, max_angle_deg)
-}
-
-/// [`grow`] on the incidence `inc` of `simplices`, built by the caller.
-/// A part grows through shared faces only, so it never leaves its
-/// connected component, and seeds are taken in the same relative order
-/// within each component: the parts of a set of components, restricted
-/// to one of them and numbered in order, are that component's own.
-fn grow_on<S: Simplex>(
-    inc: &Incidence,
-    simplices: &[S],
-    axes: impl Fn(&S) -> Option<[f64; 3]> + Sync,
-    max_angle_deg: f64,
-) -> Result<Vec<u32>, PartsError> {
-    if !(0.0..=90.0).contains(&max_angle_deg) {
-        return Err(PartsError::BadAngle(max_angle_deg));
-    }
     let n = inc.n;
     // Each unique simplex's axis, NaN where it has none (alike to none).
     let exact = |u: usize| axes(&simplices[inc.input_of(u) as usize]).unwrap_or([f64::NAN; 3]);
@@ -225,32 +208,16 @@ pub fn planar_parts(
     max_angle_deg: f64,
 ) -> Result<Vec<u32>, PartsError> {
     check_points(points, triangles)?;
-    grow(triangles, |t| triangle_normal(points, t), max_angle_deg)
-}
-
-/// [`planar_parts`] on the incidence `inc` of `triangles`, built by the
-/// caller (see [`grow_on`]).
-pub(crate) fn planar_parts_on(
-    points: &[[f64; 3]],
-    triangles: &[[u32; 3]],
-    inc: &Incidence,
-    max_angle_deg: f64,
-) -> Result<Vec<u32>, PartsError> {
-    check_points(points, triangles)?;
-    grow_on(
-        inc,
+    grow(
         triangles,
-        |t| triangle_normal(points, t),
+        |t| {
+            let [a, b, c] = t.map(|v| points[v as usize]);
+            let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+            let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+            normalize(cross(u, v))
+        },
         max_angle_deg,
     )
-}
-
-/// The unit normal of triangle `t` (None when it has no area).
-fn triangle_normal(points: &[[f64; 3]], t: &[u32; 3]) -> Option<[f64; 3]> {
-    let [a, b, c] = t.map(|v| points[v as usize]);
-    let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-    let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-    normalize(cross(u, v))
 }
 
 /// Splits edges into straight parts (module docs); returns a part id per
@@ -270,25 +237,14 @@ pub fn linear_parts(
     max_angle_deg: f64,
 ) -> Result<Vec<u32>, PartsError> {
     check_points(points, edges)?;
-    grow(edges, |e| edge_direction(points, e), max_angle_deg)
-}
-
-/// [`linear_parts`] on the incidence `inc` of `edges`, built by the
-/// caller (see [`grow_on`]).
-pub(crate) fn linear_parts_on(
-    points: &[[f64; 3]],
-    edges: &[[u32; 2]],
-    inc: &Incidence,
-    max_angle_deg: f64,
-) -> Result<Vec<u32>, PartsError> {
-    check_points(points, edges)?;
-    grow_on(inc, edges, |e| edge_direction(points, e), max_angle_deg)
-}
-
-/// The unit direction of edge `e` (None when it has no length).
-fn edge_direction(points: &[[f64; 3]], e: &[u32; 2]) -> Option<[f64; 3]> {
-    let [a, b] = e.map(|v| points[v as usize]);
-    normalize([b[0] - a[0], b[1] - a[1], b[2] - a[2]])
+    grow(
+        edges,
+        |e| {
+            let [a, b] = e.map(|v| points[v as usize]);
+            normalize([b[0] - a[0], b[1] - a[1], b[2] - a[2]])
+        },
+        max_angle_deg,
+    )
 }
 
 /// Labels points from labelled simplices: each of the `n_points` points

@@ -6,7 +6,7 @@
 //! edge.
 
 use super::super::detection::Primitive;
-use super::super::filter::{components_on, FilterError, Incidence};
+use super::super::filter::{components, FilterError};
 use super::super::regime::Regime;
 use super::super::scan::{Face, LINE_SCAN_MIN};
 use super::moments::Moments;
@@ -30,7 +30,7 @@ pub(super) fn find<S: Shape>(
     regime: &Regime,
 ) -> Result<Vec<Candidate>, FilterError> {
     let angle = settings.part_angle_deg;
-    let comps = group_components(points, kept, group, settings.scales.len(), angle)?;
+    let comps = group_components(kept, group, settings.scales.len())?;
     // Short lines start from the scan's shortest pieces (three points);
     // a part still needs min_vertices points once its claims have joined
     // its pieces.
@@ -41,11 +41,10 @@ pub(super) fn find<S: Shape>(
     };
     // Components are independent: extracted in parallel, in order.
     let per_component = map_each(comps.len(), |k| {
-        let c = &comps[k];
-        let scale = settings.scales[c.group as usize];
-        let local: Vec<S> = c.simplices.iter().map(|&s| kept[s as usize]).collect();
-        let parts = c.parts.as_deref();
-        let extracted = extract(points, &local, parts, scale.tau, seed_min, angle);
+        let (g, ss) = &comps[k];
+        let scale = settings.scales[*g as usize];
+        let local: Vec<S> = ss.iter().map(|&s| kept[s as usize]).collect();
+        let extracted = extract(points, &local, scale.tau, seed_min, angle);
         let footprint = |k: usize| {
             let (seeds, fit) = &extracted[k];
             Footprint::new(fit, points, seeds, scale.cell)
@@ -75,78 +74,31 @@ pub(super) fn find<S: Shape>(
     Ok(per_component.into_iter().flatten().collect())
 }
 
-/// A connected component of one group's simplices.
-struct Component {
-    /// The group.
-    group: u32,
-    /// Its simplices, as indices into the union.
-    simplices: Vec<u32>,
-    /// Its simplices' straight or flat parts ([`Face::parts`]), numbered
-    /// within it; `None` where the group's could not be made (a NaN
-    /// point): [`extract`] then makes the component's own.
-    parts: Option<Vec<u32>>,
-}
-
-/// The connected components of each group's simplices, group by group,
-/// components in the order [`components_on`] numbers them, with their
-/// parts: one incidence of a group's simplices serves both (a part grows
-/// through shared faces, so it never leaves its component, see
-/// [`Face::parts_on`]). Groups on the pool's threads.
+/// The connected components of each group's simplices: (group, indices
+/// into `kept`), group by group, components in the order
+/// [`components`] numbers them. Groups on the pool's threads.
 fn group_components<S: Face>(
-    points: &[[f64; 3]],
     kept: &[S],
     group: &[u32],
     n_groups: usize,
-    angle: f64,
-) -> Result<Vec<Component>, FilterError> {
+) -> Result<Vec<(u32, Vec<u32>)>, FilterError> {
     let mut by_group: Vec<Vec<u32>> = vec![Vec::new(); n_groups];
     for (s, &g) in group.iter().enumerate() {
         by_group[g as usize].push(s as u32);
     }
-    let per_group = map_each(n_groups, |g| -> Result<Vec<Component>, FilterError> {
+    let per_group = map_each(n_groups, |g| -> Result<Vec<(u32, Vec<u32>)>, FilterError> {
         let ss = &by_group[g];
         if ss.is_empty() {
             return Ok(Vec::new());
         }
         let local: Vec<S> = ss.iter().map(|&s| kept[s as usize]).collect();
-        let inc = Incidence::new(&local)?;
-        let comp = components_on(&inc);
-        let part = S::parts_on(points, &local, &inc, angle).ok();
-        drop(inc);
+        let comp = components(&local)?;
         let n_comp = comp.iter().map(|&c| c as usize + 1).max().unwrap_or(0);
-        // Each part's number within its component: the parts in the
-        // order they were made, counted per component.
-        let within = part.as_ref().map(|part| {
-            let n_parts = part.iter().map(|&p| p as usize + 1).max().unwrap_or(0);
-            let mut comp_of = vec![0u32; n_parts];
-            for (&p, &c) in part.iter().zip(&comp) {
-                comp_of[p as usize] = c;
-            }
-            let mut next = vec![0u32; n_comp];
-            comp_of
-                .iter()
-                .map(|&c| {
-                    let id = next[c as usize];
-                    next[c as usize] += 1;
-                    id
-                })
-                .collect::<Vec<u32>>()
-        });
-        let mut out: Vec<Component> = (0..n_comp)
-            .map(|_| Component {
-                group: g as u32,
-                simplices: Vec::new(),
-                parts: within.as_ref().map(|_| Vec::new()),
-            })
-            .collect();
+        let mut parts: Vec<Vec<u32>> = vec![Vec::new(); n_comp];
         for (k, &c) in comp.iter().enumerate() {
-            let o = &mut out[c as usize];
-            o.simplices.push(ss[k]);
-            if let (Some(parts), Some(part), Some(within)) = (&mut o.parts, &part, &within) {
-                parts.push(within[part[k] as usize]);
-            }
+            parts[c as usize].push(ss[k]);
         }
-        Ok(out)
+        Ok(parts.into_iter().map(|p| (g as u32, p)).collect())
     });
     let mut out = Vec::new();
     for g in per_group {
@@ -158,12 +110,10 @@ fn group_components<S: Face>(
 /// Greedy extraction of straight/flat primitives from one connected
 /// component `local` (module doc of `assemble`, step 1): their inlier
 /// vertices (within `tol`) and fits, while the best candidate covers at
-/// least `min_vertices` new vertices. `parts`: the simplices' parts when
-/// the caller has them (made here otherwise).
+/// least `min_vertices` new vertices.
 fn extract<S: Shape>(
     points: &[[f64; 3]],
     local: &[S],
-    parts: Option<&[u32]>,
     tol: f64,
     min_vertices: usize,
     angle: f64,
@@ -180,7 +130,7 @@ fn extract<S: Shape>(
     if verts.len() < min_vertices {
         return Vec::new();
     }
-    let mut cands = piece_fits(points, local, parts, &verts, angle);
+    let mut cands = piece_fits(points, local, &verts, angle);
     let inside = |c: &Primitive, v: u32| c.distance(&points[v as usize]) <= tol;
     let inliers = |fit: &Primitive| -> Vec<u32> { filter_chunks(&verts, |v| inside(fit, v)) };
     // Each candidate's count of uncovered vertices within `tol`, counted
@@ -400,26 +350,17 @@ fn count_each(
 /// The candidate primitives of a component with the vertices `verts`: the
 /// fits of its pieces of like-oriented simplices ([`Face::parts`]) with at
 /// least two simplices' worth of points, the largest [`MAX_PIECES`], and
-/// the fit of the whole component. The pieces are `parts` where given;
-/// made here otherwise, where a failure (which needs a NaN point) leaves
-/// the component in one piece.
+/// the fit of the whole component. (A failure of the pieces, which needs a
+/// NaN point, leaves the component in one piece.)
 fn piece_fits<S: Face>(
     points: &[[f64; 3]],
     local: &[S],
-    parts: Option<&[u32]>,
     verts: &[u32],
     angle: f64,
 ) -> Vec<Primitive> {
-    let own;
-    let part = match parts {
-        Some(p) => p,
-        None => {
-            own = S::parts(points, local, angle).unwrap_or_else(|_| vec![0; local.len()]);
-            &own
-        }
-    };
+    let part = S::parts(points, local, angle).unwrap_or_else(|_| vec![0; local.len()]);
     let n_parts = part.iter().map(|&p| p as usize + 1).max().unwrap_or(0);
-    let pv = part_vertices(points.len(), local, part, n_parts, verts.len());
+    let pv = part_vertices(points.len(), local, &part, n_parts, verts.len());
     let mut by_size: Vec<(usize, usize)> = pv.iter().map(Vec::len).zip(0..).collect();
     by_size.sort_unstable_by(|a, b| b.0.cmp(&a.0).then(a.1.cmp(&b.1)));
     let fitted: Vec<usize> = by_size
@@ -502,7 +443,7 @@ mod tests {
     #[test]
     fn an_l_gives_its_two_legs() {
         let (pts, edges) = l_shape();
-        let legs = extract(&pts, &edges[..20], None, 0.1, 5, 10.0);
+        let legs = extract(&pts, &edges[..20], 0.1, 5, 10.0);
         assert_eq!(legs.len(), 2);
         // Each leg's inliers: its eleven points (the corner in both).
         let mut sizes: Vec<usize> = legs.iter().map(|(s, _)| s.len()).collect();
@@ -510,7 +451,7 @@ mod tests {
         assert_eq!(sizes, [11, 11]);
         assert!(legs.iter().all(|(_, f)| f.rms() < 1e-9));
         // Too few vertices: nothing.
-        assert!(extract(&pts, &edges[..3], None, 0.1, 5, 10.0).is_empty());
+        assert!(extract(&pts, &edges[..3], 0.1, 5, 10.0).is_empty());
     }
 
     #[test]
@@ -590,28 +531,6 @@ mod tests {
     }
 
     #[test]
-    fn a_groups_parts_restricted_to_a_component_are_its_own() {
-        let (pts, tris) = folded_sheets(4, 7);
-        let group = vec![0u32; tris.len()];
-        let comps = group_components(&pts, &tris, &group, 1, 10.0).unwrap();
-        assert_eq!(comps.len(), 4);
-        let mut total_parts = 0;
-        for c in &comps {
-            let local: Vec<[u32; 3]> = c.simplices.iter().map(|&s| tris[s as usize]).collect();
-            let own = <[u32; 3]>::parts(&pts, &local, 10.0).unwrap();
-            assert_eq!(c.parts.as_deref(), Some(&own[..]));
-            total_parts += own.iter().max().map_or(0, |&p| p as usize + 1);
-        }
-        // Each sheet has several parts: the test compares numberings.
-        assert!(total_parts >= 4 * 3, "{total_parts}");
-        // A NaN point: no group parts, and each component makes its own.
-        let mut bad = pts.clone();
-        bad[0] = [f64::NAN; 3];
-        let comps = group_components(&bad, &tris, &group, 1, 10.0).unwrap();
-        assert!(comps.iter().all(|c| c.parts.is_none()));
-    }
-
-    #[test]
     fn part_vertices_are_each_parts_sorted_distinct_vertices() {
         let (pts, tris) = folded_sheets(3, 9);
         let part = <[u32; 3]>::parts(&pts, &tris, 10.0).unwrap();
@@ -680,7 +599,7 @@ mod tests {
     #[test]
     fn a_candidate_found_again_joins_the_first_and_a_parallel_shelf_does_not() {
         let (pts, tris) = noisy_sheet_and_shelf();
-        let cands = extract(&pts, &tris, None, 0.02, 4, 10.0);
+        let cands = extract(&pts, &tris, 0.02, 4, 10.0);
         let on_sheet = |c: &(Vec<u32>, Primitive)| c.0.iter().all(|&v| v < 41 * 11);
         // The sheet's slabs, the later ones mostly the first one's points,
         // are one candidate (two without the rule); the shelf, parallel

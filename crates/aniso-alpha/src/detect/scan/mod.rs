@@ -39,9 +39,9 @@ pub(crate) use path_filter::{filter_job, ChanceScale, ScanFilter, LINE_SCAN_MIN}
 
 use super::detection::Primitive;
 use super::faces::{edges_at, edges_at_levels, triangles_at};
-use super::filter::{FilterError, Incidence, Simplex};
+use super::filter::{FilterError, Simplex};
 use super::fit::{fit_line_indices, fit_plane_indices};
-use super::parts::{linear_parts, linear_parts_on, planar_parts, planar_parts_on, PartsError};
+use super::parts::{linear_parts, planar_parts, PartsError};
 use super::prune::{non_isolated, CandidatePairs};
 use crate::aniso::Anisotropy;
 use crate::delaunay::{DelaunayError, Triangulation};
@@ -66,13 +66,6 @@ pub(crate) trait Face: Simplex + AsRef<[u32]> + Send + Sync + 'static {
     fn sorted(v: impl Iterator<Item = u32>) -> Self;
     /// Straight or flat parts of a set of simplices.
     fn parts(points: &[[f64; 3]], s: &[Self], angle: f64) -> Result<Vec<u32>, PartsError>;
-    /// [`Face::parts`] on the simplices' incidence `inc`, built already.
-    fn parts_on(
-        points: &[[f64; 3]],
-        s: &[Self],
-        inc: &Incidence,
-        angle: f64,
-    ) -> Result<Vec<u32>, PartsError>;
     /// Least-squares line or plane of points.
     fn fit(points: &[[f64; 3]], vertices: &[u32]) -> Primitive;
 }
@@ -92,14 +85,6 @@ impl Face for [u32; 2] {
     }
     fn parts(points: &[[f64; 3]], s: &[Self], angle: f64) -> Result<Vec<u32>, PartsError> {
         linear_parts(points, s, angle)
-    }
-    fn parts_on(
-        points: &[[f64; 3]],
-        s: &[Self],
-        inc: &Incidence,
-        angle: f64,
-    ) -> Result<Vec<u32>, PartsError> {
-        linear_parts_on(points, s, inc, angle)
     }
     fn fit(points: &[[f64; 3]], vertices: &[u32]) -> Primitive {
         fit_line_indices(points, vertices).map_or(Primitive::None, Primitive::Line)
@@ -122,14 +107,6 @@ impl Face for [u32; 3] {
     }
     fn parts(points: &[[f64; 3]], s: &[Self], angle: f64) -> Result<Vec<u32>, PartsError> {
         planar_parts(points, s, angle)
-    }
-    fn parts_on(
-        points: &[[f64; 3]],
-        s: &[Self],
-        inc: &Incidence,
-        angle: f64,
-    ) -> Result<Vec<u32>, PartsError> {
-        planar_parts_on(points, s, inc, angle)
     }
     fn fit(points: &[[f64; 3]], vertices: &[u32]) -> Primitive {
         fit_plane_indices(points, vertices).map_or(Primitive::None, Primitive::Plane)
