@@ -423,7 +423,9 @@ fn detect_points(
     let observe = {
         let stages = stages.clone();
         move |stage: Stage, secs: f64| {
-            crate::memory::release_free();
+            if stage == Stage::Scan {
+                crate::memory::release_free();
+            }
             if let Ok(mut s) = stages.lock() {
                 s.push((stage, secs));
             }

@@ -17,13 +17,16 @@
 //! cache.
 //!
 //! Freed memory inside the heap stays resident until glibc trims it, and
-//! glibc trims only the heap's top: a stage's buffers freed below a live
-//! one (the union under the scan's faces, the candidates' incidences under
-//! their parts) stay in the peak of the next stage. The program hands the
-//! free pages back after the estimate and after each stage of a detection
-//! ([`release_free`], from the stage observer): about ten calls a run, each
-//! a walk over the free chunks, for a peak RSS lower by 4–5 MiB on the
-//! depth frames (BENCHMARKS.md, "Peaks of one stage at a time").
+//! glibc trims only the heap's top: a phase's buffers freed below a live
+//! one (the estimate's neighbourhoods under the cloud, the scan's
+//! triangulations under the union) stay in the peak of what follows. The
+//! program hands the free pages back after the estimate and after the
+//! scan ([`release_free`]), the two that free the most: 14 and 15 MiB of a
+//! depth frame's 29, 7 and 10 of an airborne tile's 21. The assembly's
+//! stages each free a few MiB that the next one reuses: handing those back
+//! too (eight more calls) kept the peaks within a run's spread and cost
+//! 10–15 ms of a depth frame's 0.39 s, the pages faulted in again by the
+//! next stage (BENCHMARKS.md, "Candidates found again").
 //!
 //! Only the command-line program does this: the Python extension lives in
 //! the interpreter's process, whose allocator is not its to tune. A user's
