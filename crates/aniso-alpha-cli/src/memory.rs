@@ -21,11 +21,12 @@
 //! one (the estimate's neighbourhoods under the cloud, the scan's
 //! triangulations under the union) stay in the peak of what follows. The
 //! program hands the free pages back after the estimate and after the
-//! scan ([`release_free`]), the two that free the most: 14 and 15 MiB of a
-//! depth frame's 29, 7 and 10 of an airborne tile's 21. The assembly's
-//! stages each free a few MiB that the next one reuses: handing those back
-//! too (eight more calls) kept the peaks within a run's spread and cost
-//! 10–15 ms of a depth frame's 0.39 s, the pages faulted in again by the
+//! scan ([`release_free`]), the two that free the most: 16 and 14 MiB of a
+//! depth frame's 28 (mOSD learn 17), 6 and 8 of an airborne tile's 18 (the
+//! AHN train tile). What the assembly's stages free, the next one mostly
+//! reuses below the peak of the scan: handing it back too (eight more
+//! calls) kept the peaks within a run's spread and cost
+//! 15–20 ms of a depth frame's 0.39 s, the pages faulted in again by the
 //! next stage (BENCHMARKS.md, "Candidates found again").
 //!
 //! Only the command-line program does this: the Python extension lives in

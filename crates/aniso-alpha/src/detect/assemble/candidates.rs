@@ -49,8 +49,9 @@ pub(super) fn find<S: Shape>(
             let (seeds, fit) = &extracted[k];
             Footprint::new(fit, points, seeds, scale.cell)
         };
-        // A large component's footprints on the pool's threads too (a
-        // depth frame's table gives a dozen candidates of 50k points).
+        // A large component's footprints on the pool's threads too (the
+        // ground of an airborne tile and what it touches: dozens of
+        // candidates of thousands of points).
         let seeds: usize = extracted.iter().map(|e| e.0.len()).sum();
         let feet = if seeds < CHUNKED_VERTICES {
             (0..extracted.len()).map(footprint).collect()
