@@ -89,15 +89,7 @@ pub(crate) fn sort_unstable_by<T: Send>(
 /// `f(item)` for each item, on the pool's threads (items that own
 /// disjoint parts of a buffer).
 pub(crate) fn for_each_mut<T: Send>(items: Vec<T>, f: impl Fn(T) + Sync) {
-    #[cfg(feature = "parallel")]
-    {
-        use rayon::prelude::*;
-        items.into_par_iter().for_each(&f);
-    }
-    #[cfg(not(feature = "parallel"))]
-    {
-        items.into_iter().for_each(f);
-    }
+    map_owned(items, f);
 }
 
 /// The threads of the current pool (1 without the `parallel` feature).

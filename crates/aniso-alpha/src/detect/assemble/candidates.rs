@@ -29,7 +29,6 @@ pub(super) fn find<S: Shape>(
     settings: &Settings,
     regime: &Regime,
 ) -> Result<Vec<Candidate>, FilterError> {
-    let angle = settings.part_angle_deg;
     let comps = group_components(kept, group, settings.scales.len())?;
     // Short lines start from the scan's shortest pieces (three points);
     // a part still needs min_vertices points once its claims have joined
@@ -44,7 +43,7 @@ pub(super) fn find<S: Shape>(
         let (g, ss) = &comps[k];
         let scale = settings.scales[*g as usize];
         let local: Vec<S> = ss.iter().map(|&s| kept[s as usize]).collect();
-        let extracted = extract(points, &local, scale.tau, seed_min, angle);
+        let extracted = extract(points, &local, scale.tau, seed_min, settings.part_angle_deg);
         let footprint = |k: usize| {
             let (seeds, fit) = &extracted[k];
             Footprint::new(fit, points, seeds, scale.cell)
