@@ -59,7 +59,8 @@ pub trait Simplex: Copy + Ord + Send + Sync + sealed::Sealed {
     /// Key of face `i` (0 ≤ i < VERTICES) of a canonical simplex: the
     /// vertex for an edge, `(a << 32) | b` (a < b) for a triangle's edge.
     fn face_key(&self, i: usize) -> u64;
-    /// `face_key >> LEAD_SHIFT` is the face's smallest vertex.
+    /// `face_key >> LEAD_SHIFT` is the face's smallest vertex, and the
+    /// bits below it (at most 32) the rest of the face.
     const LEAD_SHIFT: u32;
 }
 
@@ -178,13 +179,34 @@ fn half_faces_by_key<S: Simplex>(unique: &[S]) -> Vec<u32> {
     }
     drop(next);
     drop(lead);
-    // Each vertex's few half-faces by key: in chunks of whole vertices on
-    // the pool's threads when they are many.
+    // Each vertex's list is in half-face order; its key's lead part is
+    // the vertex. With no other part (edges) the list is sorted by key.
+    if S::LEAD_SHIFT == 0 {
+        return half;
+    }
+    // Each vertex's few half-faces by the rest of their key, then their
+    // index: packed in one u64 each (the rest of the key above, the index
+    // below) and sorted as integers, each key read once rather than at
+    // every comparison. In chunks of whole vertices on the pool's threads
+    // when they are many.
+    let rest = (1u64 << S::LEAD_SHIFT) - 1;
     let sort_vertices = |half: &mut [u32], from: usize, to: usize| {
         let base = start[from] as usize;
+        let mut packed: Vec<u64> = Vec::new();
         for w in start[from..=to].windows(2) {
-            half[w[0] as usize - base..w[1] as usize - base]
-                .sort_unstable_by_key(|&h| (key(h as usize), h));
+            let list = &mut half[w[0] as usize - base..w[1] as usize - base];
+            if list.len() < 2 {
+                continue;
+            }
+            packed.clear();
+            packed.extend(
+                list.iter()
+                    .map(|&h| ((key(h as usize) & rest) << 32) | u64::from(h)),
+            );
+            packed.sort_unstable();
+            for (h, p) in list.iter_mut().zip(&packed) {
+                *h = *p as u32;
+            }
         }
     };
     sort_by_vertex_chunks(&mut half, &start, top + 1, &sort_vertices);
