@@ -34,7 +34,7 @@
 //! ```
 
 use super::StructureKind;
-use crate::geometry::kdtree::KdTree;
+use crate::geometry::kdtree::{KdTree, LeafBatch};
 use crate::geometry::{cross, dot, sub};
 
 /// Neighbours per neighbourhood: the usual choice for PCA normals (CGAL's
@@ -245,10 +245,40 @@ fn to_f32(v: [f64; 3]) -> [f32; 3] {
     v.map(|x| x as f32)
 }
 
-/// Runs `f` over `0..n` (in parallel with the `parallel` feature), with a
-/// neighbour buffer per worker's range, and collects in order.
-fn map_points<T: Send>(n: usize, f: impl Fn(&mut Vec<(f64, u32)>, usize) -> T + Sync) -> Vec<T> {
-    crate::par::map_ranges(n, Vec::new, f)
+/// `f(batch, neighbours, t)` for each position `t` of `from`'s
+/// [`KdTree::order`], in parallel with the `parallel` feature: `batch` is
+/// a [`LeafBatch`] of `to`'s points nearest to `from`'s, made by `batch`,
+/// and `neighbours` a buffer, one of each per worker's range of
+/// positions. Collected in tree order.
+fn in_tree_order<T: Send, B>(
+    from: &KdTree,
+    batch: impl Fn() -> B + Sync,
+    f: impl Fn(&mut B, &mut Vec<(f64, u32)>, usize) -> T + Sync,
+) -> Vec<T> {
+    crate::par::map_ranges(
+        from.len(),
+        || (batch(), Vec::new()),
+        |(b, nb), t| f(b, nb, t),
+    )
+}
+
+/// [`in_tree_order`] for the queries of `from`'s points in `to`, put back
+/// in the order of `ids` (`from`'s points, ascending): each query then
+/// starts in the cache where the last one ended.
+fn in_input_order<T: Send + Copy>(
+    from: &KdTree,
+    to: &KdTree,
+    ids: &[u32],
+    f: impl Fn(&mut LeafBatch, &mut Vec<(f64, u32)>, usize) -> T + Sync,
+) -> Vec<T> {
+    let found = in_tree_order(from, || to.batch(from), f);
+    let mut out = found.clone();
+    for (&i, x) in from.order().iter().zip(found) {
+        if let Ok(at) = ids.binary_search(&i) {
+            out[at] = x;
+        }
+    }
+    out
 }
 
 /// The shape of the neighbourhood `nb` (at least 3 points).
@@ -282,6 +312,32 @@ fn row_gap(points: &[[f64; 3]], q: &[f64; 3], nb: &[(f64, u32)]) -> f32 {
     .sqrt() as f32
 }
 
+/// The shape of the neighbourhood `nb` of `q` at scale 0, with its
+/// spacing and row gap.
+fn finest_shape(points: &[[f64; 3]], q: &[f64; 3], nb: &[(f64, u32)]) -> LocalShape {
+    let spacing = nb
+        .iter()
+        .map(|&(d, _)| d)
+        .find(|&d| d > 0.0)
+        .map_or(f32::INFINITY, |d| d.sqrt() as f32);
+    let gap = row_gap(points, q, nb);
+    if nb.len() >= 3 {
+        LocalShape {
+            row_gap: gap,
+            ..shape_of(points, nb, 0, spacing)
+        }
+    } else {
+        LocalShape {
+            normal: [0.0, 0.0, 1.0],
+            direction: [1.0, 0.0, 0.0],
+            sigma: [0.0; 3],
+            scale: 0,
+            spacing,
+            row_gap: gap,
+        }
+    }
+}
+
 /// The local shape of every point (see the module doc). Deterministic;
 /// runs on the current rayon pool with the `parallel` feature.
 ///
@@ -310,51 +366,42 @@ pub fn local_shapes(points: &[[f64; 3]], kind: StructureKind) -> Vec<LocalShape>
     let mut up: Vec<Vec<u32>> = vec![Vec::new(), Vec::new()];
     for j in 1..scales {
         let ids = &samples[j];
-        coarse.push(map_points(ids.len(), |nb, t| {
-            trees[j].nearest(&points[ids[t] as usize], NEIGHBOURS, nb);
+        let tree = &trees[j];
+        coarse.push(in_input_order(tree, tree, ids, |batch, nb, t| {
+            batch.nearest(t, NEIGHBOURS, nb);
             shape_of(points, nb, j, f32::INFINITY)
         }));
         if j >= 2 {
             let below = &samples[j - 1];
-            up.push(map_points(below.len(), |nb, t| {
-                trees[j].nearest(&points[below[t] as usize], 1, nb);
-                ids.binary_search(&nb[0].1).unwrap_or(0) as u32
-            }));
+            up.push(in_input_order(
+                &trees[j - 1],
+                tree,
+                below,
+                |batch, nb, t| {
+                    batch.nearest(t, 1, nb);
+                    ids.binary_search(&nb[0].1).unwrap_or(0) as u32
+                },
+            ));
         }
     }
     // The points in tree order (each query then starts where the last one
-    // ended, in the cache), the results put back in input order.
+    // ended, in the cache), the results put back in input order; with each,
+    // its nearest point of subsample 1 when it needs the coarser scales.
+    let batches = || {
+        (
+            trees[0].batch(&trees[0]),
+            trees.get(1).map(|t| t.batch(&trees[0])),
+        )
+    };
     let order = trees[0].order();
-    let in_tree_order = map_points(order.len(), |nb, t| {
-        let i = order[t] as usize;
-        let q = &points[i];
-        trees[0].nearest(q, NEIGHBOURS, nb);
-        let spacing = nb
-            .iter()
-            .map(|&(d, _)| d)
-            .find(|&d| d > 0.0)
-            .map_or(f32::INFINITY, |d| d.sqrt() as f32);
-        let gap = row_gap(points, q, nb);
-        let mut best = if nb.len() >= 3 {
-            LocalShape {
-                row_gap: gap,
-                ..shape_of(points, nb, 0, spacing)
-            }
-        } else {
-            LocalShape {
-                normal: [0.0, 0.0, 1.0],
-                direction: [1.0, 0.0, 0.0],
-                sigma: [0.0; 3],
-                scale: 0,
-                spacing,
-                row_gap: gap,
-            }
-        };
+    let in_tree_order = in_tree_order(&trees[0], batches, |(own, coarser), nb, t| {
+        own.nearest(t, NEIGHBOURS, nb);
+        let mut best = finest_shape(points, &points[order[t] as usize], nb);
         let mut score = best.score(kind);
-        if score >= GOOD || scales < 2 {
+        let Some(coarser) = coarser.as_mut().filter(|_| score < GOOD) else {
             return best;
-        }
-        trees[1].nearest(q, 1, nb);
+        };
+        coarser.nearest(t, 1, nb);
         let mut t = samples[1].binary_search(&nb[0].1).unwrap_or(0);
         for j in 1..scales {
             if j >= 2 {
@@ -365,8 +412,8 @@ pub fn local_shapes(points: &[[f64; 3]], kind: StructureKind) -> Vec<LocalShape>
             if s > score {
                 score = s;
                 best = LocalShape {
-                    spacing,
-                    row_gap: gap,
+                    spacing: best.spacing,
+                    row_gap: best.row_gap,
                     ..c
                 };
             }
