@@ -272,9 +272,19 @@ fn in_input_order<T: Send + Copy>(
     f: impl Fn(&mut LeafBatch, &mut Vec<(f64, u32)>, usize) -> T + Sync,
 ) -> Vec<T> {
     let found = in_tree_order(from, || to.batch(from), f);
-    let mut out = found.clone();
-    for (&i, x) in from.order().iter().zip(found) {
-        if let Ok(at) = ids.binary_search(&i) {
+    put_back(found, from.order(), |i| ids.binary_search(&i).ok())
+}
+
+/// `found[t]`, the result for the point `order[t]`, moved to the slot
+/// `slot(order[t])` (none: dropped). `order` is a permutation of the slots,
+/// so every slot is written once.
+fn put_back<T: Copy>(found: Vec<T>, order: &[u32], slot: impl Fn(u32) -> Option<usize>) -> Vec<T> {
+    let Some(&fill) = found.first() else {
+        return found;
+    };
+    let mut out = vec![fill; found.len()];
+    for (&i, x) in order.iter().zip(found) {
+        if let Some(at) = slot(i) {
             out[at] = x;
         }
     }
@@ -423,11 +433,7 @@ pub fn local_shapes(points: &[[f64; 3]], kind: StructureKind) -> Vec<LocalShape>
         }
         best
     });
-    let mut shapes = in_tree_order.clone();
-    for (t, &i) in order.iter().enumerate() {
-        shapes[i as usize] = in_tree_order[t];
-    }
-    shapes
+    put_back(in_tree_order, order, |i| Some(i as usize))
 }
 
 #[cfg(test)]

@@ -139,6 +139,13 @@ impl Best {
         }
     }
 
+    /// The points held, nearest first, as (squared distance, point index).
+    fn found(&self) -> impl Iterator<Item = (f64, u32)> + '_ {
+        self.items[..self.len]
+            .iter()
+            .map(|&(d, key)| (d, index_of(key)))
+    }
+
     /// The squared distance above which no point can enter.
     #[inline(always)]
     fn bound(&self) -> f64 {
@@ -328,11 +335,7 @@ impl KdTree {
         }
         let mut best = Best::new(k, f64::INFINITY);
         self.descend(q, &mut best);
-        out.extend(
-            best.items[..best.len]
-                .iter()
-                .map(|&(d, key)| (d, index_of(key))),
-        );
+        out.extend(best.found());
     }
 
     /// The branch-and-bound descent of [`Self::nearest`] into `best`.
@@ -754,11 +757,7 @@ impl LeafBatch<'_> {
                 let (cs, ce) = to.range[c];
                 to.scan_leaf(q, cs as usize, ce as usize, &mut best);
             }
-            self.found.extend(
-                best.items[..best.len]
-                    .iter()
-                    .map(|&(d, key)| (d, index_of(key))),
-            );
+            self.found.extend(best.found());
         }
     }
 }
