@@ -86,6 +86,22 @@ pub(crate) fn sort_unstable_by<T: Send>(
     v.sort_unstable_by(cmp);
 }
 
+/// `a()` and `b()`, on two of the pool's threads when they are free (one
+/// after the other without the `parallel` feature).
+pub(crate) fn join<A: Send, B: Send>(
+    a: impl FnOnce() -> A + Send,
+    b: impl FnOnce() -> B + Send,
+) -> (A, B) {
+    #[cfg(feature = "parallel")]
+    {
+        rayon::join(a, b)
+    }
+    #[cfg(not(feature = "parallel"))]
+    {
+        (a(), b())
+    }
+}
+
 /// `f(item)` for each item, on the pool's threads (items that own
 /// disjoint parts of a buffer).
 pub(crate) fn for_each_mut<T: Send>(items: Vec<T>, f: impl Fn(T) + Sync) {

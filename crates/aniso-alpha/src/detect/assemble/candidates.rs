@@ -119,25 +119,31 @@ fn extract<S: Shape>(
     angle: f64,
 ) -> Vec<(Vec<u32>, Primitive)> {
     let mut out: Vec<Extracted> = Vec::new();
-    let mut verts: Vec<u32> = local
-        .iter()
-        .flat_map(|s| s.as_ref().iter().copied())
-        .collect();
-    crate::par::sort_unstable(&mut verts);
-    verts.dedup();
-    // Held through the extraction: a vertex is in about six triangles.
-    verts.shrink_to_fit();
+    let parts = || S::parts(points, local, angle).unwrap_or_else(|_| vec![0; local.len()]);
+    // A large component's vertices are listed while its simplices are
+    // split into pieces (the pieces' growth runs on one thread); a small
+    // one's first, which may leave nothing to split.
+    let (verts, part) = if local.len() >= CHUNKED_VERTICES {
+        crate::par::join(|| vertices_of(points.len(), local), parts)
+    } else {
+        let verts = vertices_of(points.len(), local);
+        if verts.len() < min_vertices {
+            return Vec::new();
+        }
+        (verts, parts())
+    };
     if verts.len() < min_vertices {
         return Vec::new();
     }
-    let mut cands = piece_fits(points, local, &verts, angle);
+    let mut cands = piece_fits(points, local, &part, &verts);
+    drop(part);
     let inside = |c: &Primitive, v: u32| c.distance(&points[v as usize]) <= tol;
     let inliers = |fit: &Primitive| -> Vec<u32> { filter_chunks(&verts, |v| inside(fit, v)) };
     // Each candidate's count of uncovered vertices within `tol`, counted
     // once and then lowered by the vertices each extraction covers: the
     // counts a recount over the uncovered vertices would give, at the
     // cost of one pass over the vertices per candidate in all.
-    let mut new_count: Vec<usize> = count_each(&cands, &verts, &inside);
+    let mut new_count: Vec<usize> = count_each(&cands, &vec![true; cands.len()], &verts, &inside);
     let mut covered = vec![false; verts.len()];
     loop {
         // The first candidate with the most new inliers.
@@ -170,9 +176,12 @@ fn extract<S: Shape>(
                 gained.push(v);
             }
         }
+        // A candidate below `min_vertices` can no longer be taken (counts
+        // only fall, and one above it always outranks it): not recounted.
+        let live: Vec<bool> = new_count.iter().map(|&c| c >= min_vertices).collect();
         for (count, lost) in new_count
             .iter_mut()
-            .zip(count_each(&cands, &gained, &inside))
+            .zip(count_each(&cands, &live, &gained, &inside))
         {
             *count -= lost;
         }
@@ -332,35 +341,73 @@ fn filter_chunks(verts: &[u32], keep: impl Fn(u32) -> bool + Sync) -> Vec<u32> {
     .concat()
 }
 
-/// For each candidate, how many of `verts` lie within its tolerance
-/// (`inside`); the candidates on the pool's threads when there are
-/// [`CHUNKED_VERTICES`] vertices or more.
+/// For each candidate counted (`counted`), how many of `verts` lie within
+/// its tolerance (`inside`), 0 for the others; the candidates on the
+/// pool's threads when there are [`CHUNKED_VERTICES`] vertices or more.
 fn count_each(
     cands: &[Primitive],
+    counted: &[bool],
     verts: &[u32],
     inside: &(impl Fn(&Primitive, u32) -> bool + Sync),
 ) -> Vec<usize> {
-    let count = |c: &Primitive| verts.iter().filter(|&&v| inside(c, v)).count();
+    let count = |ci: usize| match counted[ci] {
+        true => verts.iter().filter(|&&v| inside(&cands[ci], v)).count(),
+        false => 0,
+    };
     if verts.len() < CHUNKED_VERTICES {
-        return cands.iter().map(count).collect();
+        return (0..cands.len()).map(count).collect();
     }
-    map_each(cands.len(), |ci| count(&cands[ci]))
+    map_each(cands.len(), count)
 }
 
-/// The candidate primitives of a component with the vertices `verts`: the
-/// fits of its pieces of like-oriented simplices ([`Face::parts`]) with at
-/// least two simplices' worth of points, the largest [`MAX_PIECES`], and
-/// the fit of the whole component. (A failure of the pieces, which needs a
-/// NaN point, leaves the component in one piece.)
+/// The distinct vertices of the simplices `local` (of a cloud of
+/// `n_points`), ascending: marked in a bitset of the cloud's points where
+/// the simplices list more vertices than the set has words, sorted
+/// otherwise.
+fn vertices_of<S: AsRef<[u32]>>(n_points: usize, local: &[S]) -> Vec<u32> {
+    let listed: usize = local.iter().map(|s| s.as_ref().len()).sum();
+    let words = n_points.div_ceil(64);
+    let mut verts: Vec<u32>;
+    if listed >= words {
+        let mut bits = vec![0u64; words];
+        for &v in local.iter().flat_map(|s| s.as_ref()) {
+            bits[v as usize / 64] |= 1 << (v % 64);
+        }
+        verts = Vec::with_capacity(bits.iter().map(|w| w.count_ones() as usize).sum());
+        for (k, &w) in bits.iter().enumerate() {
+            let mut w = w;
+            while w != 0 {
+                verts.push((k * 64) as u32 + w.trailing_zeros());
+                w &= w - 1;
+            }
+        }
+    } else {
+        verts = local
+            .iter()
+            .flat_map(|s| s.as_ref().iter().copied())
+            .collect();
+        crate::par::sort_unstable(&mut verts);
+        verts.dedup();
+        // Held through the extraction: a vertex is in about six triangles.
+        verts.shrink_to_fit();
+    }
+    verts
+}
+
+/// The candidate primitives of a component with the simplices `local`,
+/// split into the pieces `part` of like-oriented simplices
+/// ([`Face::parts`]; all in one where that failed, which needs a NaN
+/// point), and the vertices `verts`: the fits of the pieces with at least
+/// two simplices' worth of points, the largest [`MAX_PIECES`], and the fit
+/// of the whole component.
 fn piece_fits<S: Face>(
     points: &[[f64; 3]],
     local: &[S],
+    part: &[u32],
     verts: &[u32],
-    angle: f64,
 ) -> Vec<Primitive> {
-    let part = S::parts(points, local, angle).unwrap_or_else(|_| vec![0; local.len()]);
     let n_parts = part.iter().map(|&p| p as usize + 1).max().unwrap_or(0);
-    let pv = part_vertices(points.len(), local, &part, n_parts, verts.len());
+    let pv = part_vertices(points.len(), local, part, n_parts, verts.len());
     let mut by_size: Vec<(usize, usize)> = pv.iter().map(Vec::len).zip(0..).collect();
     by_size.sort_unstable_by(|a, b| b.0.cmp(&a.0).then(a.1.cmp(&b.1)));
     let fitted: Vec<usize> = by_size
@@ -528,6 +575,40 @@ mod tests {
         }
         tris.sort_unstable();
         (pts, tris)
+    }
+
+    /// A component's vertices, sorted and distinct, by the bitset (many
+    /// simplices in a small cloud) and by the sort (few in a large one),
+    /// against a set; the oracle tells a repeat kept apart.
+    #[test]
+    fn vertices_of_are_the_sorted_distinct_vertices() {
+        let mut rng = crate::rng::SplitMix64::new(5);
+        for (n_points, n_simplices) in [(1000, 400), (100_000, 50), (130, 0), (64, 64)] {
+            let mut local: Vec<[u32; 3]> = (0..n_simplices)
+                .map(|_| [0, 1, 2].map(|_| (rng.uniform() * n_points as f64) as u32))
+                .collect();
+            // A simplex listed twice, as components' neighbours share
+            // vertices.
+            if let Some(&first) = local.first() {
+                local.push(first);
+            }
+            let want: Vec<u32> = local
+                .iter()
+                .flatten()
+                .copied()
+                .collect::<std::collections::BTreeSet<u32>>()
+                .into_iter()
+                .collect();
+            assert_eq!(
+                vertices_of(n_points, &local),
+                want,
+                "{n_points} {n_simplices}"
+            );
+            let listed: Vec<u32> = local.iter().flatten().copied().collect();
+            if n_simplices > 0 {
+                assert_ne!(listed.len(), want.len(), "the oracle must see repeats");
+            }
+        }
     }
 
     #[test]

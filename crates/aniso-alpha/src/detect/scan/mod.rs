@@ -305,13 +305,48 @@ impl TileGrid {
         [0, 1, 2].map(|k| floor_i64((p[k] - self.origin[k]) / self.side))
     }
 
-    /// The lower and upper corners of cube `t`.
-    fn bounds(&self, t: [i64; 3]) -> ([f64; 3], [f64; 3]) {
-        let corner = |c: i64, k: usize| self.origin[k] + c as f64 * self.side;
-        (
-            [0, 1, 2].map(|k| corner(t[k], k)),
-            [0, 1, 2].map(|k| corner(t[k] + 1, k)),
-        )
+    /// The lower corner of cube `c` along axis `k` (the upper one is that
+    /// of `c + 1`).
+    fn corner(&self, c: i64, k: usize) -> f64 {
+        self.origin[k] + c as f64 * self.side
+    }
+
+    /// For each cube of `tiles` (sorted, distinct), the ranks in `ids` of
+    /// the points in it grown by `h` on every side, ascending. Each point
+    /// is tested against the cubes next to the cells of its coordinates
+    /// ± h, axis by axis: a pass over the points and a sort-free bucketing,
+    /// where a spatial index queried per tile cost more than the tiles'
+    /// own bookkeeping.
+    fn members(
+        &self,
+        points: &[[f64; 3]],
+        ids: &[u32],
+        tiles: &[[i64; 3]],
+        h: f64,
+    ) -> Vec<Vec<u32>> {
+        let mut members: Vec<Vec<u32>> = vec![Vec::new(); tiles.len()];
+        let mut near: [Vec<i64>; 3] = Default::default();
+        for (rank, &i) in ids.iter().enumerate() {
+            let p = &points[i as usize];
+            for (k, cells) in near.iter_mut().enumerate() {
+                cells.clear();
+                let first = floor_i64((p[k] - h - self.origin[k]) / self.side) - 1;
+                let last = floor_i64((p[k] + h - self.origin[k]) / self.side) + 1;
+                cells.extend((first..=last).filter(|&c| {
+                    p[k] >= self.corner(c, k) - h && p[k] <= self.corner(c + 1, k) + h
+                }));
+            }
+            for &x in &near[0] {
+                for &y in &near[1] {
+                    for &z in &near[2] {
+                        if let Ok(t) = tiles.binary_search(&[x, y, z]) {
+                            members[t].push(rank as u32);
+                        }
+                    }
+                }
+            }
+        }
+        members
     }
 }
 
@@ -371,11 +406,12 @@ fn raw_faces_at<S: Face>(
     keyed.sort_unstable();
     let mut tiles: Vec<[i64; 3]> = keyed.iter().map(|k| k.0).collect();
     tiles.dedup();
-    let index = crate::geometry::kdtree::KdTree::new(points, Some(ids.to_vec()));
+    let members = grid.members(points, ids, &tiles, h);
     let mut faces: Vec<Vec<S>> = vec![Vec::new(); alphas.len()];
     let mut triangulated = 0usize;
-    for t in tiles {
-        let sub = tile_points(points, &index, grid.bounds(t), h);
+    for (t, ranks) in tiles.into_iter().zip(members) {
+        let mut sub: Vec<u32> = ranks.iter().map(|&r| ids[r as usize]).collect();
+        sub.sort_unstable();
         let (map, q) = pruned(points, &sub, a, radius, &Pruning::Grid);
         triangulated += map.len();
         let owned = |v: u32| cell(&points[v as usize]) == t;
@@ -408,7 +444,7 @@ fn raw_faces_at<S: Face>(
 /// learn 17, the room, the halls, CGAL's building and the house within
 /// a run's spread (±1.5 MB), and the same wall times (the house 3.75–3.82
 /// s on two threads, 5.98–6.20 s on one, either size). On one thread a
-/// tile's own costs (its halo, its points from the kd-tree, its first
+/// tile's own costs (its halo, the gathering of its points, its first
 /// tetrahedron) cost the house's scan 18% at 2^14 against one
 /// triangulation.
 #[cfg(not(test))]
@@ -460,16 +496,12 @@ fn faces_in_tiles<S: Face>(
     let mut tiles: Vec<[i64; 3]> = map.iter().map(|&i| cell(&points[i as usize])).collect();
     tiles.sort_unstable();
     tiles.dedup();
-    let index = crate::geometry::kdtree::KdTree::new(points, Some(map.to_vec()));
+    let members = grid.members(points, map, &tiles, h);
     // Each tile a task: tiles hold from a few points to a full tile's.
     let per_tile = crate::par::map_each(tiles.len(), |k| {
         let t = tiles[k];
-        let sub = tile_points(points, &index, grid.bounds(t), h);
-        // `map` is ascending: a kept point's transform is at its rank.
-        let sub_q: Vec<[f64; 3]> = sub
-            .iter()
-            .map(|i| q[map.binary_search(i).expect("a kept point")])
-            .collect();
+        let sub: Vec<u32> = members[k].iter().map(|&r| map[r as usize]).collect();
+        let sub_q: Vec<[f64; 3]> = members[k].iter().map(|&r| q[r as usize]).collect();
         let owned = |v: u32| cell(&points[v as usize]) == t;
         faces_at::<S>(sub_q, &sub, alphas, &owned)
     });
@@ -480,32 +512,10 @@ fn faces_in_tiles<S: Face>(
         }
     }
     for f in &mut faces {
-        f.sort_unstable();
+        crate::par::sort_unstable(f);
         f.dedup();
     }
     Ok(faces)
-}
-
-/// The points of `index` in the cube `(lo, hi)` grown by `h`, ascending:
-/// the kd-tree gives those within the circumscribed sphere, and those in
-/// the grown box are kept.
-fn tile_points(
-    points: &[[f64; 3]],
-    index: &crate::geometry::kdtree::KdTree,
-    (lo, hi): ([f64; 3], [f64; 3]),
-    h: f64,
-) -> Vec<u32> {
-    let centre = [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]));
-    let r = (3.0f64).sqrt() * (0.5 * (hi[0] - lo[0]) + h);
-    let mut sub: Vec<u32> = Vec::new();
-    index.within(&centre, r, |i| {
-        let p = &points[i as usize];
-        if (0..3).all(|k| p[k] >= lo[k] - h && p[k] <= hi[k] + h) {
-            sub.push(i);
-        }
-    });
-    sub.sort_unstable();
-    sub
 }
 
 /// One job: raw faces, then the path filter.
@@ -558,7 +568,9 @@ pub(crate) fn union<S: Face>(per_job: Vec<(u32, Vec<S>)>) -> (Vec<S>, Vec<u32>) 
         .into_iter()
         .flat_map(|(g, faces)| faces.into_iter().map(move |f| (f, g)))
         .collect();
-    crate::par::sort_unstable(&mut all);
+    // Each job's simplices come sorted: a stable sort finds those runs and
+    // merges them, in time linear in the simplices for a few jobs.
+    all.sort();
     all.dedup_by(|b, a| a.0 == b.0);
     all.into_iter().unzip()
 }
@@ -614,6 +626,49 @@ mod tests {
         assert!(pts
             .iter()
             .any(|p| from_origin.cell(p)[2] != grid.cell(p)[2]));
+    }
+
+    /// Each tile's members are the points in its cube grown by h, tested
+    /// against every point (the oracle), with halos narrower and wider
+    /// than the cubes (a user's `--tile` may be smaller than the halo),
+    /// tiles that are missing from the list included; the oracle tells a
+    /// halo dropped on one side apart.
+    #[test]
+    fn tile_members_are_the_points_of_each_grown_cube() {
+        let pts = ground();
+        let ids: Vec<u32> = (0..pts.len() as u32).filter(|i| i % 3 != 0).collect();
+        let brute = |grid: &TileGrid, t: [i64; 3], h: f64, shrink: f64| -> Vec<u32> {
+            (0..ids.len() as u32)
+                .filter(|&r| {
+                    let p = &pts[ids[r as usize] as usize];
+                    (0..3).all(|k| {
+                        p[k] >= grid.corner(t[k], k) - h + shrink
+                            && p[k] <= grid.corner(t[k] + 1, k) + h
+                    })
+                })
+                .collect()
+        };
+        for (side, h) in [(7.0, 0.5), (7.0, 3.0), (2.0, 5.0)] {
+            let grid = TileGrid {
+                side,
+                origin: [-0.3, 0.2, -0.1],
+            };
+            let mut tiles: Vec<[i64; 3]> =
+                ids.iter().map(|&i| grid.cell(&pts[i as usize])).collect();
+            tiles.sort_unstable();
+            tiles.dedup();
+            // Every other tile, so that points fall in the halos of tiles
+            // that are not listed.
+            let tiles: Vec<[i64; 3]> = tiles.into_iter().step_by(2).collect();
+            let members = grid.members(&pts, &ids, &tiles, h);
+            assert_eq!(members.len(), tiles.len());
+            let mut differs = false;
+            for (t, m) in tiles.iter().zip(&members) {
+                assert_eq!(m, &brute(&grid, *t, h, 0.0), "side {side} h {h} tile {t:?}");
+                differs |= m != &brute(&grid, *t, h, h);
+            }
+            assert!(differs, "the oracle cannot tell a halo dropped apart");
+        }
     }
 
     /// The faces of `job` at `alphas`: one triangulation of every kept
