@@ -937,12 +937,14 @@ fn mode_members(
             member_of
         },
     );
+    // Each list allocated at its length: they are held through the scan.
     (0..found.len())
         .map(|k| {
-            per_chunk
-                .iter()
-                .flat_map(|m| m[k].iter().copied())
-                .collect()
+            let mut members = Vec::with_capacity(per_chunk.iter().map(|m| m[k].len()).sum());
+            for m in &per_chunk {
+                members.extend_from_slice(&m[k]);
+            }
+            members
         })
         .collect()
 }

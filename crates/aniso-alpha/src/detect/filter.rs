@@ -260,16 +260,20 @@ impl Incidence {
         if simplices.len() >= (u32::MAX / 3) as usize {
             return Err(FilterError::TooManySimplices(simplices.len()));
         }
-        let mut canon = Vec::with_capacity(simplices.len());
-        for (index, &s) in simplices.iter().enumerate() {
-            canon.push(s.canonical().ok_or(FilterError::RepeatedVertex { index })?);
-        }
         // Merge repeated simplices. The lists the detection passes (the
-        // union and its subsets) are sorted and distinct already: they
-        // are their own unique simplices, without a sort or maps.
-        let (unique, maps) = if canon.windows(2).all(|w| w[0] < w[1]) {
-            (canon, None)
+        // union and its subsets) are canonical, sorted and distinct
+        // already: they are their own unique simplices, without a copy, a
+        // sort or maps.
+        let own: Vec<S>;
+        let (unique, maps): (&[S], _) = if simplices.windows(2).all(|w| w[0] < w[1])
+            && simplices.iter().all(|&s| s.canonical() == Some(s))
+        {
+            (simplices, None)
         } else {
+            let mut canon = Vec::with_capacity(simplices.len());
+            for (index, &s) in simplices.iter().enumerate() {
+                canon.push(s.canonical().ok_or(FilterError::RepeatedVertex { index })?);
+            }
             let mut order: Vec<u32> = (0..canon.len() as u32).collect();
             order.sort_unstable_by(|&a, &b| {
                 canon[a as usize].cmp(&canon[b as usize]).then(a.cmp(&b))
@@ -287,14 +291,14 @@ impl Incidence {
             }
             drop(order);
             unique_to_input.shrink_to_fit();
-            let unique: Vec<S> = unique_to_input.iter().map(|&i| canon[i as usize]).collect();
+            own = unique_to_input.iter().map(|&i| canon[i as usize]).collect();
             drop(canon);
-            (unique, Some((input_to_unique, unique_to_input)))
+            (&own, Some((input_to_unique, unique_to_input)))
         };
         let k = S::VERTICES;
         let n = unique.len();
         let key = |h: u32| unique[h as usize / k].face_key(h as usize % k);
-        let mut half = half_faces_by_key(&unique);
+        let mut half = half_faces_by_key(unique);
         let mut simplex_faces = vec![0u32; n * k];
         let mut fill = vec![0u8; n];
         let mut face_start: Vec<u32> = Vec::with_capacity(half.len() / 2 + 2);
