@@ -410,7 +410,7 @@ impl Plan {
         }
         let (_, scales) = self.detector.scan_jobs(self.detector.modes())?;
         self.detector
-            .finish_k(&mut cloud, &self.regime, found, scales, stats, &sf)
+            .finish_k(&mut cloud, &self.regime, found, scales, stats)
     }
 }
 
