@@ -453,9 +453,25 @@ const TILE_POINTS: usize = 1 << 13;
 #[cfg(test)]
 const TILE_POINTS: usize = 1 << 8;
 
+/// The fewest points per tile when a job is cut finer than
+/// [`TILE_POINTS`] to give the pool's threads four tiles each: 2^11. A
+/// job of a few tiles' worth (the flat mode of an airborne block, 35,000
+/// points in four tiles of 9,000) otherwise leaves threads waiting on its
+/// last tiles. Measured at 2^12 for every job (train, 2 threads, medians
+/// of 7): the simulated airborne block's scan 70 → 59 ms, the AHN tile's
+/// 69 → 61 ms, but mOSD learn 8's 137 → 143 ms (20 tiles already: the
+/// smaller tiles' halos cost more than they balance); hence finer only
+/// where the tiles are fewer than the threads can share.
+#[cfg(not(test))]
+const MIN_TILE_POINTS: usize = 1 << 11;
+/// A few dozen points in the tests.
+#[cfg(test)]
+const MIN_TILE_POINTS: usize = 1 << 6;
+
 /// The cubes in which a large job's kept points `map` are cut, so that no
 /// triangulation holds much more than [`TILE_POINTS`] points and the tiles
-/// run on the pool's threads at once, or `None` for one triangulation:
+/// run on the pool's threads at once (at least four a thread where that
+/// leaves [`MIN_TILE_POINTS`] a tile), or `None` for one triangulation:
 /// fewer than two tiles' worth of points, or a halo (2α·λ_max) that leaves
 /// tiles less than eight halos wide. The cubes start at the lower corner
 /// of the points' box, so that a surface along a face of the box (a scan's
@@ -469,14 +485,19 @@ fn tile_grid(points: &[[f64; 3]], map: &[u32], job: &Job<'_>) -> Option<TileGrid
         return None;
     }
     let tiles = map.len() / TILE_POINTS;
+    let shared = (4 * crate::par::threads()).min(map.len() / MIN_TILE_POINTS);
     let (lo, hi) = crate::geometry::bounding_box_of(points, map);
     let mut ext = [0, 1, 2].map(|k| hi[k] - lo[k]);
     ext.sort_unstable_by(f64::total_cmp);
     // Cubes over the two largest extents: a surface's points (a scan's
     // ground, a facade, a table) spread over two of them.
-    let side = (ext[1] * ext[2] / tiles as f64).sqrt();
     let h = halo_width(job);
-    (side.is_finite() && side >= 8.0 * h && ext[2] > side).then_some(TileGrid { side, origin: lo })
+    let grid = |tiles: usize| {
+        let side = (ext[1] * ext[2] / tiles as f64).sqrt();
+        (side.is_finite() && side >= 8.0 * h && ext[2] > side)
+            .then_some(TileGrid { side, origin: lo })
+    };
+    grid(tiles.max(shared)).or_else(|| grid(tiles))
 }
 
 /// `F_{k,α,Q}` at each α of `alphas` of the kept points `map` (transforms
