@@ -254,7 +254,7 @@ pub(crate) fn moments(n: usize, get: impl Fn(usize) -> [f64; 3]) -> ([f64; 3], M
     (c, end_moments(m, n))
 }
 
-fn check(n: usize, needed: usize, get: &dyn Fn(usize) -> [f64; 3]) -> Result<(), FitError> {
+fn check(n: usize, needed: usize, get: &impl Fn(usize) -> [f64; 3]) -> Result<(), FitError> {
     if n < needed {
         return Err(FitError::TooFewPoints { needed, got: n });
     }
@@ -372,7 +372,15 @@ fn fitted(c: [f64; 3], frame: Frame, spread: &Spread, n: usize) -> Fitted {
     }
 }
 
-fn fit_impl(n: usize, line: bool, get: &dyn Fn(usize) -> [f64; 3]) -> Result<Fitted, FitError> {
+/// The fit of the `n` points `get(0..n)`: generic over `get`, so that the
+/// passes over the points inline it (through a `dyn` call per point they
+/// took twice as long: the assembly fits tens of thousands of points per
+/// candidate, twice over).
+fn fit_impl(
+    n: usize,
+    line: bool,
+    get: &impl Fn(usize) -> [f64; 3],
+) -> Result<Fitted, FitError> {
     check(n, if line { 2 } else { 3 }, get)?;
     let (c, m) = moments(n, get);
     let frame = Frame::of(m, line)?;
@@ -385,14 +393,14 @@ fn fit_impl(n: usize, line: bool, get: &dyn Fn(usize) -> [f64; 3]) -> Result<Fit
     Ok(fitted(c, frame, &spread, n))
 }
 
-fn line_impl(n: usize, get: &dyn Fn(usize) -> [f64; 3]) -> Result<LineFit, FitError> {
+fn line_impl(n: usize, get: &impl Fn(usize) -> [f64; 3]) -> Result<LineFit, FitError> {
     match fit_impl(n, true, get)? {
         Fitted::Line(f) => Ok(f),
         Fitted::Plane(_) => unreachable!("a line's frame is a line"),
     }
 }
 
-fn plane_impl(n: usize, get: &dyn Fn(usize) -> [f64; 3]) -> Result<PlaneFit, FitError> {
+fn plane_impl(n: usize, get: &impl Fn(usize) -> [f64; 3]) -> Result<PlaneFit, FitError> {
     match fit_impl(n, false, get)? {
         Fitted::Plane(f) => Ok(f),
         Fitted::Line(_) => unreachable!("a plane's frame is a plane"),
