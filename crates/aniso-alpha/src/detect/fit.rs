@@ -373,14 +373,10 @@ fn fitted(c: [f64; 3], frame: Frame, spread: &Spread, n: usize) -> Fitted {
 }
 
 /// The fit of the `n` points `get(0..n)`: generic over `get`, so that the
-/// passes over the points inline it (through a `dyn` call per point they
-/// took twice as long: the assembly fits tens of thousands of points per
-/// candidate, twice over).
-fn fit_impl(
-    n: usize,
-    line: bool,
-    get: &impl Fn(usize) -> [f64; 3],
-) -> Result<Fitted, FitError> {
+/// passes over the points inline it rather than make a `dyn` call per
+/// point (the assembly refits tens of thousands of points per candidate:
+/// mOSD learn 8's candidates stage, 2 threads, 76.5 → 72.4 ms).
+fn fit_impl(n: usize, line: bool, get: &impl Fn(usize) -> [f64; 3]) -> Result<Fitted, FitError> {
     check(n, if line { 2 } else { 3 }, get)?;
     let (c, m) = moments(n, get);
     let frame = Frame::of(m, line)?;
