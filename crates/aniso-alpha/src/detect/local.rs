@@ -404,7 +404,7 @@ pub fn local_shapes(points: &[[f64; 3]], kind: StructureKind) -> Vec<LocalShape>
         )
     };
     let order = trees[0].order();
-    let in_tree_order = in_tree_order(&trees[0], batches, |(own, coarser), nb, t| {
+    let per_point = in_tree_order(&trees[0], batches, |(own, coarser), nb, t| {
         own.nearest(t, NEIGHBOURS, nb);
         let mut best = finest_shape(points, &points[order[t] as usize], nb);
         let mut score = best.score(kind);
@@ -433,7 +433,7 @@ pub fn local_shapes(points: &[[f64; 3]], kind: StructureKind) -> Vec<LocalShape>
         }
         best
     });
-    put_back(in_tree_order, order, |i| Some(i as usize))
+    put_back(per_point, order, |i| Some(i as usize))
 }
 
 #[cfg(test)]

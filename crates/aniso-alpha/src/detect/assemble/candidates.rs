@@ -124,17 +124,15 @@ fn extract<S: Shape>(
     // split into pieces (the pieces' growth runs on one thread); a small
     // one's first, which may leave nothing to split.
     let (verts, part) = if local.len() >= CHUNKED_VERTICES {
-        crate::par::join(|| vertices_of(points.len(), local), parts)
+        let (verts, part) = crate::par::join(|| vertices_of(points.len(), local), parts);
+        (verts, Some(part))
     } else {
-        let verts = vertices_of(points.len(), local);
-        if verts.len() < min_vertices {
-            return Vec::new();
-        }
-        (verts, parts())
+        (vertices_of(points.len(), local), None)
     };
     if verts.len() < min_vertices {
         return Vec::new();
     }
+    let part = part.unwrap_or_else(parts);
     let mut cands = piece_fits(points, local, &part, &verts);
     drop(part);
     let inside = |c: &Primitive, v: u32| c.distance(&points[v as usize]) <= tol;

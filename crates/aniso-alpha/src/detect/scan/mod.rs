@@ -305,6 +305,18 @@ impl TileGrid {
         [0, 1, 2].map(|k| floor_i64((p[k] - self.origin[k]) / self.side))
     }
 
+    /// The cubes that own a point of `ids`, sorted and distinct: a job's
+    /// tiles.
+    fn cells(&self, points: &[[f64; 3]], ids: &[u32]) -> Vec<[i64; 3]> {
+        let mut cells: Vec<[i64; 3]> = ids
+            .iter()
+            .map(|&i| self.cell(&points[i as usize]))
+            .collect();
+        cells.sort_unstable();
+        cells.dedup();
+        cells
+    }
+
     /// The lower corner of cube `c` along axis `k` (the upper one is that
     /// of `c + 1`).
     fn corner(&self, c: i64, k: usize) -> f64 {
@@ -399,13 +411,7 @@ fn raw_faces_at<S: Face>(
     let h = halo_width(job);
     let grid = TileGrid::from_origin(side);
     let cell = |p: &[f64; 3]| -> [i64; 3] { grid.cell(p) };
-    let mut keyed: Vec<([i64; 3], u32)> = ids
-        .iter()
-        .map(|&i| (cell(&points[i as usize]), i))
-        .collect();
-    keyed.sort_unstable();
-    let mut tiles: Vec<[i64; 3]> = keyed.iter().map(|k| k.0).collect();
-    tiles.dedup();
+    let tiles = grid.cells(points, ids);
     let members = grid.members(points, ids, &tiles, h);
     let mut faces: Vec<Vec<S>> = vec![Vec::new(); alphas.len()];
     let mut triangulated = 0usize;
@@ -514,9 +520,7 @@ fn faces_in_tiles<S: Face>(
     h: f64,
 ) -> Result<Vec<Vec<S>>, ScanError> {
     let cell = |p: &[f64; 3]| -> [i64; 3] { grid.cell(p) };
-    let mut tiles: Vec<[i64; 3]> = map.iter().map(|&i| cell(&points[i as usize])).collect();
-    tiles.sort_unstable();
-    tiles.dedup();
+    let tiles = grid.cells(points, map);
     let members = grid.members(points, map, &tiles, h);
     // Each tile a task: tiles hold from a few points to a full tile's.
     let per_tile = crate::par::map_each(tiles.len(), |k| {
