@@ -47,18 +47,18 @@ pub struct Outline {
 const OUTLINE_DOUBLINGS: usize = 6;
 
 /// Points of a part from which its 2D α-shape is cut into strips
-/// ([`strips_of`]): 2^15 (one strip per [`STRIP_POINTS`] besides). A
+/// ([`strips_of`]): 2^16 (one strip per [`STRIP_POINTS`] besides). A
 /// depth frame's table (79,000 points) or a tiling's ground was one
-/// triangulation on one thread while the other parts were long done. A
-/// part of 30,000–65,000 points (the table of most depth frames) in one
-/// triangulation was the peak of a depth frame's run; cut, it is not
-/// (train and held-out frames, 2 threads, three runs each: mOSD test 16
-/// 28.6 → 26.4 MB, test 0 29.4 → 26.6 MB, and 0.01–0.02 s faster; the
-/// simulated room's parts of 30,000–52,000 points, outlined in parallel
-/// with each other already, take as long and peak alike within a run's
-/// spread; outlines identical on the 35 corpus scans).
+/// triangulation on one thread while the other parts were long done. At
+/// 2^15, the simulated room's parts of 30,000–52,000 points, outlined in
+/// parallel with each other already, were cut too, for nothing on two
+/// threads (train scans, "Peaks of the claims, the parts and the
+/// outlines" in BENCHMARKS.md); on the 20 train scans 2^15 left the peaks
+/// and wall times as they were (medians of three, 2 threads: peak ratio
+/// 1.00, wall 0.99), so the lower bound, which lowered two held-out depth
+/// frames' peaks, is not taken.
 #[cfg(not(test))]
-const STRIPPED_POINTS: usize = 1 << 15;
+const STRIPPED_POINTS: usize = 1 << 16;
 /// A few hundred points in the tests, so that small parts take the path.
 #[cfg(test)]
 const STRIPPED_POINTS: usize = 1 << 9;
