@@ -357,9 +357,14 @@ def main():
         got = prepare(scan)
         want = scan.get("prepared", {})
         same = want.get("points") == got["points"] and want.get("sha256") == got["sha256"]
-        bad += not same and not a.update
+        # A simulated scan's coordinates come from Open3D's ray caster, whose
+        # last digits vary between machines: the same points and labels in
+        # other bytes. Its counts are still checked.
+        near = scan.get("simulated") and all(want.get(k) == v for k, v in got.items() if k != "sha256")
+        verdict = "ok" if same else "ok (counts; bytes of this machine)" if near else "CHANGED" if want else "new"
+        bad += not same and not near and not a.update
         print(f"{scan['name']:24s} {got['points']:8d} points  {got['planes_1k']:3d} planes >= 1k  "
-              f"{got['line_points']:6d} line points  {'ok' if same else 'CHANGED' if want else 'new'}", flush=True)
+              f"{got['line_points']:6d} line points  {verdict}", flush=True)
         scan["prepared"] = got
     if a.update:
         with open(MANIFEST, "w") as f:

@@ -6,6 +6,7 @@ every kind of source (array, point file, list of LAS tiles, Dask array)."""
 import contextlib
 import os
 import struct
+import time
 
 import numpy as np
 import pytest
@@ -224,8 +225,28 @@ def killing_cluster(marker, always=False, task="_run_tile"):
         c.register_plugin(KillOnTile())
         yield c
     finally:
-        c.close()
-        cluster.close()
+        try:
+            settle(c, 2)
+        finally:
+            c.close()
+            cluster.close()
+
+
+def settle(c, n_workers, timeout=60.0):
+    """Waits until ``n_workers`` workers are registered and none runs a
+    task (no task left to kill one). A nanny restarting a killed worker
+    when its cluster closes fails the close (distributed asserts that the
+    process it joins has started); a registered worker's process has."""
+
+    def busy(dask_scheduler):
+        return sum(len(ws.processing) for ws in dask_scheduler.workers.values())
+
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if len(c.scheduler_info()["workers"]) == n_workers and c.run_on_scheduler(busy) == 0:
+            return
+        time.sleep(0.1)
+    raise AssertionError(f"the cluster did not settle to {n_workers} idle workers")
 
 
 def test_a_worker_killed_mid_run_gives_the_same_labels(tmp_path):
