@@ -107,6 +107,7 @@ pub fn parameters_json(d: &Detector) -> Value {
             "noise": num(e.noise),
             "structure_fraction": num(e.structure_fraction),
             "explained": num(e.explained),
+            "structured": num(e.structured),
         });
     }
     v
