@@ -336,6 +336,27 @@ pub fn run_warnings(
             ignored_normals_reason(g.agreement)
         ));
     }
+    if let Some((e, m)) = detector
+        .estimate()
+        .and_then(|e| e.ladder_declined.map(|m| (e, m)))
+    {
+        out.push(format!(
+            "the cloud looks like sparse structures against a background (its modes explain {:.0}% \
+             of the points, {:.0}% look locally {}), but the scale ladder scans at most {} points \
+             (it triangulates them once per rotation of its sampler) and {m} would take it: the \
+             modes were scanned instead; {}, {} and {} give the paper's sampled scan",
+            100.0 * e.explained,
+            100.0 * e.structured,
+            match e.kind {
+                crate::detect::StructureKind::Planes => "planar",
+                crate::detect::StructureKind::Lines => "linear",
+            },
+            crate::detect::estimate::LADDER_MAX_POINTS,
+            style.name("alpha"),
+            style.name("lambda3"),
+            style.name("min_size"),
+        ));
+    }
     let orientations = detector.orientation_count().unwrap_or(0);
     let work = points as f64 * orientations as f64;
     if work > HUGE_RUN {

@@ -108,6 +108,7 @@ pub fn parameters_json(d: &Detector) -> Value {
             "structure_fraction": num(e.structure_fraction),
             "explained": num(e.explained),
             "structured": num(e.structured),
+            "ladder_declined_points": e.ladder_declined,
         });
     }
     v

@@ -137,3 +137,44 @@ fn the_paper_s_scenes_are_mostly_unstructured() {
         assert!(d.ladder().is_some(), "{kind:?}");
     }
 }
+
+#[test]
+fn a_large_sparse_cloud_scans_its_modes_and_says_so() {
+    // Uniform noise in a box: nothing is structure-like and no mode
+    // explains anything, as in the paper's scenes, but with more points
+    // than a ladder scans (it would triangulate them 207 times): the
+    // modes are scanned, and the run warns.
+    use aniso_alpha::detect::estimate::LADDER_MAX_POINTS;
+    use aniso_alpha::options::{run_warnings, DetectOptions, Style};
+    let n = LADDER_MAX_POINTS + 1000;
+    let mut s = 7u64;
+    let mut next = move || {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (s >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let pts: Vec<[f64; 3]> = (0..n).map(|_| [next(), next(), next()]).collect();
+    let d = Detector::auto(StructureKind::Planes, &pts, &Given::default()).unwrap();
+    let e = d.estimate().unwrap();
+    assert!(
+        e.explained < 0.5 && e.structured < 0.5,
+        "{} {}",
+        e.explained,
+        e.structured
+    );
+    assert!(d.ladder().is_none());
+    assert_eq!(e.ladder_declined, Some(n));
+    let opts = DetectOptions::new(StructureKind::Planes);
+    let w = run_warnings(&opts, &d, n, 1, Style::Cli);
+    assert!(
+        w.iter()
+            .any(|w| w.contains("scale ladder scans at most") && w.contains("--alpha")),
+        "{w:?}"
+    );
+    // The same cloud cut to the ladder's size takes it.
+    let small = &pts[..LADDER_MAX_POINTS / 4];
+    let d = Detector::auto(StructureKind::Planes, small, &Given::default()).unwrap();
+    assert!(d.ladder().is_some());
+    assert_eq!(d.estimate().unwrap().ladder_declined, None);
+}

@@ -78,7 +78,8 @@
 //!    points themselves are fewer than [`STRUCTURED_MIN`] of them (a cloud
 //!    that is mostly surface, with its orientations spread, is described
 //!    by its local shapes, however few of its points the modes hold), the
-//!    run scans instead
+//!    run scans instead (on at most [`LADDER_MAX_POINTS`]; a larger cloud
+//!    scans its modes, with a warning)
 //!    a [`Ladder`]: the Fibonacci sampler at [`LADDER_STEP_DEG`] over those
 //!    points, λ = [`LAMBDA_MAX`], and the α of each of
 //!    [`LADDER_LEVELS`] (reach C_REACH·d·level, d the median
@@ -242,6 +243,10 @@ pub struct Estimate {
     /// The scale ladder scanned instead of the modes when they explain
     /// less than [`EXPLAINED_MIN`] of the cloud (module doc, step 6).
     pub ladder: Option<Ladder>,
+    /// The number of points a ladder would have scanned where the cloud
+    /// called for one but they were more than [`LADDER_MAX_POINTS`]: the
+    /// modes were scanned instead (a run warning says so).
+    pub ladder_declined: Option<usize>,
 }
 
 /// The scales of a run whose structures are sparse against their
@@ -284,6 +289,17 @@ pub const EXPLAINED_MIN: f64 = 0.5;
 /// on the paper's scenes (scripts/eval_synth.py, seeds 1–5, every kind
 /// and variant).
 pub const STRUCTURED_MIN: f64 = 0.5;
+
+/// The most points a scale ladder scans (module doc, step 6): 2^15. The
+/// ladder triangulates its points once per rotation of its sampler (207)
+/// and assembles them at five levels, about a thousand times the work of
+/// a run over the modes: seconds for the paper's scenes, which hold 270 to
+/// 15,050 points (scripts/eval_synth.py, every kind and variant; the size
+/// depends on the variant, not on the seed), and minutes to hours for a
+/// scan. A larger cloud that looks sparse (a vegetation-heavy scan's lines)
+/// scans its modes instead, with a run warning that says so and how to ask
+/// for the paper's sampler.
+pub const LADDER_MAX_POINTS: usize = 1 << 15;
 
 /// The levels of the ladder: the reach α·λ of level j is
 /// [`C_REACH`]·d·2^(j/2 − 2), j = 0 … 4, d the median nearest-neighbour
@@ -683,19 +699,20 @@ fn estimate_with(
         .collect();
     let can_be = (0..n).filter(|&i| !off(i)).count();
     let structured = structure.len() as f64 / can_be.max(1) as f64;
-    let ladder = (explained < EXPLAINED_MIN
+    let sparse = explained < EXPLAINED_MIN
         && structured < STRUCTURED_MIN
         && given.alpha.is_none()
         && given.lambda2.is_none()
         && given.lambda3.is_none()
         && spacing_median.is_finite()
-        && spacing_median > 0.0)
-        .then(|| {
-            ladder(
-                spacing_median,
-                (0..n as u32).filter(|&i| !off(i as usize)).collect(),
-            )
-        });
+        && spacing_median > 0.0;
+    let ladder_declined = (sparse && can_be > LADDER_MAX_POINTS).then_some(can_be);
+    let ladder = (sparse && ladder_declined.is_none()).then(|| {
+        ladder(
+            spacing_median,
+            (0..n as u32).filter(|&i| !off(i as usize)).collect(),
+        )
+    });
     let (alpha_p, lambda2_p, lambda3_p) = match &ladder {
         None => (alpha_p, lambda2_p, lambda3_p),
         Some(l) => ladder_params(kind, l, (explained, structured), spacing_median),
@@ -715,6 +732,7 @@ fn estimate_with(
         explained,
         structured,
         ladder,
+        ladder_declined,
     }
 }
 
