@@ -158,3 +158,17 @@ def test_warnings_reach_python(tmp_path):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert aa.detect(cloud, "planes").warnings == []
+
+
+def test_a_ladder_too_large_is_declined_with_a_warning():
+    # Uniform noise looks like the paper's sparse scenes (nothing
+    # structure-like, no mode), but holds more points than the scale
+    # ladder scans: the modes are scanned, and Python hears why.
+    pts = np.random.default_rng(11).uniform(size=(2**15 + 1000, 3))
+    with pytest.warns(aa.AnisoAlphaWarning, match="scale ladder scans at most 32768 points") as w:
+        det = aa.detect(pts, "planes")
+    assert "alpha, lambda3 and min_size" in str(w[0].message)
+    assert det.warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert aa.detect(pts[:4000], "planes").warnings == []

@@ -78,9 +78,9 @@
 //!    points themselves are fewer than [`STRUCTURED_MIN`] of them (a cloud
 //!    that is mostly surface, with its orientations spread, is described
 //!    by its local shapes, however few of its points the modes hold), the
-//!    run scans instead (on at most [`LADDER_MAX_POINTS`]; a larger cloud
-//!    scans its modes, with a warning)
-//!    a [`Ladder`]: the Fibonacci sampler at [`LADDER_STEP_DEG`] over those
+//!    run scans instead a [`Ladder`] (of at most [`LADDER_MAX_POINTS`]
+//!    points; a larger cloud scans its modes, with a warning): the
+//!    Fibonacci sampler at [`LADDER_STEP_DEG`] over those
 //!    points, λ = [`LAMBDA_MAX`], and the α of each of
 //!    [`LADDER_LEVELS`] (reach C_REACH·d·level, d the median
 //!    nearest-neighbour distance). Each level is assembled apart up to the
@@ -241,7 +241,9 @@ pub struct Estimate {
     /// (with or without a mode).
     pub structured: f64,
     /// The scale ladder scanned instead of the modes when they explain
-    /// less than [`EXPLAINED_MIN`] of the cloud (module doc, step 6).
+    /// less than [`EXPLAINED_MIN`] of the cloud and fewer than
+    /// [`STRUCTURED_MIN`] of its points are structure-like (module doc,
+    /// step 6).
     pub ladder: Option<Ladder>,
     /// The number of points a ladder would have scanned where the cloud
     /// called for one but they were more than [`LADDER_MAX_POINTS`]: the
