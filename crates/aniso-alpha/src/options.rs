@@ -341,10 +341,10 @@ pub fn run_warnings(
         .and_then(|e| e.ladder_declined.map(|m| (e, m)))
     {
         out.push(format!(
-            "the cloud looks like sparse structures against a background (its modes explain {:.0}% \
-             of the points, {:.0}% look locally {}), but the scale ladder scans at most {} points \
-             (it triangulates them once per rotation of its sampler) and {m} would take it: the \
-             modes were scanned instead; {}, {} and {} give the paper's sampled scan",
+            "the modes of the cloud explain {:.0}% of its points (under half; {:.0}% look locally \
+             {}), which calls for the scale ladder of sparse structures, but the scale ladder scans \
+             at most {} points (it triangulates them once per rotation of its sampler) and {m} would \
+             take it: the modes were scanned instead; {}, {} and {} give the paper's sampled scan",
             100.0 * e.explained,
             100.0 * e.structured,
             match e.kind {

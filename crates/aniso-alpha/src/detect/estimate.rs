@@ -74,11 +74,8 @@
 //!    that look structured do so by chance, and their modes are not the
 //!    structures' directions. So when the structure-like members of the
 //!    modes are fewer than [`EXPLAINED_MIN`] of the points that can be
-//!    structure (for lines, those not on surfaces), and the structure-like
-//!    points themselves are fewer than [`STRUCTURED_MIN`] of them (a cloud
-//!    that is mostly surface, with its orientations spread, is described
-//!    by its local shapes, however few of its points the modes hold), the
-//!    run scans instead a [`Ladder`] (of at most [`LADDER_MAX_POINTS`]
+//!    structure (for lines, those not on surfaces), the run scans instead
+//!    a [`Ladder`] (of at most [`LADDER_MAX_POINTS`]
 //!    points; a larger cloud scans its modes, with a warning): the
 //!    Fibonacci sampler at [`LADDER_STEP_DEG`] over those
 //!    points, λ = [`LAMBDA_MAX`], and the α of each of
@@ -241,9 +238,7 @@ pub struct Estimate {
     /// (with or without a mode).
     pub structured: f64,
     /// The scale ladder scanned instead of the modes when they explain
-    /// less than [`EXPLAINED_MIN`] of the cloud and fewer than
-    /// [`STRUCTURED_MIN`] of its points are structure-like (module doc,
-    /// step 6).
+    /// less than [`EXPLAINED_MIN`] of the cloud (module doc, step 6).
     pub ladder: Option<Ladder>,
     /// The number of points a ladder would have scanned where the cloud
     /// called for one but they were more than [`LADDER_MAX_POINTS`]: the
@@ -279,26 +274,14 @@ pub struct Ladder {
 /// on the paper's scenes (scripts/eval_synth.py, seeds 1–5).
 pub const EXPLAINED_MIN: f64 = 0.5;
 
-/// The share of the points that can be structure that must be
-/// structure-like for the run to scan its modes however few points they
-/// explain (module doc, step 6). A majority, as for [`EXPLAINED_MIN`]:
-/// where most points are locally planar (or linear), the local shapes do
-/// describe the cloud, which is a dense surface whose orientations are
-/// spread (natural terrain, curved objects), not sparse structures in a
-/// background; its modes are real, and the ladder (a sampler's rotations,
-/// each over every point) would cost hundreds of triangulations of it.
-/// Measured on the train half: 0.88–0.998 on the real plane scans, 0.01–0.48
-/// on the paper's scenes (scripts/eval_synth.py, seeds 1–5, every kind
-/// and variant).
-pub const STRUCTURED_MIN: f64 = 0.5;
-
 /// The most points a scale ladder scans (module doc, step 6): 2^15. The
 /// ladder triangulates its points once per rotation of its sampler (207)
 /// and assembles them at five levels, about a thousand times the work of
 /// a run over the modes: seconds for the paper's scenes, which hold 270 to
 /// 15,050 points (scripts/eval_synth.py, every kind and variant; the size
 /// depends on the variant, not on the seed), and minutes to hours for a
-/// scan. A larger cloud that looks sparse (a vegetation-heavy scan's lines)
+/// scan. A larger cloud whose modes explain under half of it (a
+/// natural-terrain scan: its planes, and its lines among the vegetation)
 /// scans its modes instead, with a run warning that says so and how to ask
 /// for the paper's sampler.
 pub const LADDER_MAX_POINTS: usize = 1 << 15;
@@ -702,7 +685,6 @@ fn estimate_with(
     let can_be = (0..n).filter(|&i| !off(i)).count();
     let structured = structure.len() as f64 / can_be.max(1) as f64;
     let sparse = explained < EXPLAINED_MIN
-        && structured < STRUCTURED_MIN
         && given.alpha.is_none()
         && given.lambda2.is_none()
         && given.lambda3.is_none()
@@ -1073,9 +1055,9 @@ fn ladder_params(
 ) -> (Param, Param, Param) {
     let alphas: Vec<String> = l.alphas.iter().map(|a| format!("{a:.4}")).collect();
     let why = format!(
-        "scale ladder: the modes of the local {}s explain {:.0}% of the points (under {:.0}%) and \
-         {:.0}% are locally {} (under {:.0}%), so each structure takes the most significant of \
-         alpha = {} (reach {C_REACH}·{d:.4}·2^(j/2 - 2), d the median spacing) with lambda {}",
+        "scale ladder: the modes of the local {}s explain {:.0}% of the points (under {:.0}%; {:.0}% \
+         are locally {}), so each structure takes the most significant of alpha = {} (reach \
+         {C_REACH}·{d:.4}·2^(j/2 - 2), d the median spacing) with lambda {}",
         match kind {
             StructureKind::Planes => "normal",
             StructureKind::Lines => "direction",
@@ -1087,7 +1069,6 @@ fn ladder_params(
             StructureKind::Planes => "planar",
             StructureKind::Lines => "linear",
         },
-        100.0 * STRUCTURED_MIN,
         alphas.join(", "),
         l.lambda
     );
