@@ -789,12 +789,12 @@ fn summary(
     ));
     if let Some(e) = d.estimate() {
         o.push_str(&format!(
-            "  estimated: spacing {:.4} (90th percentile; median {:.4}), noise {:.4}, {:.0}% of points {}\n",
+            "  estimated: spacing {:.4} (90th percentile; median {:.4}), noise {:.4}, {:.0}% of points locally {}\n",
             e.spacing,
             e.spacing_median,
             e.noise,
             100.0 * e.structure_fraction,
-            if d.kind() == StructureKind::Planes { "locally planar" } else { "locally linear" }
+            d.kind().locally()
         ));
         o.push_str(&format!("  alpha: {}\n", e.alpha.reason));
     }

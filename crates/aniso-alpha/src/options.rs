@@ -347,10 +347,7 @@ pub fn run_warnings(
              take it: the modes were scanned instead; {}, {} and {} give the paper's sampled scan",
             100.0 * e.explained,
             100.0 * e.structured,
-            match e.kind {
-                crate::detect::StructureKind::Planes => "planar",
-                crate::detect::StructureKind::Lines => "linear",
-            },
+            e.kind.locally(),
             crate::detect::estimate::LADDER_MAX_POINTS,
             style.name("alpha"),
             style.name("lambda3"),

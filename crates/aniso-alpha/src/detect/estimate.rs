@@ -1065,10 +1065,7 @@ fn ladder_params(
         100.0 * explained,
         100.0 * EXPLAINED_MIN,
         100.0 * structured,
-        match kind {
-            StructureKind::Planes => "planar",
-            StructureKind::Lines => "linear",
-        },
+        kind.locally(),
         alphas.join(", "),
         l.lambda
     );

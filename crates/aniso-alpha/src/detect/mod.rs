@@ -85,4 +85,13 @@ impl StructureKind {
             Self::Planes => 2,
         }
     }
+
+    /// What a point of such a structure looks like locally: "planar" or
+    /// "linear" (the words of the summary and the warnings).
+    pub fn locally(self) -> &'static str {
+        match self {
+            Self::Lines => "linear",
+            Self::Planes => "planar",
+        }
+    }
 }
