@@ -657,7 +657,7 @@ fn estimate_with(
         .collect();
     let (spacing, noise) = spacing_and_noise(kind, shapes, &structure, (spacing_median, 0.0));
     let (alpha_p, lambda2_p, lambda3_p, min_size_p) = cloud_params(kind, spacing, noise, given);
-    let found = concentrated_modes(kind, shapes, &structure, &off);
+    let found = concentrated_modes(kind, points, shapes, (&structure, noise), &off);
     let member_of = mode_members(kind, shapes, &found, &off);
     let explained = explained_share(kind, shapes, &member_of, &off);
     let mode_scans: Vec<ModeScan> = found
@@ -842,17 +842,20 @@ fn cloud_params(
 ///   cone of the ground's normal is judged on its own points, not on the
 ///   ground's or the trees'. Counted so, a peak of blurred edge normals is
 ///   concentrated too (the faces' points belong to the faces' modes), so
-///   this way is closed to a peak that lies on the arc between two kept
-///   modes ([`between_kept`]): the normals of an edge blend its two
-///   faces'. A peak of one step's edge (a pane recessed in a wall) beside
-///   a single mode passes; the pieces it finds at its inflated scale lie
-///   on the wall's points and the assembly absorbs them (claims.rs).
+///   this way is closed to the blend of two kept modes' faces
+///   ([`Blends`]): a peak on the arc between them ([`arcs_through`])
+///   whose points mostly touch points of both, as an edge's normals
+///   blend its two faces', and to the edge of a step in one kept mode's
+///   faces ([`Blends::step`]: a pane recessed in a wall), whose peak
+///   found a plane of one row of the wall's points and the background
+///   around it.
 ///
 /// The modes are taken densest first.
 fn concentrated_modes(
     kind: StructureKind,
+    points: &[[f64; 3]],
     shapes: &[LocalShape],
-    structure: &[u32],
+    (structure, noise): (&[u32], f64),
     off: &dyn Fn(usize) -> bool,
 ) -> Vec<Mode> {
     let axes: Vec<[f64; 3]> = structure
@@ -873,6 +876,14 @@ fn concentrated_modes(
     // points nearer to it than to every kept mode.
     let mut candidates: Vec<([f64; 3], f64)> = axes.iter().map(|&a| (a, -1.0)).collect();
     let mut kept: Vec<Mode> = Vec::new();
+    let mut blends = Blends {
+        kind,
+        points,
+        shapes,
+        structure,
+        noise,
+        tree: None,
+    };
     for m in found {
         // Concentrated over a count when the support is at least
         // MODE_CONCENTRATION of it: the count is at most `most`, so each
@@ -884,7 +895,13 @@ fn concentrated_modes(
             c >= cos_cone && c >= limit
         });
         let keep = in_cone.nth(most).is_none()
-            || (own.nth(most).is_none() && !between_kept(m.axis, &kept));
+            || (own.nth(most).is_none()
+                && !arcs_through(m.axis, &kept)
+                    .into_iter()
+                    .any(|(a, b)| blends.blend(m.axis, [kept[a].axis, kept[b].axis]))
+                && !kept
+                    .iter()
+                    .any(|a| dot(a.axis, m.axis).abs() >= cos_cone && blends.step(m.axis, a.axis)));
         if !keep {
             continue;
         }
@@ -896,31 +913,132 @@ fn concentrated_modes(
     kept
 }
 
-/// Whether axis `m` lies on the arc between two of the `kept` axes: within
-/// the mode kernel ([`MODE_KERNEL_DEG`]) of their great circle, between
-/// them, and farther than the kernel from each (axes without sign: each
-/// kept axis is taken on `m`'s side).
-fn between_kept(m: [f64; 3], kept: &[Mode]) -> bool {
+/// The pairs of `kept` modes (their indices) on whose arc axis `m` lies:
+/// within the mode kernel ([`MODE_KERNEL_DEG`]) of their great circle,
+/// between them, and farther than the kernel from each (axes without
+/// sign: each kept axis is taken on `m`'s side).
+fn arcs_through(m: [f64; 3], kept: &[Mode]) -> Vec<(usize, usize)> {
     let h = MODE_KERNEL_DEG.to_radians();
     let toward = |a: [f64; 3]| if dot(a, m) < 0.0 { scale(-1.0, a) } else { a };
     let angle = |u: [f64; 3], v: [f64; 3]| dot(u, v).clamp(-1.0, 1.0).acos();
-    kept.iter().enumerate().any(|(i, a)| {
-        kept[i + 1..].iter().any(|b| {
-            let (a, b) = (toward(a.axis), toward(b.axis));
-            let Some(n) = normalize(cross(a, b)) else {
-                return false;
-            };
-            let off_circle = dot(m, n);
-            if off_circle.abs() > h.sin() {
-                return false;
-            }
-            let Some(p) = normalize(sub(m, scale(off_circle, n))) else {
-                return false;
-            };
-            let (ap, pb) = (angle(a, p), angle(p, b));
-            ap > h && pb > h && ap + pb <= angle(a, b) + 1e-9
-        })
-    })
+    let on_arc = |a: [f64; 3], b: [f64; 3]| {
+        let (a, b) = (toward(a), toward(b));
+        let Some(n) = normalize(cross(a, b)) else {
+            return false;
+        };
+        let off_circle = dot(m, n);
+        if off_circle.abs() > h.sin() {
+            return false;
+        }
+        let Some(p) = normalize(sub(m, scale(off_circle, n))) else {
+            return false;
+        };
+        let (ap, pb) = (angle(a, p), angle(p, b));
+        ap > h && pb > h && ap + pb <= angle(a, b) + 1e-9
+    };
+    (0..kept.len())
+        .flat_map(|a| (a + 1..kept.len()).map(move |b| (a, b)))
+        .filter(|&(a, b)| on_arc(kept[a].axis, kept[b].axis))
+        .collect()
+}
+
+/// The test of a peak against the blend of two modes' faces: where a
+/// point's neighbourhood spans two faces (an edge), its axis blends
+/// theirs, so the blend's points touch points of both. A face whose
+/// normal merely lies between two others' (roofs of three houses at
+/// three pitches of one azimuth) lies apart from them.
+struct Blends<'a> {
+    kind: StructureKind,
+    points: &'a [[f64; 3]],
+    shapes: &'a [LocalShape],
+    /// The structure-like points (indices into `points`).
+    structure: &'a [u32],
+    /// The cloud's noise σ.
+    noise: f64,
+    /// A kd-tree of the structure-like points, built at the first test.
+    tree: Option<KdTree>,
+}
+
+impl Blends<'_> {
+    /// Whether the peak at axis `m` is the blend of the faces of modes
+    /// `faces`: more than half of the structure-like points within the
+    /// kernel of `m` have, within the reach of their own neighbourhood
+    /// (2σ₁, the radius of a disc whose in-plane deviation is σ₁),
+    /// structure-like points within the kernel of each face's mode.
+    fn blend(&mut self, m: [f64; 3], faces: [[f64; 3]; 2]) -> bool {
+        let cos_h = MODE_KERNEL_DEG.to_radians().cos();
+        let (kind, shapes, points) = (self.kind, self.shapes, self.points);
+        let near =
+            |i: u32, axis: [f64; 3]| dot(axis64(&shapes[i as usize], kind), axis).abs() >= cos_h;
+        let peak: Vec<u32> = self
+            .structure
+            .iter()
+            .copied()
+            .filter(|&i| near(i, m))
+            .collect();
+        let tree = self.tree();
+        let touching = peak
+            .iter()
+            .filter(|&&i| {
+                let reach = 2.0 * f64::from(shapes[i as usize].sigma[0]);
+                let mut seen = [false; 2];
+                tree.any_within(&points[i as usize], reach, |t| {
+                    for (f, axis) in faces.iter().enumerate() {
+                        seen[f] |= near(t, *axis);
+                    }
+                    seen[0] && seen[1]
+                })
+            })
+            .count();
+        2 * touching > peak.len()
+    }
+
+    /// Whether the peak at axis `m` is the edge of a step in the faces of
+    /// mode `a` (planes only: a pane recessed in a wall): more than half
+    /// of the structure-like points within the kernel of `m` have, within
+    /// the reach of their neighbourhood (as [`Self::blend`]), points of
+    /// `a`'s kernel on two levels, their offsets along `a` farther apart
+    /// than the noise band (2·[`C_NOISE`]·σ) allows one face. An eave's
+    /// points touch the ground on one level.
+    fn step(&mut self, m: [f64; 3], a: [f64; 3]) -> bool {
+        if self.kind != StructureKind::Planes {
+            return false;
+        }
+        let cos_h = MODE_KERNEL_DEG.to_radians().cos();
+        let (kind, shapes, points) = (self.kind, self.shapes, self.points);
+        let band = 2.0 * C_NOISE * self.noise;
+        let near =
+            |i: u32, axis: [f64; 3]| dot(axis64(&shapes[i as usize], kind), axis).abs() >= cos_h;
+        let peak: Vec<u32> = self
+            .structure
+            .iter()
+            .copied()
+            .filter(|&i| near(i, m))
+            .collect();
+        let tree = self.tree();
+        let stepping = peak
+            .iter()
+            .filter(|&&i| {
+                let reach = 2.0 * f64::from(shapes[i as usize].sigma[0]);
+                let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+                tree.any_within(&points[i as usize], reach, |t| {
+                    if near(t, a) {
+                        let o = dot(points[t as usize], a);
+                        (lo, hi) = (lo.min(o), hi.max(o));
+                    }
+                    hi - lo > band
+                })
+            })
+            .count();
+        2 * stepping > peak.len()
+    }
+
+    /// The kd-tree of the structure-like points, built at the first call.
+    fn tree(&mut self) -> &KdTree {
+        let (points, structure) = (self.points, self.structure);
+        self.tree
+            .get_or_insert_with(|| KdTree::new(points, Some(structure.to_vec())))
+    }
 }
 
 /// The members of each mode (module doc, step 3): a point joins the modes
