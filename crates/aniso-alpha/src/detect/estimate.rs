@@ -997,9 +997,11 @@ impl Blends<'_> {
     /// mode `a` (planes only: a pane recessed in a wall): more than half
     /// of the structure-like points within the kernel of `m` have, within
     /// the reach of their neighbourhood (as [`Self::blend`]), points of
-    /// `a`'s kernel on two levels, their offsets along `a` farther apart
-    /// than the noise band (2·[`C_NOISE`]·σ) allows one face. An eave's
-    /// points touch the ground on one level.
+    /// `a`'s kernel on their own level along `a` and on another, farther
+    /// than the noise band (2·[`C_NOISE`]·σ) allows one face: they are
+    /// points of `a`'s faces whose normals the step has tilted. A roof's
+    /// points beside flat roofs of two heights (both in the ground's
+    /// kernel) are on neither level.
     fn step(&mut self, m: [f64; 3], a: [f64; 3]) -> bool {
         if self.kind != StructureKind::Planes {
             return false;
@@ -1020,13 +1022,17 @@ impl Blends<'_> {
             .iter()
             .filter(|&&i| {
                 let reach = 2.0 * f64::from(shapes[i as usize].sigma[0]);
-                let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+                // Its own level, and whether a point of `a` lies on it and
+                // one on another.
+                let own = dot(points[i as usize], a);
+                let (mut level, mut other) = (false, false);
                 tree.any_within(&points[i as usize], reach, |t| {
-                    if near(t, a) {
-                        let o = dot(points[t as usize], a);
-                        (lo, hi) = (lo.min(o), hi.max(o));
+                    if t != i && near(t, a) {
+                        let apart = (dot(points[t as usize], a) - own).abs() > band;
+                        level |= !apart;
+                        other |= apart;
                     }
-                    hi - lo > band
+                    level && other
                 })
             })
             .count();
