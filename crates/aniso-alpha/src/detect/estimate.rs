@@ -842,13 +842,14 @@ fn cloud_params(
 ///   cone of the ground's normal is judged on its own points, not on the
 ///   ground's or the trees'. Counted so, a peak of blurred edge normals is
 ///   concentrated too (the faces' points belong to the faces' modes), so
-///   this way is closed to the blend of two kept modes' faces
-///   ([`Blends`]): a peak on the arc between them ([`arcs_through`])
-///   whose points mostly touch points of both, as an edge's normals
-///   blend its two faces', and to the edge of a step in one kept mode's
-///   faces ([`Blends::step`]: a pane recessed in a wall), whose peak
-///   found a plane of one row of the wall's points and the background
-///   around it.
+///   this way is closed to the edges of kept modes' faces
+///   ([`Blends::edge_of`]): a peak on the arc between two of them
+///   ([`arcs_through`]) whose points are bent over two faces (their
+///   spread above the ellipsoid's half-thickness) or mostly touch points
+///   of both, as an edge's normals blend its two faces', and the edge of
+///   a step in one kept mode's faces ([`Blends::step`]: a pane recessed
+///   in a wall), whose peak found a plane of one row of the wall's
+///   points and the background around it.
 ///
 /// The modes are taken densest first.
 fn concentrated_modes(
@@ -895,13 +896,7 @@ fn concentrated_modes(
             c >= cos_cone && c >= limit
         });
         let keep = in_cone.nth(most).is_none()
-            || (own.nth(most).is_none()
-                && !arcs_through(m.axis, &kept)
-                    .into_iter()
-                    .any(|(a, b)| blends.blend(m.axis, [kept[a].axis, kept[b].axis]))
-                && !kept
-                    .iter()
-                    .any(|a| dot(a.axis, m.axis).abs() >= cos_cone && blends.step(m.axis, a.axis)));
+            || (own.nth(most).is_none() && !blends.edge_of(m.axis, &kept));
         if !keep {
             continue;
         }
@@ -942,11 +937,12 @@ fn arcs_through(m: [f64; 3], kept: &[Mode]) -> Vec<(usize, usize)> {
         .collect()
 }
 
-/// The test of a peak against the blend of two modes' faces: where a
+/// The tests of a peak against the edges of kept modes' faces: where a
 /// point's neighbourhood spans two faces (an edge), its axis blends
-/// theirs, so the blend's points touch points of both. A face whose
-/// normal merely lies between two others' (roofs of three houses at
-/// three pitches of one azimuth) lies apart from them.
+/// theirs, so the blend's points are bent and touch points of both. A
+/// face whose normal merely lies between two others' (roofs of three
+/// houses at three pitches of one azimuth) is flat and lies apart from
+/// them.
 struct Blends<'a> {
     kind: StructureKind,
     points: &'a [[f64; 3]],
@@ -960,31 +956,72 @@ struct Blends<'a> {
 }
 
 impl Blends<'_> {
+    /// Whether the peak at axis `m` is an edge of the faces of the `kept`
+    /// modes: on the arc between two of them and bent ([`Self::bent`]) or
+    /// touching both ([`Self::blend`]), or within the cone of one and the
+    /// edge of a step in its faces ([`Self::step`]).
+    fn edge_of(&mut self, m: [f64; 3], kept: &[Mode]) -> bool {
+        let arcs = arcs_through(m, kept);
+        let cos_cone = CONE_DEG.to_radians().cos();
+        (!arcs.is_empty() && self.bent(m))
+            || arcs
+                .into_iter()
+                .any(|(a, b)| self.blend(m, [kept[a].axis, kept[b].axis]))
+            || kept
+                .iter()
+                .any(|a| dot(a.axis, m).abs() >= cos_cone && self.step(m, a.axis))
+    }
+
+    /// Whether structure-like point `i`'s axis lies within the mode kernel
+    /// ([`MODE_KERNEL_DEG`]) of `axis`.
+    fn near(&self, i: u32, axis: [f64; 3]) -> bool {
+        let cos_h = MODE_KERNEL_DEG.to_radians().cos();
+        dot(axis64(&self.shapes[i as usize], self.kind), axis).abs() >= cos_h
+    }
+
+    /// The structure-like points within the kernel of `m`.
+    fn kernel(&self, m: [f64; 3]) -> Vec<u32> {
+        self.structure
+            .iter()
+            .copied()
+            .filter(|&i| self.near(i, m))
+            .collect()
+    }
+
+    /// Whether the peak at axis `m` is bent: the median spread of its
+    /// kernel's points (σ₃ for planes) exceeds the ellipsoid's
+    /// half-thickness, [`C_NOISE`]·σ. A face's points include some whose
+    /// neighbourhood lies on the face alone, flat to within the noise; an
+    /// edge's normals come from neighbourhoods bent over two faces (a
+    /// room's floor-to-wall edges: ten times the noise), and where the
+    /// faces' points near the edge are tilted too, [`Self::blend`] finds
+    /// no point of one face within their reach.
+    fn bent(&self, m: [f64; 3]) -> bool {
+        let mut spread: Vec<f32> = self
+            .kernel(m)
+            .into_iter()
+            .map(|i| self.shapes[i as usize].spread(self.kind))
+            .collect();
+        !spread.is_empty() && quantile(&mut spread, 0.5) > C_NOISE * self.noise
+    }
+
     /// Whether the peak at axis `m` is the blend of the faces of modes
     /// `faces`: more than half of the structure-like points within the
     /// kernel of `m` have, within the reach of their own neighbourhood
     /// (2σ₁, the radius of a disc whose in-plane deviation is σ₁),
     /// structure-like points within the kernel of each face's mode.
     fn blend(&mut self, m: [f64; 3], faces: [[f64; 3]; 2]) -> bool {
-        let cos_h = MODE_KERNEL_DEG.to_radians().cos();
-        let (kind, shapes, points) = (self.kind, self.shapes, self.points);
-        let near =
-            |i: u32, axis: [f64; 3]| dot(axis64(&shapes[i as usize], kind), axis).abs() >= cos_h;
-        let peak: Vec<u32> = self
-            .structure
-            .iter()
-            .copied()
-            .filter(|&i| near(i, m))
-            .collect();
-        let tree = self.tree();
+        let peak = self.kernel(m);
+        self.build_tree();
+        let tree = self.tree.as_ref().expect("built");
         let touching = peak
             .iter()
             .filter(|&&i| {
-                let reach = 2.0 * f64::from(shapes[i as usize].sigma[0]);
+                let reach = 2.0 * f64::from(self.shapes[i as usize].sigma[0]);
                 let mut seen = [false; 2];
-                tree.any_within(&points[i as usize], reach, |t| {
+                tree.any_within(&self.points[i as usize], reach, |t| {
                     for (f, axis) in faces.iter().enumerate() {
-                        seen[f] |= near(t, *axis);
+                        seen[f] |= self.near(t, *axis);
                     }
                     seen[0] && seen[1]
                 })
@@ -1006,29 +1043,21 @@ impl Blends<'_> {
         if self.kind != StructureKind::Planes {
             return false;
         }
-        let cos_h = MODE_KERNEL_DEG.to_radians().cos();
-        let (kind, shapes, points) = (self.kind, self.shapes, self.points);
         let band = 2.0 * C_NOISE * self.noise;
-        let near =
-            |i: u32, axis: [f64; 3]| dot(axis64(&shapes[i as usize], kind), axis).abs() >= cos_h;
-        let peak: Vec<u32> = self
-            .structure
-            .iter()
-            .copied()
-            .filter(|&i| near(i, m))
-            .collect();
-        let tree = self.tree();
+        let peak = self.kernel(m);
+        self.build_tree();
+        let tree = self.tree.as_ref().expect("built");
         let stepping = peak
             .iter()
             .filter(|&&i| {
-                let reach = 2.0 * f64::from(shapes[i as usize].sigma[0]);
+                let reach = 2.0 * f64::from(self.shapes[i as usize].sigma[0]);
                 // Its own level, and whether a point of `a` lies on it and
                 // one on another.
-                let own = dot(points[i as usize], a);
+                let own = dot(self.points[i as usize], a);
                 let (mut level, mut other) = (false, false);
-                tree.any_within(&points[i as usize], reach, |t| {
-                    if t != i && near(t, a) {
-                        let apart = (dot(points[t as usize], a) - own).abs() > band;
+                tree.any_within(&self.points[i as usize], reach, |t| {
+                    if t != i && self.near(t, a) {
+                        let apart = (dot(self.points[t as usize], a) - own).abs() > band;
                         level |= !apart;
                         other |= apart;
                     }
@@ -1039,11 +1068,11 @@ impl Blends<'_> {
         2 * stepping > peak.len()
     }
 
-    /// The kd-tree of the structure-like points, built at the first call.
-    fn tree(&mut self) -> &KdTree {
-        let (points, structure) = (self.points, self.structure);
-        self.tree
-            .get_or_insert_with(|| KdTree::new(points, Some(structure.to_vec())))
+    /// Builds the kd-tree of the structure-like points at the first call.
+    fn build_tree(&mut self) {
+        if self.tree.is_none() {
+            self.tree = Some(KdTree::new(self.points, Some(self.structure.to_vec())));
+        }
     }
 }
 
