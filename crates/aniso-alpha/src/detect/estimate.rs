@@ -963,13 +963,21 @@ impl Blends<'_> {
     fn edge_of(&mut self, m: [f64; 3], kept: &[Mode]) -> bool {
         let arcs = arcs_through(m, kept);
         let cos_cone = CONE_DEG.to_radians().cos();
-        (!arcs.is_empty() && self.bent(m))
+        let steps: Vec<[f64; 3]> = kept
+            .iter()
+            .filter(|a| dot(a.axis, m).abs() >= cos_cone)
+            .map(|a| a.axis)
+            .collect();
+        if arcs.is_empty() && steps.is_empty() {
+            return false;
+        }
+        // The peak's kernel points, selected once for every test.
+        let peak = self.kernel(m);
+        (!arcs.is_empty() && self.bent(&peak))
             || arcs
                 .into_iter()
-                .any(|(a, b)| self.blend(m, [kept[a].axis, kept[b].axis]))
-            || kept
-                .iter()
-                .any(|a| dot(a.axis, m).abs() >= cos_cone && self.step(m, a.axis))
+                .any(|(a, b)| self.blend(&peak, [kept[a].axis, kept[b].axis]))
+            || steps.into_iter().any(|a| self.step(&peak, a))
     }
 
     /// Whether structure-like point `i`'s axis lies within the mode kernel
@@ -988,30 +996,27 @@ impl Blends<'_> {
             .collect()
     }
 
-    /// Whether the peak at axis `m` is bent: the median spread of its
-    /// kernel's points (σ₃ for planes) exceeds the ellipsoid's
+    /// Whether the peak whose kernel points are `peak` is bent: their
+    /// median spread (σ₃ for planes) exceeds the ellipsoid's
     /// half-thickness, [`C_NOISE`]·σ. A face's points include some whose
     /// neighbourhood lies on the face alone, flat to within the noise; an
     /// edge's normals come from neighbourhoods bent over two faces (a
     /// room's floor-to-wall edges: ten times the noise), and where the
     /// faces' points near the edge are tilted too, [`Self::blend`] finds
     /// no point of one face within their reach.
-    fn bent(&self, m: [f64; 3]) -> bool {
-        let mut spread: Vec<f32> = self
-            .kernel(m)
-            .into_iter()
-            .map(|i| self.shapes[i as usize].spread(self.kind))
+    fn bent(&self, peak: &[u32]) -> bool {
+        let mut spread: Vec<f32> = peak
+            .iter()
+            .map(|&i| self.shapes[i as usize].spread(self.kind))
             .collect();
         !spread.is_empty() && quantile(&mut spread, 0.5) > C_NOISE * self.noise
     }
 
-    /// Whether the peak at axis `m` is the blend of the faces of modes
-    /// `faces`: more than half of the structure-like points within the
-    /// kernel of `m` have, within the reach of their own neighbourhood
+    /// Whether the peak whose kernel points are `peak` is the blend of the
+    /// faces of modes `faces`: more than half of those points have, within the reach of their own neighbourhood
     /// (2σ₁, the radius of a disc whose in-plane deviation is σ₁),
     /// structure-like points within the kernel of each face's mode.
-    fn blend(&mut self, m: [f64; 3], faces: [[f64; 3]; 2]) -> bool {
-        let peak = self.kernel(m);
+    fn blend(&mut self, peak: &[u32], faces: [[f64; 3]; 2]) -> bool {
         self.build_tree();
         let tree = self.tree.as_ref().expect("built");
         let touching = peak
@@ -1030,21 +1035,20 @@ impl Blends<'_> {
         2 * touching > peak.len()
     }
 
-    /// Whether the peak at axis `m` is the edge of a step in the faces of
-    /// mode `a` (planes only: a pane recessed in a wall): more than half
-    /// of the structure-like points within the kernel of `m` have, within
+    /// Whether the peak whose kernel points are `peak` is the edge of a
+    /// step in the faces of mode `a` (planes only: a pane recessed in a
+    /// wall): more than half of those points have, within
     /// the reach of their neighbourhood (as [`Self::blend`]), points of
     /// `a`'s kernel on their own level along `a` and on another, farther
     /// than the noise band (2·[`C_NOISE`]·σ) allows one face: they are
     /// points of `a`'s faces whose normals the step has tilted. A roof's
     /// points beside flat roofs of two heights (both in the ground's
     /// kernel) are on neither level.
-    fn step(&mut self, m: [f64; 3], a: [f64; 3]) -> bool {
+    fn step(&mut self, peak: &[u32], a: [f64; 3]) -> bool {
         if self.kind != StructureKind::Planes {
             return false;
         }
         let band = 2.0 * C_NOISE * self.noise;
-        let peak = self.kernel(m);
         self.build_tree();
         let tree = self.tree.as_ref().expect("built");
         let stepping = peak
