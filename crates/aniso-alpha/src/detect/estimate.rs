@@ -1013,9 +1013,10 @@ impl Blends<'_> {
     }
 
     /// Whether the peak whose kernel points are `peak` is the blend of the
-    /// faces of modes `faces`: more than half of those points have, within the reach of their own neighbourhood
-    /// (2σ₁, the radius of a disc whose in-plane deviation is σ₁),
-    /// structure-like points within the kernel of each face's mode.
+    /// faces of modes `faces`: more than half of those points have, within
+    /// the reach of their own neighbourhood (2σ₁, the radius of a disc
+    /// whose in-plane deviation is σ₁), structure-like points within the
+    /// kernel of each face's mode.
     fn blend(&mut self, peak: &[u32], faces: [[f64; 3]; 2]) -> bool {
         self.build_tree();
         let tree = self.tree.as_ref().expect("built");
@@ -1037,13 +1038,13 @@ impl Blends<'_> {
 
     /// Whether the peak whose kernel points are `peak` is the edge of a
     /// step in the faces of mode `a` (planes only: a pane recessed in a
-    /// wall): more than half of those points have, within
-    /// the reach of their neighbourhood (as [`Self::blend`]), points of
-    /// `a`'s kernel on their own level along `a` and on another, farther
-    /// than the noise band (2·[`C_NOISE`]·σ) allows one face: they are
-    /// points of `a`'s faces whose normals the step has tilted. A roof's
-    /// points beside flat roofs of two heights (both in the ground's
-    /// kernel) are on neither level.
+    /// wall): more than half of those points have, within the reach of
+    /// their neighbourhood (as [`Self::blend`]), points of `a`'s kernel on
+    /// their own level along `a` and on another, farther than the noise
+    /// band (2·[`C_NOISE`]·σ) allows one face: they are points of `a`'s
+    /// faces whose normals the step has tilted. A roof's points beside
+    /// flat roofs of two heights (both in the ground's kernel) are on
+    /// neither level.
     fn step(&mut self, peak: &[u32], a: [f64; 3]) -> bool {
         if self.kind != StructureKind::Planes {
             return false;

@@ -59,7 +59,7 @@ pub const MAX_SAMPLES: usize = 4_000;
 pub struct Mode {
     /// Unit axis (largest |component| positive).
     pub axis: [f64; 3],
-    /// Axes within the kernel radius of it (scaled to the whole input).
+    /// Axes within the kernel radius of it, counted over every axis given.
     pub support: usize,
 }
 
