@@ -33,6 +33,7 @@
 //! assert!(shapes.iter().all(|s| (s.row_gap - 1.0).abs() < 1e-6));
 //! ```
 
+use super::estimate::SCORE_MIN;
 use super::StructureKind;
 use crate::geometry::kdtree::{KdTree, LeafBatch};
 use crate::geometry::{cross, dot, sub};
@@ -68,8 +69,11 @@ pub struct LocalShape {
     /// Distance to the nearest neighbour at least 45° away from the
     /// direction of the nearest one (either way): on a scan line, the
     /// gap to the next line; on an isotropic sampling, about the spacing.
-    /// The farthest of the neighbours when none is (the gap is at least
-    /// that); ∞ when there is no neighbour.
+    /// Where the neighbourhood at scale 0 is a line, the direction is the
+    /// line's and a neighbour across it nearer than the nearest along it
+    /// is skipped (a twin line, as a zigzag scanner's forward and backward
+    /// lines near the swath's edges). The farthest of the neighbours when
+    /// none is (the gap is at least that); ∞ when there is no neighbour.
     pub row_gap: f32,
 }
 
@@ -305,21 +309,41 @@ fn shape_of(points: &[[f64; 3]], nb: &[(f64, u32)], scale: usize, spacing: f32) 
 }
 
 /// The row gap of `q` among its neighbours `nb` (squared distances,
-/// ascending; see [`LocalShape::row_gap`]).
-fn row_gap(points: &[[f64; 3]], q: &[f64; 3], nb: &[(f64, u32)]) -> f32 {
+/// ascending; see [`LocalShape::row_gap`]), across `line` (unit) when the
+/// neighbourhood is a line, else across the direction of the nearest
+/// neighbour.
+fn row_gap(points: &[[f64; 3]], q: &[f64; 3], nb: &[(f64, u32)], line: Option<[f64; 3]>) -> f32 {
     let offset = |j: u32| sub(points[j as usize], *q);
     let mut rest = nb.iter().filter(|&&(d, _)| d > 0.0);
-    let Some(&(d0, first)) = rest.next() else {
+    let Some(&(d0, first)) = rest.clone().next() else {
         return f32::INFINITY;
     };
-    let u = offset(first);
+    let farthest = nb[nb.len() - 1].0;
     // |cos| ≤ cos 45° ⟺ 2·(u·v)² ≤ |u|²·|v|².
-    rest.find(|&&(d, j)| {
+    let across = |u: [f64; 3], uu: f64, d: f64, j: u32| {
         let uv = dot(u, offset(j));
-        2.0 * uv * uv <= d0 * d
-    })
-    .map_or(nb[nb.len() - 1].0, |&(d, _)| d)
-    .sqrt() as f32
+        2.0 * uv * uv <= uu * d
+    };
+    let gap = match line {
+        None => {
+            let u = offset(first);
+            rest.find(|&&(d, j)| across(u, d0, d, j))
+                .map_or(farthest, |&(d, _)| d)
+        }
+        // The nearest neighbour along the line is its spacing; a point
+        // across it but nearer than that lies on a twin line (a zigzag
+        // scanner's forward and backward lines nearly meet near the
+        // swath's edges), and the gap to bridge is to the next pair.
+        Some(u) => {
+            let along = rest
+                .clone()
+                .find(|&&(d, j)| !across(u, 1.0, d, j))
+                .map_or(0.0, |&(d, _)| d);
+            rest.find(|&&(d, j)| d > along && across(u, 1.0, d, j))
+                .map_or(farthest, |&(d, _)| d)
+        }
+    };
+    gap.sqrt() as f32
 }
 
 /// The shape of the neighbourhood `nb` of `q` at scale 0, with its
@@ -330,13 +354,17 @@ fn finest_shape(points: &[[f64; 3]], q: &[f64; 3], nb: &[(f64, u32)]) -> LocalSh
         .map(|&(d, _)| d)
         .find(|&d| d > 0.0)
         .map_or(f32::INFINITY, |d| d.sqrt() as f32);
-    let gap = row_gap(points, q, nb);
     if nb.len() >= 3 {
+        let shape = shape_of(points, nb, 0, spacing);
+        // A neighbourhood that is a line (linearity at least the features'
+        // midpoint) lies on a scan line: its gap is measured across it.
+        let line = (shape.linearity() >= SCORE_MIN).then(|| shape.direction.map(f64::from));
         LocalShape {
-            row_gap: gap,
-            ..shape_of(points, nb, 0, spacing)
+            row_gap: row_gap(points, q, nb, line),
+            ..shape
         }
     } else {
+        let gap = row_gap(points, q, nb, None);
         LocalShape {
             normal: [0.0, 0.0, 1.0],
             direction: [1.0, 0.0, 0.0],
@@ -545,6 +573,30 @@ mod tests {
             "{}",
             shapes[30].row_gap
         );
+    }
+
+    #[test]
+    fn a_twin_line_does_not_hide_the_gap_to_the_next_pair() {
+        // Scan lines in pairs (a zigzag scanner's forward and backward
+        // lines near the swath's edges): 0.05 apart, the pairs 1.2 apart,
+        // 0.3 between points along a line. The nearest neighbour is on the
+        // twin line, across; the gap to bridge is to the next pair, not
+        // the spacing along the line (0.3, what the nearest neighbour's
+        // direction gave).
+        let pts: Vec<[f64; 3]> = (0..6)
+            .flat_map(|j| {
+                (0..40).flat_map(move |i| {
+                    let (x, y) = (0.3 * i as f64, 1.2 * j as f64);
+                    [[x, y, 0.0], [x + 0.02, y + 0.05, 0.0]]
+                })
+            })
+            .collect();
+        let shapes = local_shapes(&pts, StructureKind::Planes);
+        for (p, s) in pts.iter().zip(&shapes) {
+            if p[0] > 3.0 && p[0] < 9.0 && p[1] > 2.0 && p[1] < 5.0 {
+                assert!(s.row_gap > 1.0, "{p:?}: {}", s.row_gap);
+            }
+        }
     }
 
     #[test]
