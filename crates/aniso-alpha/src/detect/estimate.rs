@@ -91,16 +91,12 @@
 //! given, no ladder.
 
 use super::detection::{distinct_count, position_key};
-use super::local::{local_shapes, LocalShape};
+use super::local::{local_shapes, LocalShape, SCORE_MIN};
 use super::modes::{modes, Mode};
 use super::StructureKind;
 use crate::aniso::{completion_first_row, completion_third_row, Mat3};
 use crate::geometry::kdtree::KdTree;
 use crate::geometry::{cross, dot, normalize, scale, sub};
-
-/// Score (planarity or linearity) from which a point is structure-like: the
-/// midpoint of the features' range [0, 1].
-pub const SCORE_MIN: f32 = 0.5;
 
 /// Angular radius of the mean-shift kernel of the modes (degrees): about
 /// the median angular error of local normals on the real scans measured
@@ -1013,64 +1009,66 @@ impl Blends<'_> {
     }
 
     /// Whether the peak whose kernel points are `peak` is the blend of the
-    /// faces of modes `faces`: more than half of those points have, within
-    /// the reach of their own neighbourhood (2σ₁, the radius of a disc
-    /// whose in-plane deviation is σ₁), structure-like points within the
+    /// faces of modes `faces`: a majority ([`Self::majority`]) of those
+    /// points have, within their reach, structure-like points within the
     /// kernel of each face's mode.
     fn blend(&mut self, peak: &[u32], faces: [[f64; 3]; 2]) -> bool {
-        self.build_tree();
-        let tree = self.tree.as_ref().expect("built");
-        let touching = peak
-            .iter()
-            .filter(|&&i| {
-                let reach = 2.0 * f64::from(self.shapes[i as usize].sigma[0]);
-                let mut seen = [false; 2];
-                tree.any_within(&self.points[i as usize], reach, |t| {
-                    for (f, axis) in faces.iter().enumerate() {
-                        seen[f] |= self.near(t, *axis);
-                    }
-                    seen[0] && seen[1]
-                })
+        self.majority(peak, |this, tree, i, reach| {
+            let mut seen = [false; 2];
+            tree.any_within(&this.points[i as usize], reach, |t| {
+                for (f, axis) in faces.iter().enumerate() {
+                    seen[f] |= this.near(t, *axis);
+                }
+                seen[0] && seen[1]
             })
-            .count();
-        2 * touching > peak.len()
+        })
     }
 
     /// Whether the peak whose kernel points are `peak` is the edge of a
     /// step in the faces of mode `a` (planes only: a pane recessed in a
-    /// wall): more than half of those points have, within the reach of
-    /// their neighbourhood (as [`Self::blend`]), points of `a`'s kernel on
-    /// their own level along `a` and on another, farther than the noise
-    /// band (2·[`C_NOISE`]·σ) allows one face: they are points of `a`'s
-    /// faces whose normals the step has tilted. A roof's points beside
-    /// flat roofs of two heights (both in the ground's kernel) are on
-    /// neither level.
+    /// wall): a majority ([`Self::majority`]) of those points have, within
+    /// their reach, points of `a`'s kernel on their own level along `a` and
+    /// on another, farther than the noise band (2·[`C_NOISE`]·σ) allows one
+    /// face: they are points of `a`'s faces whose normals the step has
+    /// tilted. A roof's points beside flat roofs of two heights (both in
+    /// the ground's kernel) are on neither level.
     fn step(&mut self, peak: &[u32], a: [f64; 3]) -> bool {
         if self.kind != StructureKind::Planes {
             return false;
         }
         let band = 2.0 * C_NOISE * self.noise;
+        self.majority(peak, |this, tree, i, reach| {
+            // Its own level, and whether a point of `a` lies on it and
+            // one on another.
+            let own = dot(this.points[i as usize], a);
+            let (mut level, mut other) = (false, false);
+            tree.any_within(&this.points[i as usize], reach, |t| {
+                if t != i && this.near(t, a) {
+                    let apart = (dot(this.points[t as usize], a) - own).abs() > band;
+                    level |= !apart;
+                    other |= apart;
+                }
+                level && other
+            })
+        })
+    }
+
+    /// Whether more than half of the peak's points `peak` pass `test`,
+    /// which sees the kd-tree of the structure-like points, the point and
+    /// its reach: the radius of its own neighbourhood, 2σ₁ (a disc whose
+    /// in-plane deviation is σ₁ has that radius).
+    fn majority(&mut self, peak: &[u32], test: impl Fn(&Self, &KdTree, u32, f64) -> bool) -> bool {
         self.build_tree();
-        let tree = self.tree.as_ref().expect("built");
-        let stepping = peak
+        let this = &*self;
+        let tree = this.tree.as_ref().expect("built");
+        let passing = peak
             .iter()
             .filter(|&&i| {
-                let reach = 2.0 * f64::from(self.shapes[i as usize].sigma[0]);
-                // Its own level, and whether a point of `a` lies on it and
-                // one on another.
-                let own = dot(self.points[i as usize], a);
-                let (mut level, mut other) = (false, false);
-                tree.any_within(&self.points[i as usize], reach, |t| {
-                    if t != i && self.near(t, a) {
-                        let apart = (dot(self.points[t as usize], a) - own).abs() > band;
-                        level |= !apart;
-                        other |= apart;
-                    }
-                    level && other
-                })
+                let reach = 2.0 * f64::from(this.shapes[i as usize].sigma[0]);
+                test(this, tree, i, reach)
             })
             .count();
-        2 * stepping > peak.len()
+        2 * passing > peak.len()
     }
 
     /// Builds the kd-tree of the structure-like points at the first call.

@@ -33,7 +33,6 @@
 //! assert!(shapes.iter().all(|s| (s.row_gap - 1.0).abs() < 1e-6));
 //! ```
 
-use super::estimate::SCORE_MIN;
 use super::StructureKind;
 use crate::geometry::kdtree::{KdTree, LeafBatch};
 use crate::geometry::{cross, dot, sub};
@@ -51,6 +50,10 @@ pub const MAX_SCALES: usize = 6;
 /// planarity of a clean plane sampled irregularly (σ₂/σ₁ ≈ 0.8–0.9, σ₃ ≈ 0)
 /// and the linearity of a line with points a little off it.
 pub const GOOD: f32 = 0.8;
+
+/// Score (planarity or linearity) from which a point is structure-like: the
+/// midpoint of the features' range [0, 1].
+pub const SCORE_MIN: f32 = 0.5;
 
 /// The local shape of the cloud around one point.
 #[derive(Debug, Clone, Copy, PartialEq)]
