@@ -33,7 +33,8 @@ pub enum Stage {
     Merge,
     /// Parts without their shape's proportions dropped.
     Proportions,
-    /// Structures, numbering, outlines or segments, labels.
+    /// The points left behind joined to the kept parts claiming them;
+    /// structures, numbering, outlines or segments, labels.
     Structures,
 }
 

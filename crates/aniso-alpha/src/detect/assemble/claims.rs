@@ -620,6 +620,61 @@ pub(super) fn parts<S: Shape>(
         .collect()
 }
 
+/// The points left out of every part that a kept part's candidate claims
+/// join the nearest such candidate's part (the rule of
+/// [`Claims::resolve`], over the kept parts' candidates and pieces); the
+/// parts that gain points are refitted. A point goes to its nearest
+/// claimer, and that candidate may make no part (too few members), or
+/// make one that goes (not significant, out of proportion, taken at
+/// another level): the point is then still within the claim radius of a
+/// kept primitive and over its footprint, as every member is. The number
+/// of points that joined a part.
+pub(super) fn reclaim<S: Shape>(
+    parts: &mut [Draft],
+    claims: &Claims,
+    n_cands: usize,
+    points: &[[f64; 3]],
+) -> usize {
+    let mut part_of_cand = vec![u32::MAX; n_cands];
+    for (pi, p) in parts.iter().enumerate() {
+        for c in std::iter::once(p.cand).chain(p.pieces.iter().copied()) {
+            part_of_cand[c] = pi as u32;
+        }
+    }
+    let mut taken = vec![false; points.len()];
+    for &i in parts.iter().flat_map(|p| &p.members) {
+        taken[i as usize] = true;
+    }
+    let mut gained: Vec<Vec<u32>> = vec![Vec::new(); parts.len()];
+    for here in claims.by_point() {
+        let point = here[0].0;
+        if taken[point as usize] {
+            continue;
+        }
+        let nearest = here
+            .iter()
+            .filter(|c| part_of_cand[c.1 as usize] != u32::MAX)
+            .min_by(|a, b| a.2.total_cmp(&b.2).then(a.1.cmp(&b.1)));
+        if let Some(c) = nearest {
+            gained[part_of_cand[c.1 as usize] as usize].push(point);
+        }
+    }
+    let mut joined = 0;
+    for (part, gain) in parts.iter_mut().zip(gained) {
+        if gain.is_empty() {
+            continue;
+        }
+        joined += gain.len();
+        part.members.extend(gain);
+        part.members.sort_unstable();
+        let fit = S::fit(points, &part.members);
+        if !matches!(fit, Primitive::None) {
+            part.fit = fit;
+        }
+    }
+    joined
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -740,6 +795,37 @@ mod tests {
         assert_eq!(c.shared(Some), [(0, 1), (0, 2), (1, 2), (2, 3)]);
         // Mapped: 0 and 1 are one, 3 is none.
         assert_eq!(c.shared(|x| (x != 3).then_some(x.max(1))), [(1, 2)]);
+    }
+
+    #[test]
+    fn points_whose_nearest_claimer_made_no_part_join_a_kept_part() {
+        // Points 0..=20 along x, all claimed by candidate 0; points 5..=8
+        // nearer to candidate 1, which with point 21 (claimed by it
+        // alone) has 5 members, too few for a part of 6; point 22 is
+        // claimed by none.
+        let mut pts: Vec<[f64; 3]> = (0..21).map(|i| [f64::from(i), 0.0, 0.0]).collect();
+        pts.extend([[6.5, 0.15, 0.0], [9.0, 5.0, 0.0]]);
+        let mut v: Vec<Claim> = Vec::new();
+        for p in 0..21u32 {
+            v.push((p, 0, 0.01));
+            if (5..=8).contains(&p) {
+                v.push((p, 1, 0.0));
+            }
+        }
+        v.push((21, 1, 0.09));
+        let claims = Claims(v);
+        let mut found = parts::<[u32; 2]>(&claims, 2, &pts, 6);
+        assert_eq!(found.len(), 1);
+        assert_eq!(found[0].members.len(), 17);
+        assert_eq!(reclaim::<[u32; 2]>(&mut found, &claims, 2, &pts), 4);
+        assert_eq!(found[0].members, (0..21).collect::<Vec<u32>>());
+        // The refit runs through every member.
+        let Primitive::Line(f) = &found[0].fit else {
+            unreachable!()
+        };
+        assert!((f.centroid[0] - 10.0).abs() < 1e-9, "{:?}", f.centroid);
+        // Nothing left to take.
+        assert_eq!(reclaim::<[u32; 2]>(&mut found, &claims, 2, &pts), 0);
     }
 
     #[test]

@@ -28,7 +28,10 @@
 //!    **Proportions** (`proportions`; with the data's orientations): a plane holds as many rows of
 //!    points across as its ellipsoid is long in spacings, a line is as
 //!    elongated as its ellipsoid; the others go.
-//! 6. **Structures** (`structures`). Parts that share claimed points and
+//! 6. **Points left behind** (`claims::reclaim`). A point whose nearest
+//!    claimer made no part, or a part that went, joins the nearest kept
+//!    part claiming it; those parts are refitted.
+//! 7. **Structures** (`structures`). Parts that share claimed points and
 //!    do not cross each other are facets of one structure; structures and
 //!    their parts are numbered by size, each part gets its outline and
 //!    mesh or its segment, and every point its labels.
@@ -228,7 +231,7 @@ pub(crate) fn level<S: Shape>(
     })
 }
 
-/// Stages 5–6 of the assembly over the `levels` of a run: the parts kept
+/// Stages 5–7 of the assembly over the `levels` of a run: the parts kept
 /// across levels (the most significant first, `select`), one part per
 /// primitive, structures, outlines and labels. The cloud's kd-tree is
 /// freed once the levels are selected: nothing after queries it.
@@ -264,8 +267,10 @@ pub(crate) fn finish<S: Shape>(
             proportions::reject(&mut parts, &cands, cloud.points())
         });
     }
-    // 6. Structures, outlines, labels.
+    // 6–7. Points left behind, to the kept parts claiming them;
+    // structures, outlines, labels.
     clock.time(Stage::Structures, || {
+        claims::reclaim::<S>(&mut parts, &claims, cands.len(), cloud.points());
         structures::detection::<S>(cloud, regime.kind(), parts, cands, claims, kept, stats)
     })
 }

@@ -1,4 +1,4 @@
-//! Stage 6 of the assembly (docs/method.md §4): structures from the parts,
+//! Stage 7 of the assembly (docs/method.md §4): structures from the parts,
 //! and the detection. Parts that share claimed points (where two facets
 //! meet) and do not cross each other (crossing lines, planes cutting
 //! through each other, a T-junction) are facets of one structure.
