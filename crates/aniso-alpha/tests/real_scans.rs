@@ -232,14 +232,18 @@ fn building_planes_from_the_data() {
     // reads them) and without (`--ignore-normals`).
     //
     // With them: 11 of the 11 labelled planes of >= 1,000 points, F1
-    // 0.907: window frames and ledges within a facade's claim radius,
+    // 0.922: window frames and ledges within a facade's claim radius,
     // whose normals run across it, stay out of it.
     //
-    // Without: 11/11, F1 0.847. A wall whose two pieces, 29 m apart, fit
+    // Without: 11/11, F1 0.863. A wall whose two pieces, 29 m apart, fit
     // planes 0.37 m apart is one part through the plane fitted to both
     // pieces (`assemble::same::joint_plane_keeps`); a facade that the
     // labels count as one plane, 1.5 m deep, keeps its points because a
     // noisy plane's claim radius widens (`assemble::widen`).
+    //
+    // Both F1s guard the points left behind (`assemble::claims::reclaim`):
+    // without it, points whose nearest claimer made no kept part stay
+    // background (F1 0.907 and 0.851).
     //
     // Both: no part is a plane tilted through the floors of two storeys
     // (pairwise merging would chain small horizontal patches 5 m apart in
@@ -257,7 +261,7 @@ fn building_planes_from_the_data() {
     assert_eq!(s.big, 11);
     assert!(s.found >= 11, "{s:?}");
     assert!(s.parts <= 120, "{s:?}");
-    assert!(s.f1 >= 0.9, "{s:?}");
+    assert!(s.f1 >= 0.915, "{s:?}");
     assert!(worst_rms(&det) < 1.0, "{}", worst_rms(&det));
     check_parts(&det, &points);
 
@@ -274,7 +278,7 @@ fn building_planes_from_the_data() {
     // longer merges (docs/method.md §4, "what a part is").
     assert!(s.found >= 10, "{s:?}");
     assert!(s.parts <= 90, "{s:?}");
-    assert!(s.f1 >= 0.83, "{s:?}");
+    assert!(s.f1 >= 0.857, "{s:?}");
     assert!(worst_rms(&det) < 1.0, "{}", worst_rms(&det));
     check_parts(&det, &points);
 }
