@@ -164,6 +164,9 @@ pub struct RunStats {
     /// of their ellipsoid: planes narrower than it is long, lines less
     /// elongated than it.
     pub out_of_proportion: usize,
+    /// Points whose nearest claimer made no kept part, joined to the
+    /// nearest kept part that claims them (docs/method.md §4 step 6).
+    pub reclaimed_points: usize,
 }
 
 /// Simplices with the same number of vertices each (2: edges, k = 1; 3:

@@ -270,7 +270,8 @@ pub(crate) fn finish<S: Shape>(
     // 6–7. Points left behind, to the kept parts claiming them;
     // structures, outlines, labels.
     clock.time(Stage::Structures, || {
-        claims::reclaim::<S>(&mut parts, &claims, cands.len(), cloud.points());
+        stats.reclaimed_points +=
+            claims::reclaim::<S>(&mut parts, &claims, cands.len(), cloud.points());
         structures::detection::<S>(cloud, regime.kind(), parts, cands, claims, kept, stats)
     })
 }
