@@ -25,7 +25,7 @@ use super::super::detection::Primitive;
 use super::footprint::for_near_in;
 use super::moments::Moments;
 use super::same::{absorbed, Piece};
-use super::{Candidate, Draft, Footprint, Shape};
+use super::{part_of_candidates, Candidate, Draft, Footprint, Shape};
 use crate::par::map_each;
 use crate::unionfind::UnionFind;
 use std::collections::HashSet;
@@ -115,14 +115,16 @@ impl Claims {
     pub(super) fn resolve(&self, n: usize) -> Vec<Vec<u32>> {
         let mut members: Vec<Vec<u32>> = vec![Vec::new(); n];
         for here in self.by_point() {
-            let best = here
-                .iter()
-                .min_by(|a, b| a.2.total_cmp(&b.2).then(a.1.cmp(&b.1)))
-                .map_or(0, |c| c.1);
+            let best = nearest(here.iter()).map_or(0, |c| c.1);
             members[best as usize].push(here[0].0);
         }
         members
     }
+}
+
+/// The nearest of `claims` (of one point), the smaller candidate on a tie.
+fn nearest<'a>(claims: impl Iterator<Item = &'a Claim>) -> Option<&'a Claim> {
+    claims.min_by(|a, b| a.2.total_cmp(&b.2).then(a.1.cmp(&b.1)))
 }
 
 /// Which candidates claim a point together, without the distances: what
@@ -635,12 +637,7 @@ pub(super) fn reclaim<S: Shape>(
     n_cands: usize,
     points: &[[f64; 3]],
 ) -> usize {
-    let mut part_of_cand = vec![u32::MAX; n_cands];
-    for (pi, p) in parts.iter().enumerate() {
-        for c in std::iter::once(p.cand).chain(p.pieces.iter().copied()) {
-            part_of_cand[c] = pi as u32;
-        }
-    }
+    let part_of_cand = part_of_candidates(parts, n_cands);
     let mut taken = vec![false; points.len()];
     for &i in parts.iter().flat_map(|p| &p.members) {
         taken[i as usize] = true;
@@ -651,11 +648,10 @@ pub(super) fn reclaim<S: Shape>(
         if taken[point as usize] {
             continue;
         }
-        let nearest = here
+        let kept = here
             .iter()
-            .filter(|c| part_of_cand[c.1 as usize] != u32::MAX)
-            .min_by(|a, b| a.2.total_cmp(&b.2).then(a.1.cmp(&b.1)));
-        if let Some(c) = nearest {
+            .filter(|c| part_of_cand[c.1 as usize] != u32::MAX);
+        if let Some(c) = nearest(kept) {
             gained[part_of_cand[c.1 as usize] as usize].push(point);
         }
     }

@@ -116,6 +116,18 @@ pub(crate) struct Draft {
     log10_nfa: f64,
 }
 
+/// Per candidate (of `n_cands`), the index among `parts` of the part it
+/// made or is a piece of; `u32::MAX` for none.
+fn part_of_candidates(parts: &[Draft], n_cands: usize) -> Vec<u32> {
+    let mut part_of = vec![u32::MAX; n_cands];
+    for (pi, p) in parts.iter().enumerate() {
+        for c in std::iter::once(p.cand).chain(p.pieces.iter().copied()) {
+            part_of[c] = pi as u32;
+        }
+    }
+    part_of
+}
+
 #[cfg(test)]
 impl Draft {
     /// For the stages' tests: a part of `members` with the primitive `fit`

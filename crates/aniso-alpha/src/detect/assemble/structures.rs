@@ -13,7 +13,7 @@ use super::super::detection::{Detection, Part, RunStats, Simplices, Structure};
 use super::super::StructureKind;
 use super::claims::Claims;
 use super::shape::crosses;
-use super::{Candidate, Draft, Shape};
+use super::{part_of_candidates, Candidate, Draft, Shape};
 use crate::par::map_each;
 use crate::unionfind::UnionFind;
 
@@ -89,12 +89,7 @@ fn group_parts<S: Shape>(
     claims: &Claims,
     points: &[[f64; 3]],
 ) -> Vec<Vec<u32>> {
-    let mut part_of_cand = vec![u32::MAX; n_cands];
-    for (pi, p) in parts.iter().enumerate() {
-        for c in std::iter::once(p.cand).chain(p.pieces.iter().copied()) {
-            part_of_cand[c] = pi as u32;
-        }
-    }
+    let part_of_cand = part_of_candidates(parts, n_cands);
     let mut uf = UnionFind::new(parts.len());
     let part_of = |c: u32| Some(part_of_cand[c as usize]).filter(|&p| p != u32::MAX);
     for (a, b) in claims.shared(part_of) {
