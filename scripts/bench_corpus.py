@@ -6,7 +6,8 @@ against CGAL's Efficient RANSAC, CGAL's region growing and an Open3D
 (scripts/corpus/README.md; build it first with scripts/corpus/prepare.py).
 
     python3 scripts/bench_corpus.py --bin PATH [--split train|heldout|all] [--peers]
-        [--jobs N] [--repeat N] [--scans a,b] [--kinds depth,airborne] [--json out.json] [--md out.md]
+        [--jobs N] [--repeat N] [--scans a,b] [--kinds depth,airborne] [--set core|sweep|all]
+        [--json out.json] [--md out.md]
 
 The train and held-out halves are reported in separate tables, never mixed.
 
@@ -277,11 +278,16 @@ def main():
                          "alternately, and report the medians (the other peers: one run)")
     ap.add_argument("--scans", default="", help="comma-separated scan names")
     ap.add_argument("--kinds", default="", help="comma-separated kinds")
+    ap.add_argument("--set", default="core", choices=["core", "sweep", "all"],
+                    help="core: the corpus of the tables (default); sweep: the other mOSD frames of the "
+                         "boxes, stacked boxes and cylindric categories (manifest `sweep`); all: both")
     ap.add_argument("--json", help="write every figure here")
     ap.add_argument("--md", help="write the tables here too")
     a = ap.parse_args()
     man = load_manifest()
     scans = [s for s in man["scans"] if a.split == "all" or s["split"] == a.split]
+    if a.set != "all":
+        scans = [s for s in scans if bool(s.get("sweep")) == (a.set == "sweep")]
     if a.scans:
         scans = [s for s in scans if s["name"] in a.scans.split(",")]
     if a.kinds:
