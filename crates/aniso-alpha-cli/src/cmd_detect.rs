@@ -296,6 +296,13 @@ impl OutputPaths {
         }
         w
     }
+
+    /// Whether an output holds the plane parts' outlines or meshes (the
+    /// report's polygons, a mesh or labelled-cloud output, the views):
+    /// without one, the run skips them ([`Detector::outlines`]).
+    fn holds_outlines(&self, args: &DetectArgs) -> bool {
+        self.report.is_some() || self.html.is_some() || self.output.is_some() || args.png.is_some()
+    }
 }
 
 /// `--classify` needs a labelled cloud output and names the structure
@@ -382,13 +389,14 @@ fn read_cloud(
 }
 
 /// Builds the detector (phase "estimate") and runs it on `points` (phase
-/// "detect") behind a progress bar: the detector, its detection and the
+/// "detect") behind a progress bar, for the built-in example or not, with
+/// the plane parts' outlines or not: the detector, its detection and the
 /// wall seconds of the two.
 fn detect_points(
     args: &DetectArgs,
     points: &[[f64; 3]],
     normals: Option<&[[f64; 3]]>,
-    example: bool,
+    (example, outlines): (bool, bool),
     timings: &mut Timings,
 ) -> Result<(Detector, Detection, f64), CliError> {
     let in_file = |e: DetectError| match (&args.input, &e) {
@@ -435,6 +443,7 @@ fn detect_points(
         .phase("detect", || {
             detector
                 .clone()
+                .outlines(outlines)
                 .progress(tick)
                 .on_stage(observe)
                 .run(points)
@@ -680,8 +689,13 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
         return crate::cmd_regions::run(&input, &options(args, example), &out, timings);
     }
     let n_input = cloud.points.len();
-    let (detector, det, seconds) =
-        detect_points(args, points, normals.as_deref(), example, timings)?;
+    let (detector, det, seconds) = detect_points(
+        args,
+        points,
+        normals.as_deref(),
+        (example, paths.holds_outlines(args)),
+        timings,
+    )?;
 
     let run = Outcome {
         cloud: &cloud,

@@ -701,3 +701,54 @@ fn detect_timings_name_every_stage_of_the_run_within_the_detect_phase() {
         "stages {sum} cover little of detect {detect}: {t}"
     );
 }
+
+#[test]
+fn labels_alone_skip_the_outlines_and_keep_the_labels() {
+    // With labels alone no output holds the plane parts' outlines, and the
+    // run does not draw them; the labels are those of a run whose report
+    // does hold them, a polygon per plane part.
+    let dir = TempDir::new("e2e", "outlines");
+    let scene = dir.path("planes.xyz");
+    ok(&[
+        "synth",
+        "planes",
+        "--seed",
+        "3",
+        "--output",
+        scene.to_str().unwrap(),
+    ]);
+    let run = |report: Option<&Path>, name: &str| {
+        let parts = dir.path(&format!("{name}.parts"));
+        let mut args = vec![
+            "detect",
+            scene.to_str().unwrap(),
+            "--structure",
+            "planes",
+            "--part-labels",
+            parts.to_str().unwrap(),
+            "--quiet",
+        ];
+        if let Some(r) = report {
+            args.extend(["--report", r.to_str().unwrap()]);
+        }
+        ok(&args);
+        std::fs::read_to_string(parts).unwrap()
+    };
+    let report = dir.path("report.json");
+    let with = run(Some(&report), "with");
+    assert!(with.lines().any(|l| l != "-1"), "no part found");
+    assert_eq!(run(None, "without"), with);
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let parts: Vec<&serde_json::Value> = r["structures"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|s| s["parts"].as_array().unwrap())
+        .collect();
+    assert!(!parts.is_empty());
+    for p in parts {
+        assert!(p["polygon"].as_array().map_or(0, Vec::len) >= 3, "{p}");
+        assert!(p["triangles"].as_u64().unwrap_or(0) > 0, "{p}");
+    }
+}

@@ -1,7 +1,7 @@
 //! End-to-end detection on the synthetic scenes with the paper's
 //! parameters (docs/method.md §5), scored as in docs/method.md §6.
 
-use aniso_alpha::detect::{Detection, Detector};
+use aniso_alpha::detect::{Detection, Detector, Part};
 use aniso_alpha::eval::{evaluate, Evaluation};
 use aniso_alpha::synth::{Scene, SceneOptions};
 
@@ -220,4 +220,47 @@ fn duplicates_take_their_first_occurrences_labels() {
     assert_eq!(p2[..n], p1[..]);
     assert_eq!(p2[n..], p1[..]);
     assert!(twice.first_occurrence[n..].iter().copied().eq(0..n as u32));
+}
+
+/// A run without outlines is the run with them, less the plane parts'
+/// outlines and meshes: the same labels, parts, planes and NFAs; line
+/// parts keep their segments.
+#[test]
+fn outlines_off_changes_nothing_but_the_outlines() {
+    let scene = SceneOptions::polyhedron().seed(2).generate().unwrap();
+    let detector = Detector::planes(1.0, 4.0, 8.0, 20);
+    assert!(detector.draws_outlines());
+    let with = detector.clone().run(&scene.points).unwrap();
+    let without = detector.outlines(false).run(&scene.points).unwrap();
+    assert_eq!(with.labels, without.labels);
+    assert_eq!(with.part_labels(), without.part_labels());
+    assert_eq!(with.simplices, without.simplices);
+    let parts = |d: &Detection| -> Vec<Part> {
+        d.structures.iter().flat_map(|s| s.parts.clone()).collect()
+    };
+    let (a, b) = (parts(&with), parts(&without));
+    assert!(a.len() >= 5, "{} parts", a.len());
+    assert_eq!(a.len(), b.len());
+    for (p, q) in a.iter().zip(&b) {
+        assert!(p.outline.len() >= 3 && !p.mesh.is_empty());
+        assert!(q.outline.is_empty() && q.mesh.is_empty());
+        assert_eq!(
+            (&p.vertices, &p.primitive, &p.simplices),
+            (&q.vertices, &q.primitive, &q.simplices)
+        );
+        assert_eq!(p.log10_nfa.to_bits(), q.log10_nfa.to_bits());
+    }
+    // Lines: the segments stay.
+    let scene = SceneOptions::lines().seed(1).generate().unwrap();
+    let det = Detector::lines(1.0, 10.0, 4)
+        .outlines(false)
+        .run(&scene.points)
+        .unwrap();
+    let segs: Vec<_> = det
+        .structures
+        .iter()
+        .flat_map(|s| &s.parts)
+        .map(|p| p.segment())
+        .collect();
+    assert!(!segs.is_empty() && segs.iter().all(Option::is_some));
 }

@@ -506,6 +506,7 @@ mod tests {
         let group: Vec<u32> = (0..edges.len()).map(|i| u32::from(i >= 20)).collect();
         let settings = Settings {
             part_angle_deg: 10.0,
+            outlines: true,
             min_vertices: 4,
             scales: vec![
                 Scale {

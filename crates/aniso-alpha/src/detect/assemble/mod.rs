@@ -78,6 +78,9 @@ pub(crate) struct Scale {
 pub(crate) struct Settings {
     /// Angle tolerance (degrees) of straight/flat pieces and of merging.
     pub part_angle_deg: f64,
+    /// Whether plane parts get their outline and mesh
+    /// ([`super::Detector::outlines`]).
+    pub outlines: bool,
     /// Fewest points of a part ([`Shape::min_vertices`]).
     pub min_vertices: usize,
     /// The scale of each group.
@@ -284,6 +287,6 @@ pub(crate) fn finish<S: Shape>(
     clock.time(Stage::Structures, || {
         stats.reclaimed_points +=
             claims::reclaim::<S>(&mut parts, &claims, cands.len(), cloud.points());
-        structures::detection::<S>(cloud, regime.kind(), parts, cands, claims, kept, stats)
+        structures::detection::<S>(cloud, settings.outlines, parts, cands, claims, kept, stats)
     })
 }

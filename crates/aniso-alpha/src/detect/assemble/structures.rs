@@ -17,15 +17,16 @@ use super::{part_of_candidates, Candidate, Draft, Shape};
 use crate::par::map_each;
 use crate::unionfind::UnionFind;
 
-/// The detection of `parts` (module doc); `claims` are the candidates'
-/// final claims, `kept` the cleaned union. What the outlines do not need
+/// The detection of `parts` (module doc), lines or planes by the shape
+/// `S`, the plane parts with their outlines and meshes if `outlines`;
+/// `claims` are the candidates' final claims, `kept` the cleaned union. What the outlines do not need
 /// (the claims, the candidates but their cells, the union) is dropped
 /// before they are drawn, the parts' members move into the detection,
 /// and the union's simplices are listed after: a large part's 2D
 /// triangulation is the last peak of a run's memory.
 pub(super) fn detection<S: Shape>(
     cloud: &Cloud<'_>,
-    kind: StructureKind,
+    outlines: bool,
     parts: Vec<Draft>,
     cands: Vec<Candidate>,
     claims: Claims,
@@ -43,10 +44,14 @@ pub(super) fn detection<S: Shape>(
         .collect();
     drop(cands);
     let (mut structures, vstruct, vpart) = number::<S>(parts, groups, points);
-    // Each part's outline and mesh, or segment, the parts in parallel;
-    // then the union's simplices into the structures.
+    // Each part's outline and mesh (unless the run draws none), or
+    // segment, the parts in parallel; then the union's simplices into the
+    // structures.
     let numbered: Vec<&Part> = structures.iter().flat_map(|st| &st.parts).collect();
     let shapes = map_each(numbered.len(), |k| {
+        if S::K == 2 && !outlines {
+            return Default::default();
+        }
         S::outline(
             &numbered[k].primitive,
             &numbered[k].vertices,
@@ -70,7 +75,11 @@ pub(super) fn detection<S: Shape>(
         })
         .collect();
     Detection {
-        kind,
+        kind: if S::K == 1 {
+            StructureKind::Lines
+        } else {
+            StructureKind::Planes
+        },
         simplices,
         simplex_structure,
         structures,
@@ -265,7 +274,7 @@ mod tests {
         let kept: Vec<[u32; 2]> = vec![[0, 1], [9, 10], [10, 11], [17, 18], [3, 20]];
         let det = detection::<[u32; 2]>(
             &cloud,
-            StructureKind::Lines,
+            true,
             parts,
             cands,
             claims,

@@ -86,6 +86,7 @@ pub struct Detector {
     set: OrientationSet,
     prune: bool,
     part_angle_deg: f64,
+    outlines: bool,
     epsilon: Option<f64>,
     threads: Option<usize>,
     tile: Option<f64>,
@@ -150,6 +151,7 @@ impl Detector {
             set: OrientationSet::Sampler(Sampler::default()),
             prune: true,
             part_angle_deg: 10.0,
+            outlines: true,
             epsilon: Some(1.0),
             threads: None,
             tile: None,
@@ -371,6 +373,23 @@ impl Detector {
     /// The angle tolerance (degrees) of the straight/flat parts.
     pub fn part_angle_degrees(&self) -> f64 {
         self.part_angle_deg
+    }
+
+    /// Whether plane parts get their outline and mesh, the 2D α-shape of
+    /// their points ([`super::Part::outline`], [`super::Part::mesh`];
+    /// default true). Without them a plane part's outline and mesh are
+    /// empty and everything else is the same: its points, plane, NFA, and
+    /// every label. A run whose output holds neither (labels alone) skips
+    /// a triangulation of every plane's points. Line parts always get
+    /// their segment.
+    pub fn outlines(mut self, yes: bool) -> Self {
+        self.outlines = yes;
+        self
+    }
+
+    /// Whether plane parts get their outline and mesh.
+    pub fn draws_outlines(&self) -> bool {
+        self.outlines
     }
 
     /// The significance test's ε (default 1: keep parts with at most one

@@ -352,6 +352,7 @@ impl Detector {
     ) -> Result<Detection, DetectError> {
         let settings = |scales: Vec<Scale>| Settings {
             part_angle_deg: self.part_angle_deg,
+            outlines: self.outlines,
             min_vertices: S::min_vertices(self.nb_c),
             scales,
             clock: self.stages.clone(),
