@@ -254,7 +254,7 @@ pub fn region_task<'py>(
         if let Some(m) = wider_margin(&detector, margin).map_err(value_error)? {
             return Ok(("wider", m, None));
         }
-        let step = region_step(&detector, pts).map_err(value_error)?;
+        let step = region_step(detector, pts).map_err(value_error)?;
         Ok(("step", margin, Some(step)))
     })?;
     let (kind, m, step) = out;

@@ -173,14 +173,18 @@ pub struct RegionStep {
 }
 
 /// Runs `detector` on a region's points `sub` (its core and margin, in
-/// input order).
+/// input order), without outlines: a region's step keeps its labels and
+/// its parts' axes, and the joined parts are outlined by no one
+/// ([`Detector::outlines`]).
 ///
 /// # Errors
 /// As [`Detector::run`].
-pub fn region_step(detector: &Detector, sub: &[[f64; 3]]) -> Result<RegionStep, DetectError> {
-    let det = detector.run(sub)?;
-    let mut step = step_of(&det, detector.part_angle_degrees());
-    step.normals_ignored = detector.given_normals().is_some_and(|g| !g.used);
+pub fn region_step(detector: Detector, sub: &[[f64; 3]]) -> Result<RegionStep, DetectError> {
+    let ignored = detector.given_normals().is_some_and(|g| !g.used);
+    let part_angle = detector.part_angle_degrees();
+    let det = detector.outlines(false).run(sub)?;
+    let mut step = step_of(&det, part_angle);
+    step.normals_ignored = ignored;
     Ok(step)
 }
 
@@ -289,7 +293,7 @@ fn run_region<'a, E: From<DetectError>>(
         };
         match wider_margin(&detector, margin)? {
             None => {
-                let step = region_step(&detector, &points)?;
+                let step = region_step(detector, &points)?;
                 return Ok(RegionDone {
                     ids,
                     core,
@@ -595,7 +599,7 @@ mod tests {
                     }
                 }
             };
-            steps.push((r, ids, region_step(&d, &sub).unwrap(), widened));
+            steps.push((r, ids, region_step(d, &sub).unwrap(), widened));
         }
         // The joining takes the regions in the plan's order (the numbering
         // of region parts follows it), wherever they ran.
