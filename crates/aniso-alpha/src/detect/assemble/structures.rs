@@ -19,11 +19,11 @@ use crate::unionfind::UnionFind;
 
 /// The detection of `parts` (module doc), lines or planes by the shape
 /// `S`, the plane parts with their outlines and meshes if `outlines`;
-/// `claims` are the candidates' final claims, `kept` the cleaned union. What the outlines do not need
-/// (the claims, the candidates but their cells, the union) is dropped
-/// before they are drawn, the parts' members move into the detection,
-/// and the union's simplices are listed after: a large part's 2D
-/// triangulation is the last peak of a run's memory.
+/// `claims` are the candidates' final claims, `kept` the cleaned union.
+/// What the outlines do not need (the claims, the candidates but their
+/// cells, the union) is dropped before they are drawn, the parts' members
+/// move into the detection, and the union's simplices are listed after: a
+/// large part's 2D triangulation is the last peak of a run's memory.
 pub(super) fn detection<S: Shape>(
     cloud: &Cloud<'_>,
     outlines: bool,
