@@ -500,14 +500,8 @@ fn quiet_means_quiet() {
     assert!(String::from_utf8_lossy(&o.stdout).contains("structure(s)"));
 }
 
-#[test]
-fn detect_tile_gives_the_untiled_labels() {
-    // `detect --tile SIZE` (docs/method.md §8): tiles of side 15, smaller
-    // than the scene's planes (20–30 units across at spacing 3, in a
-    // 125-unit box; estimated α 0.75, λ 8, so halos of 12), each
-    // triangulated with its halo, give the same labels and part labels as
-    // one triangulation per orientation.
-    let dir = TempDir::new("e2e", "tile");
+/// `synth planes --seed 3` in `dir`, the scene both tests below detect on.
+fn planes_scene(dir: &TempDir) -> PathBuf {
     let scene = dir.path("planes.xyz");
     ok(&[
         "synth",
@@ -517,34 +511,51 @@ fn detect_tile_gives_the_untiled_labels() {
         "--output",
         scene.to_str().unwrap(),
     ]);
-    let run = |tile: Option<&str>, name: &str| {
-        let (labels, parts) = (
-            dir.path(&format!("{name}.labels")),
-            dir.path(&format!("{name}.parts")),
-        );
-        let mut args = vec![
-            "detect",
-            scene.to_str().unwrap(),
-            "--structure",
-            "planes",
-            "--labels",
-            labels.to_str().unwrap(),
-            "--part-labels",
-            parts.to_str().unwrap(),
-            "--quiet",
-        ];
-        if let Some(t) = tile {
-            args.extend(["--tile", t]);
-        }
-        ok(&args);
-        (
-            std::fs::read_to_string(labels).unwrap(),
-            std::fs::read_to_string(parts).unwrap(),
-        )
-    };
-    let whole = run(None, "whole");
+    scene
+}
+
+/// `detect SCENE --structure planes` with `extra` flags, its labels and
+/// part labels written as `name.labels` and `name.parts` in `dir`: their
+/// texts.
+fn planes_labels(dir: &TempDir, scene: &Path, name: &str, extra: &[&str]) -> (String, String) {
+    let (labels, parts) = (
+        dir.path(&format!("{name}.labels")),
+        dir.path(&format!("{name}.parts")),
+    );
+    let mut args = vec![
+        "detect",
+        scene.to_str().unwrap(),
+        "--structure",
+        "planes",
+        "--labels",
+        labels.to_str().unwrap(),
+        "--part-labels",
+        parts.to_str().unwrap(),
+        "--quiet",
+    ];
+    args.extend(extra);
+    ok(&args);
+    (
+        std::fs::read_to_string(labels).unwrap(),
+        std::fs::read_to_string(parts).unwrap(),
+    )
+}
+
+#[test]
+fn detect_tile_gives_the_untiled_labels() {
+    // `detect --tile SIZE` (docs/method.md §8): tiles of side 15, smaller
+    // than the scene's planes (20–30 units across at spacing 3, in a
+    // 125-unit box; estimated α 0.75, λ 8, so halos of 12), each
+    // triangulated with its halo, give the same labels and part labels as
+    // one triangulation per orientation.
+    let dir = TempDir::new("e2e", "tile");
+    let scene = planes_scene(&dir);
+    let whole = planes_labels(&dir, &scene, "whole", &[]);
     assert!(whole.0.lines().any(|l| l != "-1"), "no structure found");
-    assert_eq!(run(Some("15"), "tiled"), whole);
+    assert_eq!(
+        planes_labels(&dir, &scene, "tiled", &["--tile", "15"]),
+        whole
+    );
 }
 
 #[test]
@@ -708,36 +719,16 @@ fn labels_alone_skip_the_outlines_and_keep_the_labels() {
     // run does not draw them; the labels are those of a run whose report
     // does hold them, a polygon per plane part.
     let dir = TempDir::new("e2e", "outlines");
-    let scene = dir.path("planes.xyz");
-    ok(&[
-        "synth",
-        "planes",
-        "--seed",
-        "3",
-        "--output",
-        scene.to_str().unwrap(),
-    ]);
-    let run = |report: Option<&Path>, name: &str| {
-        let parts = dir.path(&format!("{name}.parts"));
-        let mut args = vec![
-            "detect",
-            scene.to_str().unwrap(),
-            "--structure",
-            "planes",
-            "--part-labels",
-            parts.to_str().unwrap(),
-            "--quiet",
-        ];
-        if let Some(r) = report {
-            args.extend(["--report", r.to_str().unwrap()]);
-        }
-        ok(&args);
-        std::fs::read_to_string(parts).unwrap()
-    };
+    let scene = planes_scene(&dir);
     let report = dir.path("report.json");
-    let with = run(Some(&report), "with");
-    assert!(with.lines().any(|l| l != "-1"), "no part found");
-    assert_eq!(run(None, "without"), with);
+    let with = planes_labels(
+        &dir,
+        &scene,
+        "with",
+        &["--report", report.to_str().unwrap()],
+    );
+    assert!(with.1.lines().any(|l| l != "-1"), "no part found");
+    assert_eq!(planes_labels(&dir, &scene, "without", &[]), with);
     let r: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     let parts: Vec<&serde_json::Value> = r["structures"]
