@@ -213,8 +213,13 @@ impl<'py> DetectInput<'py> {
 /// orientation scanned, from the worker threads (the GIL taken for the
 /// call); returning `False` cancels the run, and an exception it raises
 /// cancels the run and is raised again from here.
+///
+/// `outlines` false skips the plane parts' outlines and meshes
+/// ([`Detector::outlines`](aniso_alpha::detect::Detector::outlines)):
+/// everything else is the same.
 #[pyfunction]
-#[pyo3(signature = (points, structure, options = None, threads = None, normals = None, progress = None))]
+#[pyo3(signature = (points, structure, options = None, threads = None, normals = None, progress = None, outlines = true))]
+#[allow(clippy::too_many_arguments)]
 fn detect<'py>(
     py: Python<'py>,
     points: &Bound<'py, PyAny>,
@@ -223,6 +228,7 @@ fn detect<'py>(
     threads: Option<i64>,
     normals: Option<&Bound<'py, PyAny>>,
     progress: Option<Py<PyAny>>,
+    outlines: bool,
 ) -> PyResult<DetectOut<'py>> {
     let options = options::detect_options(structure, options)?;
     let input = DetectInput::extract(points, normals, threads)?;
@@ -232,7 +238,7 @@ fn detect<'py>(
     // would start a second pool.
     let callback = progress.map(progress::Callback::new);
     let (det, json, warnings) = detached(py, threads, |n| {
-        let mut detector = options::build(&options, pts, normals)?;
+        let mut detector = options::build(&options, pts, normals)?.outlines(outlines);
         if let Some(cb) = &callback {
             detector = detector.progress(cb.tick());
         }

@@ -125,3 +125,33 @@ def test_normals_of_another_shape_are_a_value_error():
         aa.detect(pts, "planes", normals=normals[:10])
     with pytest.raises(ValueError, match="normals"):
         aa.detect(pts, "planes", normals=normals[:, :2])
+
+
+def test_outlines_off_changes_nothing_but_the_polygons(planes_auto, tmp_path):
+    """outlines=False: the same labels, equations, inliers and report, every
+    polygon empty (0, 3), and a PLY written from it without meshes."""
+    pts, _, det = planes_auto
+    bare = aa.detect(pts, "planes", outlines=False)
+    np.testing.assert_array_equal(bare.labels, det.labels)
+    np.testing.assert_array_equal(bare.part_labels, det.part_labels)
+    assert bare.parameters == det.parameters
+    assert len(bare.planes) == len(det.planes) >= 2
+    for a, b in zip(bare.planes, det.planes):
+        np.testing.assert_array_equal(a.equation, b.equation)
+        np.testing.assert_array_equal(a.inliers, b.inliers)
+        assert a.rms == b.rms
+        assert a.polygon.shape == (0, 3) and len(b.polygon) >= 3
+    strip = ("polygon", "triangles")
+
+    def without_outlines(structures):
+        return [
+            {**s, "parts": [{k: v for k, v in p.items() if k not in strip} for p in s["parts"]]}
+            for s in structures
+        ]
+
+    assert without_outlines(bare.structures) == without_outlines(det.structures)
+    with_meshes, bare_ply = tmp_path / "full.ply", tmp_path / "bare.ply"
+    aa.write(with_meshes, pts, det)
+    aa.write(bare_ply, pts, bare)
+    assert b"element face" in with_meshes.read_bytes()[:2000]
+    assert b"element face" not in bare_ply.read_bytes()[:2000]

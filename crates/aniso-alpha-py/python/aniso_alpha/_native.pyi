@@ -37,6 +37,7 @@ def detect(
     threads: Optional[int] = None,
     normals: Optional[ArrayLike] = None,
     progress: Optional[Callable[[int, int], Optional[bool]]] = None,
+    outlines: bool = True,
 ) -> _DetectOut:
     """(labels, part_labels, JSON text of {"structures": [...], "parameters": {...}},
     warnings, the detection)."""
