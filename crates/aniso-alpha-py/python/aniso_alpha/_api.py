@@ -268,11 +268,11 @@ def detect(
             call.
         outlines: compute each plane's outline (``Plane.polygon``) and the
             parts' meshes that :func:`write` puts in a PLY; ``False``
-            skips them, which is faster (8–16% on depth frames): every
-            ``polygon`` is then empty (0, 3), a part's ``"triangles"`` 0
-            and a PLY gets no meshes, while the labels, equations, inliers
-            and NFAs are the same. The CLI skips them when no output holds
-            them.
+            skips them, which is faster (4–13% of the CLI's time on depth
+            frames, BENCHMARKS.md): every ``polygon`` is then empty
+            (0, 3), a part's ``"triangles"`` 0 and a PLY gets no meshes,
+            while the labels, equations, inliers and NFAs are the same.
+            The CLI skips them when no output holds them.
 
     With ``alpha``, ``lambda3`` and ``min_size`` all given, this is the
     paper's run with explicit parameters (the box of orientations). With
