@@ -495,41 +495,93 @@ fn item_layers(item: Item) -> u64 {
 }
 
 /// Validates a LAZ file before the `laz` crate reads it; returns the
-/// parsed laszip VLR. See the module docs.
+/// parsed laszip VLR. See the module docs. The checks, in order: the
+/// laszip VLR's own fields ([`LaszipHeader::parse`]), its items against
+/// the point format ([`check_items`]), the chunk table ([`chunk_table`]),
+/// the points its chunks hold ([`check_chunk_points`]) and, for the
+/// layered formats 6–10, each chunk's layer sizes ([`check_layers`]).
 pub(crate) fn laz_precheck<B: LasBytes + ?Sized>(
     b: &B,
     layout: &Layout,
 ) -> Result<laz::LazVlr, String> {
     let data = find_laszip_vlr(b).ok_or("compressed point format but no laszip VLR")?;
-    let field = |o: usize, n: usize| data.get(o..o + n).ok_or("laszip VLR is too short");
-    let compressor = u16::from_le_bytes(field(0, 2)?.try_into().unwrap_or_default());
-    let coder = u16::from_le_bytes(field(2, 2)?.try_into().unwrap_or_default());
-    let chunk_size = u32::from_le_bytes(field(12, 4)?.try_into().unwrap_or_default());
-    let num_items = usize::from(u16::from_le_bytes(
-        field(32, 2)?.try_into().unwrap_or_default(),
-    ));
-    if !(compressor == 2 || compressor == 3) {
-        return Err(format!(
-            "unsupported LAZ compressor {compressor} (expected chunked: 2 or 3)"
+    let header = LaszipHeader::parse(&data)?;
+    let layered = check_items(b, layout, &header)?;
+    let vlr = laz::LazVlr::from_buffer(&data).map_err(|e| format!("laszip VLR: {e}"))?;
+    let Some(table) = chunk_table(b, layout, header.variable())? else {
+        return Ok(vlr);
+    };
+    check_chunk_points(&table, layout, &header)?;
+    if layered {
+        check_layers(b, layout, &header.items, &table.entries)?;
+    }
+    Ok(vlr)
+}
+
+/// The fields of a laszip VLR that the checks read.
+struct LaszipHeader {
+    /// 2 (chunked) or 3 (chunked, layered).
+    compressor: u16,
+    /// Points per chunk; 0 or `u32::MAX`: chunks of variable size.
+    chunk_size: u32,
+    /// (kind, size, version) of each item.
+    items: Vec<Item>,
+}
+
+impl LaszipHeader {
+    /// The VLR's compressor, coder, chunk size and items, checked on their
+    /// own.
+    fn parse(data: &[u8]) -> Result<Self, String> {
+        let field = |o: usize, n: usize| data.get(o..o + n).ok_or("laszip VLR is too short");
+        let compressor = u16::from_le_bytes(field(0, 2)?.try_into().unwrap_or_default());
+        let coder = u16::from_le_bytes(field(2, 2)?.try_into().unwrap_or_default());
+        let chunk_size = u32::from_le_bytes(field(12, 4)?.try_into().unwrap_or_default());
+        let num_items = usize::from(u16::from_le_bytes(
+            field(32, 2)?.try_into().unwrap_or_default(),
         ));
-    }
-    if coder != 0 {
-        return Err(format!("unknown LAZ coder {coder}"));
-    }
-    if num_items == 0 {
-        return Err("the laszip VLR lists no items".into());
-    }
-    let raw_items = field(34, 6 * num_items)?;
-    let items: Vec<Item> = raw_items
-        .chunks_exact(6)
-        .map(|c| {
-            (
-                u16::from_le_bytes([c[0], c[1]]),
-                u16::from_le_bytes([c[2], c[3]]),
-                u16::from_le_bytes([c[4], c[5]]),
-            )
+        if !(compressor == 2 || compressor == 3) {
+            return Err(format!(
+                "unsupported LAZ compressor {compressor} (expected chunked: 2 or 3)"
+            ));
+        }
+        if coder != 0 {
+            return Err(format!("unknown LAZ coder {coder}"));
+        }
+        if num_items == 0 {
+            return Err("the laszip VLR lists no items".into());
+        }
+        let items = field(34, 6 * num_items)?
+            .chunks_exact(6)
+            .map(|c| {
+                (
+                    u16::from_le_bytes([c[0], c[1]]),
+                    u16::from_le_bytes([c[2], c[3]]),
+                    u16::from_le_bytes([c[4], c[5]]),
+                )
+            })
+            .collect();
+        Ok(LaszipHeader {
+            compressor,
+            chunk_size,
+            items,
         })
-        .collect();
+    }
+
+    /// Whether the chunks hold a variable number of points each.
+    fn variable(&self) -> bool {
+        self.chunk_size == 0 || self.chunk_size == u32::MAX
+    }
+}
+
+/// The VLR's items against the header's point format and record length:
+/// the kinds the format needs, each of its size and of a version the
+/// format allows, and the compressor that goes with it. Returns whether
+/// the format is layered (6–10).
+fn check_items<B: LasBytes + ?Sized>(
+    b: &B,
+    layout: &Layout,
+    header: &LaszipHeader,
+) -> Result<bool, String> {
     let format = u8_at(b, 104).unwrap_or(0) & 0x3F;
     let base = match format {
         0 => 20,
@@ -552,13 +604,13 @@ pub(crate) fn laz_precheck<B: LasBytes + ?Sized>(
         .ok_or("record length shorter than the point format")?;
     let want = expected_items(format, extra).ok_or("unknown point format")?;
     let layered = format >= 6;
-    let kinds: Vec<u16> = items.iter().map(|i| i.0).collect();
+    let kinds: Vec<u16> = header.items.iter().map(|i| i.0).collect();
     if kinds != want {
         return Err(format!(
             "the laszip VLR's items {kinds:?} do not describe point format {format} with {extra} extra bytes"
         ));
     }
-    for &(kind, size, version) in &items {
+    for &(kind, size, version) in &header.items {
         let ok_size = match kind {
             0 | 14 => size == extra,
             _ => item_size(kind) == Some(size),
@@ -577,16 +629,35 @@ pub(crate) fn laz_precheck<B: LasBytes + ?Sized>(
             ));
         }
     }
+    let compressor = header.compressor;
     if (compressor == 3) != layered {
         return Err(format!(
             "LAZ compressor {compressor} does not fit point format {format}"
         ));
     }
-    let vlr = laz::LazVlr::from_buffer(&data).map_err(|e| format!("laszip VLR: {e}"))?;
-    let variable = chunk_size == 0 || chunk_size == u32::MAX;
+    Ok(layered)
+}
 
-    // The chunk table: its offset is the first 8 bytes of the point data
-    // (or, when the writer could not seek back, the last 8 bytes of the file).
+/// A LAZ file's chunk table.
+struct ChunkTable {
+    /// (points, bytes) of each chunk; the points are 0 in a table of
+    /// fixed-size chunks.
+    entries: Vec<(u64, u64)>,
+    /// The chunks the table declares.
+    count: u64,
+    /// The bytes of compressed data before the table.
+    compressed_bytes: u64,
+}
+
+/// The chunk table, found where the first 8 bytes of the point data say
+/// (or, when the writer could not seek back, the last 8 bytes of the
+/// file), its count bounded by the compressed data's size before it is
+/// read; `None` for an empty table of a file without points.
+fn chunk_table<B: LasBytes + ?Sized>(
+    b: &B,
+    layout: &Layout,
+    variable: bool,
+) -> Result<Option<ChunkTable>, String> {
     let len = b.size();
     let start = layout.data_start as u64;
     let mut table = u64_at(b, start).ok_or("no LAZ point data")? as i64;
@@ -616,21 +687,38 @@ pub(crate) fn laz_precheck<B: LasBytes + ?Sized>(
         if layout.points > 0 {
             return Err("LAZ chunk table is empty but the header declares points".into());
         }
-        return Ok(vlr);
+        return Ok(None);
     }
     let mut cur = ByteReader::new(b);
     cur.seek(SeekFrom::Start(table))
         .map_err(|e| format!("LAZ chunk table: {e}"))?;
     let entries = laz::laszip::ChunkTable::read(&mut cur, variable)
         .map_err(|e| format!("LAZ chunk table: {e}"))?;
-    let entries: Vec<(u64, u64)> = entries
+    let entries = entries
         .as_ref()
         .iter()
         .map(|e| (e.point_count, e.byte_count))
         .collect();
+    Ok(Some(ChunkTable {
+        entries,
+        count,
+        compressed_bytes,
+    }))
+}
+
+/// The chunks against the data and the header: each holds its first
+/// record (and, when their sizes vary, a point), their bytes fit in the
+/// compressed data, and their points are at least the header's.
+fn check_chunk_points(
+    table: &ChunkTable,
+    layout: &Layout,
+    header: &LaszipHeader,
+) -> Result<(), String> {
+    let record_len = layout.record_len as u64;
+    let variable = header.variable();
     let mut total_bytes = 0u64;
     let mut total_points = 0u64;
-    for &(points, bytes) in &entries {
+    for &(points, bytes) in &table.entries {
         if bytes < record_len {
             return Err(format!(
                 "LAZ chunk table: a chunk of {bytes} bytes cannot hold its first record"
@@ -644,13 +732,14 @@ pub(crate) fn laz_precheck<B: LasBytes + ?Sized>(
             total_points = total_points.saturating_add(points);
         }
     }
+    let compressed_bytes = table.compressed_bytes;
     if total_bytes > compressed_bytes {
         return Err(format!(
             "LAZ chunk table: chunks of {total_bytes} bytes in {compressed_bytes} bytes of data"
         ));
     }
     if !variable {
-        total_points = count.saturating_mul(u64::from(chunk_size));
+        total_points = table.count.saturating_mul(u64::from(header.chunk_size));
     }
     if total_points < layout.points {
         return Err(format!(
@@ -658,32 +747,42 @@ pub(crate) fn laz_precheck<B: LasBytes + ?Sized>(
             layout.points
         ));
     }
-    if layered {
-        let layers: u64 = items.iter().map(|&i| item_layers(i)).sum();
-        let mut at = start + 8;
-        for &(_, bytes) in &entries {
-            let head = record_len + 4 + 4 * layers;
-            if bytes < head {
-                return Err("LAZ chunk too short for its layer sizes".into());
-            }
-            let sizes_at = at + record_len + 4;
-            let sizes = b
-                .piece(sizes_at, 4 * layers)
-                .ok_or("LAZ chunk past the end of the file")?;
-            let sum: u64 = sizes
-                .chunks_exact(4)
-                .map(|c| u64::from(u32::from_le_bytes([c[0], c[1], c[2], c[3]])))
-                .sum();
-            if sum > bytes - head {
-                return Err(format!(
-                    "LAZ chunk declares {sum} bytes of layers in {} bytes",
-                    bytes - head
-                ));
-            }
-            at += bytes;
+    Ok(())
+}
+
+/// For the layered formats: each chunk's layer sizes, read after its first
+/// record and point count, fit in the chunk.
+fn check_layers<B: LasBytes + ?Sized>(
+    b: &B,
+    layout: &Layout,
+    items: &[Item],
+    entries: &[(u64, u64)],
+) -> Result<(), String> {
+    let record_len = layout.record_len as u64;
+    let layers: u64 = items.iter().map(|&i| item_layers(i)).sum();
+    let mut at = layout.data_start as u64 + 8;
+    for &(_, bytes) in entries {
+        let head = record_len + 4 + 4 * layers;
+        if bytes < head {
+            return Err("LAZ chunk too short for its layer sizes".into());
         }
+        let sizes_at = at + record_len + 4;
+        let sizes = b
+            .piece(sizes_at, 4 * layers)
+            .ok_or("LAZ chunk past the end of the file")?;
+        let sum: u64 = sizes
+            .chunks_exact(4)
+            .map(|c| u64::from(u32::from_le_bytes([c[0], c[1], c[2], c[3]])))
+            .sum();
+        if sum > bytes - head {
+            return Err(format!(
+                "LAZ chunk declares {sum} bytes of layers in {} bytes",
+                bytes - head
+            ));
+        }
+        at += bytes;
     }
-    Ok(vlr)
+    Ok(())
 }
 
 /// `size` times `done / count`.
@@ -777,6 +876,110 @@ mod tests {
         let all: std::collections::HashSet<String> =
             (0..65_536).map(|_| n.unique("same", "f")).collect();
         assert_eq!(all.len(), 65_536);
+    }
+
+    /// A laszip VLR's payload: compressor, coder 0, the chunk size, and
+    /// the items (kind, size, version).
+    fn laszip(compressor: u16, coder: u16, chunk_size: u32, items: &[Item]) -> Vec<u8> {
+        let mut v = vec![0u8; 34];
+        v[0..2].copy_from_slice(&compressor.to_le_bytes());
+        v[2..4].copy_from_slice(&coder.to_le_bytes());
+        v[12..16].copy_from_slice(&chunk_size.to_le_bytes());
+        v[32..34].copy_from_slice(&(items.len() as u16).to_le_bytes());
+        for &(kind, size, version) in items {
+            for x in [kind, size, version] {
+                v.extend_from_slice(&x.to_le_bytes());
+            }
+        }
+        v
+    }
+
+    fn layout(record_len: usize, points: u64) -> Layout {
+        Layout {
+            data_start: 0,
+            record_len,
+            points,
+            compressed: true,
+            extended: false,
+            scale: [1.0; 3],
+            offset: [0.0; 3],
+        }
+    }
+
+    #[test]
+    fn laszip_header_fields_are_checked_on_their_own() {
+        let h = LaszipHeader::parse(&laszip(2, 0, 50_000, &[(6, 20, 2)])).unwrap();
+        assert_eq!((h.compressor, h.chunk_size), (2, 50_000));
+        assert_eq!(h.items, vec![(6, 20, 2)]);
+        assert!(!h.variable());
+        assert!(LaszipHeader::parse(&laszip(3, 0, u32::MAX, &[(10, 30, 3)]))
+            .unwrap()
+            .variable());
+        let err = |v: Vec<u8>| LaszipHeader::parse(&v).err().unwrap();
+        assert!(err(laszip(1, 0, 0, &[(6, 20, 2)])).contains("unsupported LAZ compressor 1"));
+        assert!(err(laszip(2, 1, 0, &[(6, 20, 2)])).contains("unknown LAZ coder 1"));
+        assert!(err(laszip(2, 0, 0, &[])).contains("lists no items"));
+        let mut short = laszip(2, 0, 0, &[(6, 20, 2), (7, 8, 2)]);
+        short.truncate(36);
+        assert!(err(short).contains("too short"));
+    }
+
+    #[test]
+    fn chunks_must_hold_the_header_s_points_in_the_data() {
+        let fixed = LaszipHeader::parse(&laszip(2, 0, 100, &[(6, 20, 2)])).unwrap();
+        let variable = LaszipHeader::parse(&laszip(2, 0, 0, &[(6, 20, 2)])).unwrap();
+        let table = |entries: Vec<(u64, u64)>, compressed_bytes| ChunkTable {
+            count: entries.len() as u64,
+            entries,
+            compressed_bytes,
+        };
+        // Two fixed chunks of 100 points: 200 points at most.
+        let two = table(vec![(0, 40), (0, 40)], 80);
+        assert!(check_chunk_points(&two, &layout(20, 200), &fixed).is_ok());
+        let e = check_chunk_points(&two, &layout(20, 201), &fixed).unwrap_err();
+        assert!(
+            e.contains("holds 200 points, the header declares 201"),
+            "{e}"
+        );
+        let e = check_chunk_points(&table(vec![(0, 40), (0, 40)], 79), &layout(20, 1), &fixed)
+            .unwrap_err();
+        assert!(e.contains("chunks of 80 bytes in 79 bytes"), "{e}");
+        let e = check_chunk_points(&table(vec![(0, 19)], 80), &layout(20, 1), &fixed).unwrap_err();
+        assert!(e.contains("cannot hold its first record"), "{e}");
+        // Variable chunks count their own points.
+        let var = table(vec![(3, 40), (4, 40)], 80);
+        assert!(check_chunk_points(&var, &layout(20, 7), &variable).is_ok());
+        assert!(check_chunk_points(&var, &layout(20, 8), &variable).is_err());
+        let e =
+            check_chunk_points(&table(vec![(0, 40)], 80), &layout(20, 0), &variable).unwrap_err();
+        assert!(e.contains("a chunk of 0 points"), "{e}");
+    }
+
+    #[test]
+    fn layered_chunks_must_hold_their_layers() {
+        // Point format 6 (one layer item of 9 layers) in records of 30
+        // bytes: a chunk is its first record, a point count, 9 layer sizes
+        // and the layers.
+        let items = [(10, 30, 3)];
+        let layers = item_layers(items[0]);
+        let head = 30 + 4 + 4 * layers;
+        let chunk = |sizes: u32| {
+            let mut c = vec![0u8; 8 + 30 + 4];
+            for _ in 0..layers {
+                c.extend_from_slice(&sizes.to_le_bytes());
+            }
+            c
+        };
+        let ok = chunk(1);
+        let bytes = head + layers;
+        assert!(check_layers(ok.as_slice(), &layout(30, 1), &items, &[(1, bytes)]).is_ok());
+        let e = check_layers(ok.as_slice(), &layout(30, 1), &items, &[(1, bytes - 1)]).unwrap_err();
+        assert!(e.contains("bytes of layers in"), "{e}");
+        let e = check_layers(ok.as_slice(), &layout(30, 1), &items, &[(1, head - 1)]).unwrap_err();
+        assert!(e.contains("too short for its layer sizes"), "{e}");
+        let cut = &ok[..ok.len() - 1];
+        let e = check_layers(cut, &layout(30, 1), &items, &[(1, bytes)]).unwrap_err();
+        assert!(e.contains("past the end of the file"), "{e}");
     }
 
     #[test]
