@@ -562,6 +562,60 @@ pub fn write_html(
 
 /// The self-contained HTML page of `input`.
 pub fn html(input: &ViewInput<'_>) -> Result<String, CliError> {
+    check_input(input)?;
+    let mut scene = structures_of(input);
+    let counts = drawn_points(&mut scene, input.max_points);
+    let frame = frame(input.points);
+    let focus = first_view(input.points, &scene.members_of, &frame);
+    let buffers = vertex_buffers(input, &scene, frame.center);
+    let model = script_model(input, &frame, focus, &scene, &counts, &buffers);
+    Ok(page(input, &scene, &counts, &model, &buffers))
+}
+
+/// The structures, and which points belong to each or to the background.
+struct Scene {
+    /// From the report first, then those only the labels name.
+    structures: Vec<StructureView>,
+    /// Per structure (as indexed in `structures`): its points.
+    members_of: Vec<Vec<u32>>,
+    /// The points of no structure.
+    background: Vec<u32>,
+}
+
+/// How many points there are and how many are drawn.
+struct Counts {
+    /// Background points before thinning.
+    background_total: usize,
+    /// Points drawn, background and structures.
+    shown: usize,
+}
+
+/// Where the scene lies: the bounding box's centre and half-diagonal.
+struct Frame {
+    center: [f64; 3],
+    radius: f64,
+}
+
+/// The vertex buffers of the points and the outlines, and each structure's
+/// range (first vertex, vertex count) in them.
+struct Buffers {
+    /// Points: positions (`float32` × 3, relative to the centre).
+    pos: Vec<u8>,
+    /// Points: colours (`uint8` RGB).
+    col: Vec<u8>,
+    /// Per structure: its points' range.
+    ranges: Vec<(usize, usize)>,
+    /// Outline segments: positions, two vertices a segment.
+    lpos: Vec<u8>,
+    /// Outline segments: colours.
+    lcol: Vec<u8>,
+    /// Per structure: its outline vertices' range.
+    lranges: Vec<(usize, usize)>,
+}
+
+/// The errors of an input that cannot make a page: labels of the wrong
+/// length, a cap of zero.
+fn check_input(input: &ViewInput<'_>) -> Result<(), CliError> {
     let n = input.points.len();
     for (what, v) in [("labels", input.labels), ("part labels", input.parts)] {
         if let Some(v) = v {
@@ -573,9 +627,41 @@ pub fn html(input: &ViewInput<'_>) -> Result<String, CliError> {
     if input.max_points == 0 {
         return Err(CliError::msg("--max-points must be at least 1"));
     }
+    Ok(())
+}
 
-    // ---- structures: from the report, then those only the labels name
-    // (in id order).
+/// The structures (from the report, then those only the labels name, in id
+/// order), their points and parts, completed from the points where the
+/// report is silent.
+fn structures_of(input: &ViewInput<'_>) -> Scene {
+    let (mut structures, index_of_id) = structure_list(input);
+    let mut members_of: Vec<Vec<u32>> = vec![Vec::new(); structures.len()];
+    let mut background: Vec<u32> = Vec::new();
+    match input.labels {
+        Some(labels) => {
+            for (i, &l) in labels.iter().enumerate() {
+                if l < 0 {
+                    background.push(i as u32);
+                } else {
+                    members_of[index_of_id[&l]].push(i as u32);
+                }
+            }
+        }
+        None => background.extend(0..input.points.len() as u32),
+    }
+    let part_members = part_members_of(input.parts);
+    attach_label_parts(&mut structures, &part_members, input.labels, &index_of_id);
+    complete_from_points(&mut structures, &members_of, &part_members, input.points);
+    Scene {
+        structures,
+        members_of,
+        background,
+    }
+}
+
+/// The report's structures, then one per label id the report does not
+/// know (in id order), and the index of each id in that list.
+fn structure_list(input: &ViewInput<'_>) -> (Vec<StructureView>, BTreeMap<i64, usize>) {
     let mut structures = input.report.map(structures_from_report).unwrap_or_default();
     let mut index_of_id: BTreeMap<i64, usize> = BTreeMap::new();
     for (k, s) in structures.iter().enumerate() {
@@ -599,42 +685,40 @@ pub fn html(input: &ViewInput<'_>) -> Result<String, CliError> {
             });
         }
     }
-    let mut members_of: Vec<Vec<u32>> = vec![Vec::new(); structures.len()];
-    let mut background: Vec<u32> = Vec::new();
-    match input.labels {
-        Some(labels) => {
-            for (i, &l) in labels.iter().enumerate() {
-                if l < 0 {
-                    background.push(i as u32);
-                } else {
-                    members_of[index_of_id[&l]].push(i as u32);
-                }
-            }
-        }
-        None => background.extend(0..n as u32),
-    }
+    (structures, index_of_id)
+}
 
-    // Parts known from the part labels only, and the members of each part.
+/// The members of each part the part labels name, by part id.
+fn part_members_of(parts: Option<&[i64]>) -> BTreeMap<i64, Vec<u32>> {
     let mut part_members: BTreeMap<i64, Vec<u32>> = Default::default();
-    if let Some(parts) = input.parts {
+    if let Some(parts) = parts {
         for (i, &p) in parts.iter().enumerate() {
             if p >= 0 {
                 part_members.entry(p).or_default().push(i as u32);
             }
         }
     }
+    part_members
+}
+
+/// Parts known from the part labels only: each goes to the structure
+/// holding most of its points.
+fn attach_label_parts(
+    structures: &mut [StructureView],
+    part_members: &BTreeMap<i64, Vec<u32>>,
+    labels: Option<&[i64]>,
+    index_of_id: &BTreeMap<i64, usize>,
+) {
     let structure_of_point = |i: u32| -> Option<usize> {
-        let l = input.labels?[i as usize];
+        let l = labels?[i as usize];
         index_of_id.get(&l).copied()
     };
-    // Parts not in the report: give each to the structure holding most of
-    // its points.
     let known_parts: BTreeSet<i64> = structures
         .iter()
         .flat_map(|s| s.parts.iter().filter_map(|p| p.id))
         .collect();
     let mut extra: Vec<(usize, i64)> = Vec::new();
-    for (&pid, members) in &part_members {
+    for (&pid, members) in part_members {
         if known_parts.contains(&pid) {
             continue;
         }
@@ -658,15 +742,22 @@ pub fn html(input: &ViewInput<'_>) -> Result<String, CliError> {
             ..Default::default()
         });
     }
+}
 
-    // Kinds, counts and outlines from the points where the report is silent.
+/// Kinds, counts and outlines from the points where the report is silent.
+fn complete_from_points(
+    structures: &mut [StructureView],
+    members_of: &[Vec<u32>],
+    part_members: &BTreeMap<i64, Vec<u32>>,
+    points: &[[f64; 3]],
+) {
     for (k, s) in structures.iter_mut().enumerate() {
         let members = &members_of[k];
         if s.points.is_none() {
             s.points = Some(members.len() as u64);
         }
         if s.kind == Kind::Unknown && members.len() >= 3 {
-            s.kind = guess_kind(input.points, members, s.parts.len());
+            s.kind = guess_kind(points, members, s.parts.len());
         }
         let linear = s.kind.linear().unwrap_or(false);
         let n_parts = s.parts.len();
@@ -679,7 +770,7 @@ pub fn html(input: &ViewInput<'_>) -> Result<String, CliError> {
             }
             let pts: Option<&Vec<u32>> = own.or(if n_parts == 1 { Some(members) } else { None });
             if let Some(pts) = pts.filter(|p| p.len() >= 2) {
-                if let Some(o) = outline_of_points(input.points, pts, linear) {
+                if let Some(o) = outline_of_points(points, pts, linear) {
                     part.outline = o.vertices;
                     part.closed = o.closed;
                     part.outline_source = "points";
@@ -693,7 +784,7 @@ pub fn html(input: &ViewInput<'_>) -> Result<String, CliError> {
             }
         }
         if s.parts.is_empty() && members.len() >= 3 {
-            if let Some(o) = outline_of_points(input.points, members, linear) {
+            if let Some(o) = outline_of_points(points, members, linear) {
                 s.parts.push(PartView {
                     id: None,
                     points: Some(members.len() as u64),
@@ -713,29 +804,41 @@ pub fn html(input: &ViewInput<'_>) -> Result<String, CliError> {
             s.rms = s.rms.or(s.parts[0].rms);
         }
     }
+}
 
-    // ---- which points are drawn.
+/// Which points are drawn: thins the background first (down to a tenth of
+/// `cap`), then the structures, each in proportion.
+fn drawn_points(scene: &mut Scene, cap: usize) -> Counts {
+    let members_of = &mut scene.members_of;
+    let background = &mut scene.background;
     let n_struct: usize = members_of.iter().map(Vec::len).sum();
     let n_bg_all = background.len();
-    let cap = input.max_points;
     let bg_keep = if n_bg_all + n_struct <= cap {
         n_bg_all
     } else {
         n_bg_all.min(cap.saturating_sub(n_struct).max(cap / 10))
     };
-    thin(&mut background, bg_keep);
+    thin(background, bg_keep);
     let struct_budget = cap - background.len();
     if n_struct > struct_budget {
-        for m in &mut members_of {
+        for m in members_of.iter_mut() {
             let keep = ((m.len() as u128 * struct_budget as u128) / n_struct as u128) as usize;
             thin(m, keep);
         }
     }
     let shown: usize = background.len() + members_of.iter().map(Vec::len).sum::<usize>();
+    Counts {
+        background_total: n_bg_all,
+        shown,
+    }
+}
 
-    // ---- geometry: centre and radius.
+/// The geometry: the centre of the points' bounding box and its
+/// half-diagonal (1 for no points or a single one).
+fn frame(points: &[[f64; 3]]) -> Frame {
+    let n = points.len();
     let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for p in input.points {
+    for p in points {
         for k in 0..3 {
             lo[k] = lo[k].min(p[k]);
             hi[k] = hi[k].max(p[k]);
@@ -762,29 +865,44 @@ pub fn html(input: &ViewInput<'_>) -> Result<String, CliError> {
             1.0
         }
     };
+    Frame { center, radius }
+}
 
-    // ---- the first view: framed on the structures, else on everything.
-    let focus = {
-        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-        for &i in members_of.iter().flatten() {
-            let p = input.points[i as usize];
-            for k in 0..3 {
-                lo[k] = lo[k].min(p[k]);
-                hi[k] = hi[k].max(p[k]);
-            }
+/// The first view (`{"center", "radius"}`, relative to the frame's centre):
+/// framed on the structures' drawn points, else on everything.
+fn first_view(points: &[[f64; 3]], members_of: &[Vec<u32>], frame: &Frame) -> Value {
+    let (center, radius) = (frame.center, frame.radius);
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for &i in members_of.iter().flatten() {
+        let p = points[i as usize];
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
         }
-        if lo[0] <= hi[0] {
-            let c: Vec<f64> = (0..3).map(|k| (lo[k] + hi[k]) / 2.0 - center[k]).collect();
-            let r = ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2))
-                .sqrt()
-                / 2.0;
-            json!({"center": c, "radius": if r > 0.0 { r * 1.2 } else { radius }})
-        } else {
-            json!({"center": [0.0, 0.0, 0.0], "radius": radius})
-        }
-    };
+    }
+    if lo[0] <= hi[0] {
+        let c: Vec<f64> = (0..3).map(|k| (lo[k] + hi[k]) / 2.0 - center[k]).collect();
+        let r = ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2))
+            .sqrt()
+            / 2.0;
+        json!({"center": c, "radius": if r > 0.0 { r * 1.2 } else { radius }})
+    } else {
+        json!({"center": [0.0, 0.0, 0.0], "radius": radius})
+    }
+}
 
-    // ---- vertex buffers.
+/// Appends `p`, relative to `center`, as three little-endian `float32`.
+fn push_pos(pos: &mut Vec<u8>, p: [f64; 3], center: [f64; 3]) {
+    for k in 0..3 {
+        pos.extend_from_slice(&((p[k] - center[k]) as f32).to_le_bytes());
+    }
+}
+
+/// The vertex buffers: the drawn points (background first, then structure
+/// by structure) and the parts' outlines as line segments.
+fn vertex_buffers(input: &ViewInput<'_>, scene: &Scene, center: [f64; 3]) -> Buffers {
+    let structures = &scene.structures;
+    let shown = scene.background.len() + scene.members_of.iter().map(Vec::len).sum::<usize>();
     let part_index: BTreeMap<i64, usize> = structures
         .iter()
         .flat_map(|s| {
@@ -796,26 +914,21 @@ pub fn html(input: &ViewInput<'_>) -> Result<String, CliError> {
         .collect();
     let mut pos: Vec<u8> = Vec::with_capacity(shown * 12);
     let mut col: Vec<u8> = Vec::with_capacity(shown * 3);
-    let push_pos = |pos: &mut Vec<u8>, p: [f64; 3]| {
-        for k in 0..3 {
-            pos.extend_from_slice(&((p[k] - center[k]) as f32).to_le_bytes());
-        }
-    };
     // Unlabelled points are not background: drawn light, not dimmed.
     let bg_color = if input.labels.is_some() {
         BACKGROUND_DARK
     } else {
         UNLABELLED
     };
-    for &i in &background {
-        push_pos(&mut pos, input.points[i as usize]);
+    for &i in &scene.background {
+        push_pos(&mut pos, input.points[i as usize], center);
         col.extend_from_slice(&bg_color);
     }
     let mut ranges = Vec::with_capacity(structures.len());
-    let mut start = background.len();
-    for (k, m) in members_of.iter().enumerate() {
+    let mut start = scene.background.len();
+    for (k, m) in scene.members_of.iter().enumerate() {
         for &i in m {
-            push_pos(&mut pos, input.points[i as usize]);
+            push_pos(&mut pos, input.points[i as usize], center);
             let part = input
                 .parts
                 .map(|p| p[i as usize])
@@ -844,8 +957,8 @@ pub fn html(input: &ViewInput<'_>) -> Result<String, CliError> {
                 m.saturating_sub(1)
             };
             for e in 0..segs {
-                push_pos(&mut lpos, p.outline[e]);
-                push_pos(&mut lpos, p.outline[(e + 1) % m]);
+                push_pos(&mut lpos, p.outline[e], center);
+                push_pos(&mut lpos, p.outline[(e + 1) % m], center);
                 lcol.extend_from_slice(&c);
                 lcol.extend_from_slice(&c);
                 count += 2;
@@ -854,17 +967,39 @@ pub fn html(input: &ViewInput<'_>) -> Result<String, CliError> {
         lranges.push((lstart, count));
         lstart += count;
     }
+    Buffers {
+        pos,
+        col,
+        ranges,
+        lpos,
+        lcol,
+        lranges,
+    }
+}
 
-    // ---- the model for the script.
+/// The JSON model for the script, escaped for a `<script>` element.
+fn script_model(
+    input: &ViewInput<'_>,
+    frame: &Frame,
+    focus: Value,
+    scene: &Scene,
+    counts: &Counts,
+    buffers: &Buffers,
+) -> String {
+    let (ranges, lranges) = (&buffers.ranges, &buffers.lranges);
     let model = json!({
         "title": input.title,
-        "input_points": n,
-        "shown_points": shown,
-        "radius": radius,
-        "center": center,
+        "input_points": input.points.len(),
+        "shown_points": counts.shown,
+        "radius": frame.radius,
+        "center": frame.center,
         "focus": focus,
-        "background": {"start": 0, "count": background.len(), "total": n_bg_all},
-        "structures": structures.iter().enumerate().map(|(k, s)| json!({
+        "background": {
+            "start": 0,
+            "count": scene.background.len(),
+            "total": counts.background_total,
+        },
+        "structures": scene.structures.iter().enumerate().map(|(k, s)| json!({
             "id": s.id,
             "kind": s.kind.name(),
             "points": s.points,
@@ -874,9 +1009,12 @@ pub fn html(input: &ViewInput<'_>) -> Result<String, CliError> {
             "lcount": lranges[k].1,
         })).collect::<Vec<_>>(),
     });
-    let model = model.to_string().replace("</", "<\\/");
+    model.to_string().replace("</", "<\\/")
+}
 
-    // ---- the page.
+/// The legend's items: one per structure, with its equation and, for more
+/// than one part, the list of its parts.
+fn legend(structures: &[StructureView]) -> String {
     let mut legend = String::new();
     for (k, s) in structures.iter().enumerate() {
         let mut line = format!(
@@ -923,37 +1061,50 @@ pub fn html(input: &ViewInput<'_>) -> Result<String, CliError> {
                 s.parts.len()
             );
             for (j, p) in s.parts.iter().enumerate() {
-                let mut t = String::new();
-                if let Some(id) = p.id {
-                    let _ = write!(t, "part {id}");
-                }
-                if let Some(c) = p.points {
-                    let _ = write!(t, " · {c} pts");
-                }
-                if let Some(r) = p.rms {
-                    let _ = write!(t, " · rms {}", fmt_num(r));
-                }
-                if let Some(x) = p.log10_nfa {
-                    let _ = write!(t, " · NFA {}", fmt_nfa(x));
-                }
-                let eq = match (p.plane, p.segment) {
-                    (Some(pl), _) => fmt_plane(pl),
-                    (None, Some(g)) => fmt_segment(g),
-                    _ => String::new(),
-                };
-                let _ = write!(
-                    legend,
-                    "<li><span class=\"sw\" style=\"background:{}\"></span>{}<div class=\"eq\">{}</div></li>",
-                    hex(part_color(k, j)),
-                    html_escape(t.trim_start_matches(" · ")),
-                    html_escape(&eq)
-                );
+                legend_part(&mut legend, k, j, p);
             }
             legend.push_str("</ol></details>");
         }
         legend.push_str("</li>");
     }
-    let info = format!(
+    legend
+}
+
+/// Appends the legend item of part `j` of structure `k`.
+fn legend_part(legend: &mut String, k: usize, j: usize, p: &PartView) {
+    let mut t = String::new();
+    if let Some(id) = p.id {
+        let _ = write!(t, "part {id}");
+    }
+    if let Some(c) = p.points {
+        let _ = write!(t, " · {c} pts");
+    }
+    if let Some(r) = p.rms {
+        let _ = write!(t, " · rms {}", fmt_num(r));
+    }
+    if let Some(x) = p.log10_nfa {
+        let _ = write!(t, " · NFA {}", fmt_nfa(x));
+    }
+    let eq = match (p.plane, p.segment) {
+        (Some(pl), _) => fmt_plane(pl),
+        (None, Some(g)) => fmt_segment(g),
+        _ => String::new(),
+    };
+    let _ = write!(
+        legend,
+        "<li><span class=\"sw\" style=\"background:{}\"></span>{}<div class=\"eq\">{}</div></li>",
+        hex(part_color(k, j)),
+        html_escape(t.trim_start_matches(" · ")),
+        html_escape(&eq)
+    );
+}
+
+/// The line saying how many points, structures and background points
+/// there are, and how many are drawn.
+fn info_line(input: &ViewInput<'_>, scene: &Scene, counts: &Counts) -> String {
+    let n = input.points.len();
+    let (shown, cap, n_bg_all) = (counts.shown, input.max_points, counts.background_total);
+    format!(
         "{} points{}; {} structure(s), {} background point(s){}",
         n,
         if shown < n {
@@ -961,16 +1112,19 @@ pub fn html(input: &ViewInput<'_>) -> Result<String, CliError> {
         } else {
             String::new()
         },
-        structures.len(),
+        scene.structures.len(),
         n_bg_all,
-        if background.len() < n_bg_all {
-            format!(", {} drawn", background.len())
+        if scene.background.len() < n_bg_all {
+            format!(", {} drawn", scene.background.len())
         } else {
             String::new()
         }
-    );
-    let params = input
-        .report
+    )
+}
+
+/// The report's parameters as one paragraph, or nothing without them.
+fn params_paragraph(report: Option<&Value>) -> String {
+    report
         .and_then(|r| r.get("parameters"))
         .filter(|p| p.is_object())
         .map(|p| {
@@ -999,8 +1153,29 @@ pub fn html(input: &ViewInput<'_>) -> Result<String, CliError> {
                 html_escape(s.trim_end_matches(", "))
             )
         })
-        .unwrap_or_default();
+        .unwrap_or_default()
+}
+
+/// The page: the panel (title, counts, parameters, controls, legend), the
+/// model, the base64 vertex buffers and the script.
+fn page(
+    input: &ViewInput<'_>,
+    scene: &Scene,
+    counts: &Counts,
+    model: &str,
+    buffers: &Buffers,
+) -> String {
+    let legend = legend(&scene.structures);
+    let info = info_line(input, scene, counts);
+    let params = params_paragraph(input.report);
     let title = html_escape(input.title);
+    let Buffers {
+        pos,
+        col,
+        lpos,
+        lcol,
+        ..
+    } = buffers;
     let mut page = String::with_capacity(pos.len() * 4 / 3 + col.len() * 4 / 3 + 64 * 1024);
     let _ = write!(
         page,
@@ -1031,14 +1206,13 @@ pub fn html(input: &ViewInput<'_>) -> Result<String, CliError> {
 <script>{VIEWER_JS}</script>
 </body></html>
 "#,
-        b64(&pos),
-        b64(&col),
-        b64(&lpos),
-        b64(&lcol),
+        b64(pos),
+        b64(col),
+        b64(lpos),
+        b64(lcol),
     );
-    Ok(page)
+    page
 }
-
 /// Line (or polyline) when the points' spread across their main direction
 /// is small against their length; plane (or surface) otherwise.
 fn guess_kind(points: &[[f64; 3]], members: &[u32], n_parts: usize) -> Kind {
