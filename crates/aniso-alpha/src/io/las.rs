@@ -18,7 +18,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::Path;
 
 use super::attributes::LasSource;
-use super::las_attrs::{parse_vlrs, record_attributes};
+use super::las_attrs::{base_len, parse_vlrs, record_attributes};
 use super::las_bytes::{u16_at, u32_at, u64_at, u8_at, ByteReader, LasBytes};
 use super::{check_finite, non_empty, ClassSet, IoError, PointCloud};
 
@@ -583,20 +583,7 @@ fn check_items<B: LasBytes + ?Sized>(
     header: &LaszipHeader,
 ) -> Result<bool, String> {
     let format = u8_at(b, 104).unwrap_or(0) & 0x3F;
-    let base = match format {
-        0 => 20,
-        1 => 28,
-        2 => 26,
-        3 => 34,
-        4 => 57,
-        5 => 63,
-        6 => 30,
-        7 => 36,
-        8 => 38,
-        9 => 59,
-        10 => 67,
-        _ => return Err(format!("unknown point format {format}")),
-    };
+    let base = base_len(format).ok_or_else(|| format!("unknown point format {format}"))?;
     let extra = layout
         .record_len
         .checked_sub(base)
