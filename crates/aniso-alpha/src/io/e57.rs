@@ -25,7 +25,6 @@
 //! [`IoError::Format`].
 
 use std::io::Cursor;
-use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::Path;
 
 use e57::{E57Reader, RecordDataType, RecordName, RecordValue};
@@ -225,17 +224,7 @@ fn precheck(bytes: &[u8]) -> Result<(), String> {
 /// Runs `f`, turning a panic inside it (from the `e57` crate on corrupt
 /// data) into an error naming the file.
 fn contain<T>(path: &Path, f: impl FnOnce() -> T) -> Result<T, IoError> {
-    catch_unwind(AssertUnwindSafe(f)).map_err(|payload| {
-        let what = payload
-            .downcast_ref::<&str>()
-            .map(|s| (*s).to_string())
-            .or_else(|| payload.downcast_ref::<String>().cloned())
-            .unwrap_or_else(|| "unknown cause".into());
-        IoError::format(
-            path,
-            format!("invalid E57 file: the decoder failed on corrupt data ({what})"),
-        )
-    })
+    super::error::contain_decoder(path, "E57", f)
 }
 
 /// Where a scan's coordinates are: Cartesian if it has all three, else

@@ -156,6 +156,28 @@ impl IoError {
     }
 }
 
+/// Runs `f`, turning a panic inside it (from a decoder crate on corrupt
+/// data) into a format error naming the file: "invalid `kind` file: the
+/// decoder failed on corrupt data (the panic's message)".
+#[cfg(any(feature = "las", feature = "e57"))]
+pub(crate) fn contain_decoder<T>(
+    path: &Path,
+    kind: &str,
+    f: impl FnOnce() -> T,
+) -> Result<T, IoError> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).map_err(|payload| {
+        let what = payload
+            .downcast_ref::<&str>()
+            .map(|s| (*s).to_string())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "unknown cause".into());
+        IoError::format(
+            path,
+            format!("invalid {kind} file: the decoder failed on corrupt data ({what})"),
+        )
+    })
+}
+
 impl fmt::Display for IoError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
@@ -253,4 +275,22 @@ pub(crate) fn show_token(token: &[u8]) -> String {
         }
     }
     out
+}
+
+#[cfg(all(test, any(feature = "las", feature = "e57")))]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_decoder_s_panic_is_a_format_error_with_its_message() {
+        let path = Path::new("scan.laz");
+        assert_eq!(contain_decoder(path, "LAS/LAZ", || 7).unwrap(), 7);
+        let message = |f: fn()| contain_decoder(path, "LAS/LAZ", f).unwrap_err().to_string();
+        assert_eq!(
+            message(|| panic!("bad chunk")),
+            "scan.laz: invalid LAS/LAZ file: the decoder failed on corrupt data (bad chunk)"
+        );
+        assert!(message(|| panic!("{} bytes", 3)).ends_with("(3 bytes)"));
+        assert!(message(|| std::panic::panic_any(5u8)).ends_with("(unknown cause)"));
+    }
 }

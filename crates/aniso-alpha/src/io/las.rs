@@ -14,7 +14,6 @@
 //! compressed bytes.
 
 use std::io::{Seek, SeekFrom};
-use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::Path;
 
 use super::attributes::LasSource;
@@ -330,20 +329,10 @@ fn invalid(path: &Path, message: String) -> IoError {
     IoError::format(path, format!("invalid LAS/LAZ file: {message}"))
 }
 
-/// Runs `f`, turning a panic inside it (from the `las` or `laz` crates on
-/// corrupt data) into an error naming the file.
+/// Runs `f`, turning a panic inside it (from the `las` or `laz` crates on corrupt
+/// data) into an error naming the file.
 pub(crate) fn contain<T>(path: &Path, f: impl FnOnce() -> T) -> Result<T, IoError> {
-    catch_unwind(AssertUnwindSafe(f)).map_err(|payload| {
-        let what = payload
-            .downcast_ref::<&str>()
-            .map(|s| (*s).to_string())
-            .or_else(|| payload.downcast_ref::<String>().cloned())
-            .unwrap_or_else(|| "unknown cause".into());
-        IoError::format(
-            path,
-            format!("invalid LAS/LAZ file: the decoder failed on corrupt data ({what})"),
-        )
-    })
+    super::error::contain_decoder(path, "LAS/LAZ", f)
 }
 
 /// Parses the header with the `las` crate and, for LAZ, checks the laszip
