@@ -130,6 +130,27 @@ pub(crate) struct TextParser<'p> {
     cloud: PointCloud,
 }
 
+/// What one line's scan found ([`TextParser::scan_line`]).
+#[derive(Default)]
+struct LineScan {
+    /// Columns seen (counted past those read in a comma-separated file).
+    col: usize,
+    /// The first three columns.
+    xyz: [f64; 3],
+    /// The label column's value.
+    label: i64,
+    /// The first column is not a number on a line before any content.
+    header: bool,
+    /// Some columns are separated by white space alone.
+    ws_sep: bool,
+    /// The first comma between two digits with nothing else between them.
+    tight_comma: Option<usize>,
+    /// Some columns are separated by commas.
+    has_comma: bool,
+    /// The first field with a leading zero (start, end).
+    leading_zero: Option<(usize, usize)>,
+}
+
 impl<'p> TextParser<'p> {
     pub(crate) fn new(path: &'p Path, label_column: Option<usize>, size_hint: usize) -> Self {
         let needed = match label_column {
@@ -194,155 +215,183 @@ impl<'p> TextParser<'p> {
         } else {
             bytes
         };
-        let n = bytes.len();
         let mut i = 0usize;
         if self.pending_cr && bytes.first() == Some(&b'\n') {
             i = 1;
         }
         self.pending_cr = false;
-        while i < n {
+        while i < bytes.len() {
             self.line += 1;
             let line_start = i;
-            let mut col = 0usize;
-            let mut xyz = [0.0f64; 3];
-            let mut label = 0i64;
-            let mut header = false;
-            let mut ws_sep = false;
-            let mut tight_comma: Option<usize> = None;
-            let mut has_comma = false;
-            let mut leading_zero: Option<(usize, usize)> = None;
-            loop {
-                let sep_start = i;
-                let mut comma = 0usize;
-                while i < n && is_sep(bytes[i]) {
-                    comma += usize::from(bytes[i] == b',');
-                    i += 1;
-                }
-                if i >= n || is_eol(bytes[i]) || bytes[i] == b'#' {
-                    break;
-                }
-                if col > 0 {
-                    if comma == 0 {
-                        ws_sep = true;
-                    } else {
-                        has_comma = true;
-                        if i - sep_start == 1
-                            && bytes[sep_start - 1].is_ascii_digit()
-                            && bytes[i].is_ascii_digit()
-                        {
-                            tight_comma.get_or_insert(sep_start);
-                        }
-                    }
-                } else if comma > 0 {
-                    has_comma = true;
-                }
-                let start = i;
-                while i < n && !ends_token(bytes[i]) {
-                    i += 1;
-                }
-                let tok = &bytes[start..i];
-                if tok.len() > 1 && tok[0] == b'0' && tok[1].is_ascii_digit() {
-                    leading_zero.get_or_insert((start, i));
-                }
-                if col >= self.needed {
-                    // Past what is read: only counted (comma files).
-                    col += 1;
-                    continue;
-                }
-                if col < 3 {
-                    match parse_f64(tok) {
-                        Some(v) => xyz[col] = v,
-                        None if col == 0 && !self.seen_content => {
-                            header = true;
-                            break;
-                        }
-                        None => return Err(self.bad_number(tok, col)),
-                    }
-                }
-                if Some(col) == self.label_column {
-                    label = parse_label(tok).ok_or_else(|| {
-                        self.err(format!(
-                            "invalid label '{}' in column {} (expected an integer)",
-                            show_token(tok),
-                            col + 1
-                        ))
-                    })?;
-                }
-                col += 1;
-                if col == self.needed && !has_comma {
-                    break;
-                }
-            }
+            let scan = self.scan_line(bytes, &mut i)?;
             // Skip the rest of the line (extra columns, comment).
-            while i < n && !is_eol(bytes[i]) {
+            while i < bytes.len() && !is_eol(bytes[i]) {
                 i += 1;
             }
             let line_end = i;
-            if i < n {
-                if bytes[i] == b'\r' {
-                    if i + 1 < n {
-                        if bytes[i + 1] == b'\n' {
-                            i += 1;
-                        }
-                    } else {
-                        self.pending_cr = true;
+            i = self.past_line_end(bytes, i);
+            self.take_line(&scan, bytes, line_start..line_end)?;
+        }
+        Ok(())
+    }
+
+    /// The columns of the line starting at `*i`, read up to what is needed
+    /// (all of them in a comma-separated file, to count them); `*i` is left
+    /// where the scan stopped.
+    #[inline]
+    fn scan_line(&self, bytes: &[u8], i: &mut usize) -> Result<LineScan, IoError> {
+        let n = bytes.len();
+        let mut line = LineScan::default();
+        loop {
+            let sep_start = *i;
+            let mut comma = 0usize;
+            while *i < n && is_sep(bytes[*i]) {
+                comma += usize::from(bytes[*i] == b',');
+                *i += 1;
+            }
+            if *i >= n || is_eol(bytes[*i]) || bytes[*i] == b'#' {
+                break;
+            }
+            if line.col > 0 {
+                if comma == 0 {
+                    line.ws_sep = true;
+                } else {
+                    line.has_comma = true;
+                    if *i - sep_start == 1
+                        && bytes[sep_start - 1].is_ascii_digit()
+                        && bytes[*i].is_ascii_digit()
+                    {
+                        line.tight_comma.get_or_insert(sep_start);
                     }
                 }
-                i += 1;
+            } else if comma > 0 {
+                line.has_comma = true;
             }
-            let text = &bytes[line_start..line_end];
-            if header {
-                self.header_line(text)?;
+            let start = *i;
+            while *i < n && !ends_token(bytes[*i]) {
+                *i += 1;
+            }
+            let tok = &bytes[start..*i];
+            if tok.len() > 1 && tok[0] == b'0' && tok[1].is_ascii_digit() {
+                line.leading_zero.get_or_insert((start, *i));
+            }
+            let col = line.col;
+            if col >= self.needed {
+                // Past what is read: only counted (comma files).
+                line.col += 1;
                 continue;
             }
-            if col == 0 {
-                continue; // blank or comment line
+            if col < 3 {
+                match parse_f64(tok) {
+                    Some(v) => line.xyz[col] = v,
+                    None if col == 0 && !self.seen_content => {
+                        line.header = true;
+                        break;
+                    }
+                    None => return Err(self.bad_number(tok, col)),
+                }
             }
-            if col == 1 && !self.seen_content {
-                // A lone number first: the point count line of `.pts` files.
-                self.seen_content = true;
-                continue;
+            if Some(col) == self.label_column {
+                line.label = parse_label(tok).ok_or_else(|| {
+                    self.err(format!(
+                        "invalid label '{}' in column {} (expected an integer)",
+                        show_token(tok),
+                        col + 1
+                    ))
+                })?;
             }
+            line.col += 1;
+            if line.col == self.needed && !line.has_comma {
+                break;
+            }
+        }
+        Ok(line)
+    }
+
+    /// The position after the line end at `i` (CR, LF or CR LF), or `i`
+    /// at the end of `bytes`; a CR that ends `bytes` may have its LF in the
+    /// next piece.
+    #[inline]
+    fn past_line_end(&mut self, bytes: &[u8], i: usize) -> usize {
+        let n = bytes.len();
+        if i >= n {
+            return i;
+        }
+        let mut i = i;
+        if bytes[i] == b'\r' {
+            if i + 1 < n {
+                if bytes[i + 1] == b'\n' {
+                    i += 1;
+                }
+            } else {
+                self.pending_cr = true;
+            }
+        }
+        i + 1
+    }
+
+    /// The scanned line `bytes[text]`: a header, a blank or comment line,
+    /// a `.pts` count line, or a point (and its label) after the checks of
+    /// its separators, columns and coordinates.
+    #[inline]
+    fn take_line(
+        &mut self,
+        line: &LineScan,
+        bytes: &[u8],
+        text: std::ops::Range<usize>,
+    ) -> Result<(), IoError> {
+        let col = line.col;
+        if line.header {
+            return self.header_line(&bytes[text]);
+        }
+        if col == 0 {
+            return Ok(()); // blank or comment line
+        }
+        if col == 1 && !self.seen_content {
+            // A lone number first: the point count line of `.pts` files.
             self.seen_content = true;
-            if let (true, Some(at)) = (ws_sep, tight_comma) {
-                let tok = token_around(bytes, at, line_start, line_end);
+            return Ok(());
+        }
+        self.seen_content = true;
+        if let (true, Some(at)) = (line.ws_sep, line.tight_comma) {
+            let tok = token_around(bytes, at, text.start, text.end);
+            return Err(self.err(format!(
+                "ambiguous comma in '{}': decimal commas are not read (use '.' for decimals, \
+                 and commas or spaces between columns)",
+                show_token(tok)
+            )));
+        }
+        if line.has_comma {
+            self.check_comma_fields(col)?;
+            if let Some((a, b)) = line.leading_zero {
+                let tok = &bytes[a..b];
                 return Err(self.err(format!(
-                    "ambiguous comma in '{}': decimal commas are not read (use '.' for decimals, \
-                     and commas or spaces between columns)",
+                    "field '{}' has a leading zero: a thousands separator? (write numbers \
+                     without digit grouping)",
                     show_token(tok)
                 )));
             }
-            if has_comma {
-                self.check_comma_fields(col)?;
-                if let Some((a, b)) = leading_zero {
-                    let tok = &bytes[a..b];
-                    return Err(self.err(format!(
-                        "field '{}' has a leading zero: a thousands separator? (write numbers \
-                         without digit grouping)",
-                        show_token(tok)
-                    )));
-                }
-            }
-            if col < 3 {
-                return Err(self.err(format!("expected 3 numeric columns, found {col}")));
-            }
-            if col < self.needed {
-                return Err(self.err(format!(
-                    "expected a label in column {}, found {col} columns",
-                    self.needed
-                )));
-            }
-            if !(xyz[0].is_finite() && xyz[1].is_finite() && xyz[2].is_finite()) {
-                return Err(IoError::NonFinite {
-                    path: self.path.to_path_buf(),
-                    line: Some(self.line),
-                    index: self.cloud.points.len(),
-                });
-            }
-            self.cloud.points.push(xyz);
-            if let Some(labels) = self.cloud.labels.as_mut() {
-                labels.push(label);
-            }
+        }
+        if col < 3 {
+            return Err(self.err(format!("expected 3 numeric columns, found {col}")));
+        }
+        if col < self.needed {
+            return Err(self.err(format!(
+                "expected a label in column {}, found {col} columns",
+                self.needed
+            )));
+        }
+        let xyz = line.xyz;
+        if !(xyz[0].is_finite() && xyz[1].is_finite() && xyz[2].is_finite()) {
+            return Err(IoError::NonFinite {
+                path: self.path.to_path_buf(),
+                line: Some(self.line),
+                index: self.cloud.points.len(),
+            });
+        }
+        self.cloud.points.push(xyz);
+        if let Some(labels) = self.cloud.labels.as_mut() {
+            labels.push(line.label);
         }
         Ok(())
     }
