@@ -833,10 +833,8 @@ fn drawn_points(scene: &mut Scene, cap: usize) -> Counts {
     }
 }
 
-/// The geometry: the centre of the points' bounding box and its
-/// half-diagonal (1 for no points or a single one).
-fn frame(points: &[[f64; 3]]) -> Frame {
-    let n = points.len();
+/// The bounding box (min, max) of `points`; min above max for none.
+fn bounds(points: impl IntoIterator<Item = [f64; 3]>) -> ([f64; 3], [f64; 3]) {
     let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
     for p in points {
         for k in 0..3 {
@@ -844,47 +842,39 @@ fn frame(points: &[[f64; 3]]) -> Frame {
             hi[k] = hi[k].max(p[k]);
         }
     }
-    let center = if n == 0 {
-        [0.0; 3]
-    } else {
-        [
-            (lo[0] + hi[0]) / 2.0,
-            (lo[1] + hi[1]) / 2.0,
-            (lo[2] + hi[2]) / 2.0,
-        ]
-    };
-    let radius = if n == 0 {
-        1.0
-    } else {
-        let d = ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2))
-            .sqrt()
-            / 2.0;
-        if d > 0.0 {
-            d
-        } else {
-            1.0
-        }
-    };
-    Frame { center, radius }
+    (lo, hi)
+}
+
+/// Half the diagonal of the box (`lo`, `hi`).
+fn half_diagonal(lo: [f64; 3], hi: [f64; 3]) -> f64 {
+    ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt() / 2.0
+}
+
+/// The geometry: the centre of the points' bounding box and its
+/// half-diagonal (1 for no points or a single one).
+fn frame(points: &[[f64; 3]]) -> Frame {
+    if points.is_empty() {
+        return Frame {
+            center: [0.0; 3],
+            radius: 1.0,
+        };
+    }
+    let (lo, hi) = bounds(points.iter().copied());
+    let d = half_diagonal(lo, hi);
+    Frame {
+        center: [0, 1, 2].map(|k| (lo[k] + hi[k]) / 2.0),
+        radius: if d > 0.0 { d } else { 1.0 },
+    }
 }
 
 /// The first view (`{"center", "radius"}`, relative to the frame's centre):
 /// framed on the structures' drawn points, else on everything.
 fn first_view(points: &[[f64; 3]], members_of: &[Vec<u32>], frame: &Frame) -> Value {
     let (center, radius) = (frame.center, frame.radius);
-    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for &i in members_of.iter().flatten() {
-        let p = points[i as usize];
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
+    let (lo, hi) = bounds(members_of.iter().flatten().map(|&i| points[i as usize]));
     if lo[0] <= hi[0] {
         let c: Vec<f64> = (0..3).map(|k| (lo[k] + hi[k]) / 2.0 - center[k]).collect();
-        let r = ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2))
-            .sqrt()
-            / 2.0;
+        let r = half_diagonal(lo, hi);
         json!({"center": c, "radius": if r > 0.0 { r * 1.2 } else { radius }})
     } else {
         json!({"center": [0.0, 0.0, 0.0], "radius": radius})

@@ -329,8 +329,8 @@ fn invalid(path: &Path, message: String) -> IoError {
     IoError::format(path, format!("invalid LAS/LAZ file: {message}"))
 }
 
-/// Runs `f`, turning a panic inside it (from the `las` or `laz` crates on corrupt
-/// data) into an error naming the file.
+/// Runs `f`, turning a panic inside it (from the `las` or `laz` crates on
+/// corrupt data) into an error naming the file.
 pub(crate) fn contain<T>(path: &Path, f: impl FnOnce() -> T) -> Result<T, IoError> {
     super::error::contain_decoder(path, "LAS/LAZ", f)
 }
@@ -736,9 +736,10 @@ fn check_layers<B: LasBytes + ?Sized>(
 ) -> Result<(), String> {
     let record_len = layout.record_len as u64;
     let layers: u64 = items.iter().map(|&i| item_layers(i)).sum();
+    // A chunk's head: its first record, its point count, its layer sizes.
+    let head = record_len + 4 + 4 * layers;
     let mut at = layout.data_start as u64 + 8;
     for &(_, bytes) in entries {
-        let head = record_len + 4 + 4 * layers;
         if bytes < head {
             return Err("LAZ chunk too short for its layer sizes".into());
         }
