@@ -10,9 +10,7 @@ use aniso_alpha::detect::StructureKind;
 use aniso_alpha::detect::{DetectError, Detection, Detector, OrientationSet, Primitive, Stage};
 use aniso_alpha::eval::{evaluate, Evaluation};
 use aniso_alpha::io::{self, write_scene, Mesh, PointCloud, ReadOptions};
-use aniso_alpha::options::{
-    ignored_normals_reason, run_warnings, DetectOptions, SamplerChoice, Style,
-};
+use aniso_alpha::options::{run_warnings, DetectOptions, SamplerChoice, Style};
 use aniso_alpha::report::{detection_json, part_meshes, PartMeshes};
 use aniso_alpha::synth::{Scene, SceneOptions};
 use clap::{Args, ValueEnum};
@@ -849,10 +847,15 @@ fn summary(
             det.labels.len()
         ));
     }
-    if let Some(g) = d.given_normals().filter(|g| !g.used) {
+    if let Some(g) = d.given_normals().filter(|g| !(g.used && g.gate)) {
         o.push_str(&format!(
-            "  normals: the input's were ignored: {}\n",
-            ignored_normals_reason(g.agreement)
+            "  normals: the input's were {}: {}\n",
+            if g.ignored() {
+                "ignored"
+            } else {
+                "used in part"
+            },
+            g.ignored_reason()
         ));
     }
     o.push_str(&format!(

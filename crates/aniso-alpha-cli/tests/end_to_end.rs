@@ -672,6 +672,82 @@ fn detect_ignores_normals_that_disagree_with_the_points() {
 }
 
 #[test]
+fn detect_takes_the_modes_from_estimated_normals_when_the_given_ones_scatter() {
+    // Three perpendicular walls whose PLY gives each point its wall's
+    // normal tilted 10-22 degrees at random (normals over too few
+    // neighbours): they agree with the points, but their modes explain
+    // less of the cloud than the estimated normals' modes, so `detect`
+    // warns, scans the estimated normals' modes, still gates the claims
+    // with the given normals, and finds the three walls.
+    let dir = TempDir::new("e2e", "scattered-normals");
+    let mut rng = SplitMix64::new(6);
+    let mut rows = Vec::new();
+    for i in 1..40 {
+        for j in 1..40 {
+            let (u, v) = (i as f64 * 0.1, j as f64 * 0.1);
+            let mut e = || 0.01 * (rng.uniform() - 0.5);
+            let points = [[u, v, e()], [e(), u, v], [u, e(), v]];
+            for (w, p) in points.iter().enumerate() {
+                let tilt = (10.0 + 12.0 * rng.uniform()).to_radians();
+                let turn = std::f64::consts::TAU * rng.uniform();
+                let (a, b) = (tilt.sin() * turn.cos(), tilt.sin() * turn.sin());
+                let n = match w {
+                    0 => [a, b, tilt.cos()],
+                    1 => [tilt.cos(), a, b],
+                    _ => [a, tilt.cos(), b],
+                };
+                rows.push(format!(
+                    "{} {} {} {} {} {}",
+                    p[0], p[1], p[2], n[0], n[1], n[2]
+                ));
+            }
+        }
+    }
+    let ply = format!(
+        "ply\nformat ascii 1.0\nelement vertex {}\nproperty double x\nproperty double y\n\
+         property double z\nproperty float nx\nproperty float ny\nproperty float nz\nend_header\n{}\n",
+        rows.len(),
+        rows.join("\n")
+    );
+    let input = dir.file("corner.ply", ply.as_bytes());
+    let report = dir.path("r.json");
+    let o = ok(&[
+        "detect",
+        input.to_str().unwrap(),
+        "--structure",
+        "planes",
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        stderr.contains("do worse than normals estimated"),
+        "{stderr}"
+    );
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(report).unwrap()).unwrap();
+    let n = &r["parameters"]["normals"];
+    assert_eq!(n["source"], "input");
+    assert_eq!(n["modes_from"], "estimated");
+    assert_eq!(n["gate"], true);
+    let (given, own) = (
+        n["explained"]["given"].as_f64().unwrap(),
+        n["explained"]["estimated"].as_f64().unwrap(),
+    );
+    assert!(given < own && own > 0.9, "{n}");
+    assert_eq!(r["parameters"]["orientations"]["count"], 3);
+    let big = r["structures"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|s| s["parts"].as_array().unwrap())
+        .filter(|p| p["points"].as_u64().unwrap() > 1300)
+        .count();
+    assert_eq!(big, 3, "{}", r["structures"]);
+    assert!(String::from_utf8_lossy(&o.stdout).contains("normals: the input's were used in part"));
+}
+
+#[test]
 fn detect_timings_name_every_stage_of_the_run_within_the_detect_phase() {
     // CGAL's ball scan, automatic mode: the stages a run meets, each
     // timed once (no ladder), add up to no more than the detect phase.

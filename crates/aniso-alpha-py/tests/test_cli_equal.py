@@ -160,6 +160,33 @@ def test_warnings_reach_python(tmp_path):
         assert aa.detect(cloud, "planes").warnings == []
 
 
+def test_scattered_normals_give_the_modes_to_estimated_ones_with_a_warning():
+    # Three perpendicular walls whose normals are each tilted 10-22 degrees
+    # at random (as normals over too few neighbours are): they agree with
+    # the points but scatter the walls' orientation modes, so the modes come
+    # from estimated normals, Python hears why, and the walls are found.
+    rng = np.random.default_rng(6)
+    u, v = np.meshgrid(np.arange(1, 40) * 0.1, np.arange(1, 40) * 0.1)
+    u, v = u.ravel(), v.ravel()
+    e = lambda: 0.01 * (rng.uniform(size=u.size) - 0.5)  # noqa: E731
+    walls = [np.c_[u, v, e()], np.c_[e(), u, v], np.c_[u, e(), v]]
+    normals = []
+    for w in range(3):
+        tilt = np.radians(10 + 12 * rng.uniform(size=u.size))
+        turn = 2 * np.pi * rng.uniform(size=u.size)
+        a, b, c = np.sin(tilt) * np.cos(turn), np.sin(tilt) * np.sin(turn), np.cos(tilt)
+        normals.append([np.c_[a, b, c], np.c_[c, a, b], np.c_[a, c, b]][w])
+    pts, nrm = np.concatenate(walls), np.concatenate(normals)
+    with pytest.warns(aa.AnisoAlphaWarning, match="do worse than normals estimated") as w:
+        det = aa.detect(pts, "planes", normals=nrm)
+    assert det.warnings and det.warnings[0] in str(w[0].message)
+    n = det.parameters["normals"]
+    assert n["modes_from"] == "estimated" and n["gate"] is True
+    assert n["explained"]["given"] < n["explained"]["estimated"]
+    sizes = np.bincount(det.part_labels[det.part_labels >= 0])
+    assert np.sum(sizes > 1300) == 3, sizes
+
+
 def test_a_ladder_too_large_is_declined_with_a_warning():
     # Uniform noise looks like the paper's sparse scenes (nothing
     # structure-like, no mode), but holds more points than the scale

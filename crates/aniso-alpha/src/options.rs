@@ -308,16 +308,6 @@ impl DetectOptions {
     }
 }
 
-/// Why the normals given with the points were not used (the detector's
-/// [`Detector::given_normals`] agreement, 0 to 1).
-pub fn ignored_normals_reason(agreement: f64) -> String {
-    format!(
-        "only {:.0}% of the locally planar points have their given normal within 25 degrees of \
-         their neighbourhood's (at least half must); normals estimated instead",
-        100.0 * agreement
-    )
-}
-
 /// The warnings a front end gives before running `detector` on `points`
 /// points with `threads` threads: normals given but not used, and a run
 /// of more than [`HUGE_RUN`] point insertions (its options named as
@@ -330,11 +320,12 @@ pub fn run_warnings(
     style: Style,
 ) -> Vec<String> {
     let mut out = Vec::new();
-    if let Some(g) = detector.given_normals().filter(|g| !g.used) {
-        out.push(format!(
-            "the input's normals disagree with its points: {}",
-            ignored_normals_reason(g.agreement)
-        ));
+    if let Some(g) = detector.given_normals().filter(|g| !(g.used && g.gate)) {
+        let lead = match g.explained {
+            Some(_) => "the input's normals do worse than normals estimated from the points",
+            None => "the input's normals disagree with its points",
+        };
+        out.push(format!("{lead}: {}", g.ignored_reason()));
     }
     if let Some((e, m)) = detector
         .estimate()
@@ -380,7 +371,8 @@ pub fn region_warnings(run: &crate::detect::regions::RegionRun) -> Vec<String> {
         out.push(format!(
             "the input's normals disagree with its points in {} of {} region(s): fewer than half of \
              a region's locally planar points have their given normal within 25 degrees of their \
-             neighbourhood's; normals estimated there instead",
+             neighbourhood's, or the orientation modes of the given normals explain less of the \
+             region than those of normals estimated from its points; normals estimated there instead",
             run.normals_ignored, run.regions
         ));
     }

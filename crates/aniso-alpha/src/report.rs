@@ -28,6 +28,12 @@ fn num(x: f64) -> Value {
     }
 }
 
+/// The shares of the cloud that the orientation modes of the given and of
+/// the estimated normals explain ([`crate::detect::GivenNormals`]).
+fn explained((given, estimated): (f64, f64)) -> Value {
+    json!({"given": num(given), "estimated": num(estimated)})
+}
+
 fn param(value: f64, estimated: bool, reason: &str) -> Value {
     json!({"value": num(value), "estimated": estimated, "reason": reason})
 }
@@ -91,11 +97,18 @@ pub fn parameters_json(d: &Detector) -> Value {
                 "source": "input",
                 "usable": n,
                 "agreement": g.map(|g| num(g.agreement)),
+                "explained": g.and_then(|g| g.explained).map(explained),
+                "modes_from": if g.is_none_or(|g| g.used) { "input" } else { "estimated" },
+                "gate": true,
             }),
             (StructureKind::Planes, None, Some(g)) => json!({
                 "source": "estimated",
                 "input_ignored": true,
                 "agreement": num(g.agreement),
+                "explained": g.explained.map(explained),
+                "modes_from": if g.used { "input" } else { "estimated" },
+                "gate": false,
+                "reason": g.ignored_reason(),
             }),
             _ => json!({"source": "estimated"}),
         },

@@ -220,3 +220,81 @@ fn normals_that_disagree_with_the_points_are_ignored() {
         .normals(&placeholder);
     assert_eq!(explicit.run(&points).unwrap(), plain);
 }
+
+#[test]
+fn normals_whose_modes_explain_less_give_the_modes_to_the_estimated_ones() {
+    // The corner's true normals, each tilted 10–22° in a random direction
+    // (normals over too few neighbours): every one lies within 25° of its
+    // wall's, so they pass the agreement check, but they scatter the
+    // walls' peaks. Their modes explain less of the cloud than those of
+    // the estimated normals, so the orientations come from the latter,
+    // and the three walls are found as without normals; the given normals
+    // (all within the 36.9° gate) still gate the claims.
+    let points = corner();
+    let given = Given::default();
+    let plain = Detector::auto(StructureKind::Planes, &points, &given).unwrap();
+    let plain_run = plain.run(&points).unwrap();
+    let mut rng = SplitMix64::new(5);
+    let tilted: Vec<[f64; 3]> = (0..points.len())
+        .map(|i| {
+            let tilt = (10.0 + 12.0 * rng.uniform()).to_radians();
+            let turn = std::f64::consts::TAU * rng.uniform();
+            let (a, b) = (tilt.sin() * turn.cos(), tilt.sin() * turn.sin());
+            match i % 3 {
+                0 => [a, b, tilt.cos()],
+                1 => [tilt.cos(), a, b],
+                _ => [a, tilt.cos(), b],
+            }
+        })
+        .collect();
+    let d = Detector::auto_oriented(StructureKind::Planes, &points, &tilted, &given, 12).unwrap();
+    let g = d.given_normals().unwrap();
+    let (from_given, from_own) = g.explained.expect("the modes were compared");
+    assert!(g.agreement > 0.5 && from_given < from_own, "{g:?}");
+    assert!(!g.used && g.gate && !g.ignored(), "{g:?}");
+    assert!(g
+        .ignored_reason()
+        .contains("orientations come from the estimated normals"));
+    assert_eq!(d.normals_given(), Some(points.len()));
+    let axes = |d: &Detector| match d.orientations() {
+        aniso_alpha::detect::OrientationSet::Data(m) => {
+            m.iter().map(|m| m.axis).collect::<Vec<_>>()
+        }
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(axes(&d), axes(&plain));
+    let run = d.run(&points).unwrap();
+    let wall_share = |det: &Detection| {
+        let labels = det.part_labels();
+        (0..3)
+            .map(|w| {
+                let mut count = std::collections::BTreeMap::new();
+                for i in (w..points.len()).step_by(3) {
+                    *count.entry(labels[i]).or_insert(0usize) += 1;
+                }
+                let best = count
+                    .iter()
+                    .filter(|(p, _)| **p >= 0)
+                    .map(|(_, c)| *c)
+                    .max();
+                best.unwrap_or(0) as f64 / (points.len() / 3) as f64
+            })
+            .fold(1.0, f64::min)
+    };
+    assert!(wall_share(&plain_run) > 0.9, "{}", wall_share(&plain_run));
+    assert!(wall_share(&run) > 0.9, "{}", wall_share(&run));
+    // The warning both front ends print says so.
+    let warnings = aniso_alpha::options::run_warnings(
+        &aniso_alpha::options::DetectOptions::new(StructureKind::Planes),
+        &d,
+        points.len(),
+        1,
+        aniso_alpha::options::Style::Cli,
+    );
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w.contains("do worse than normals estimated")),
+        "{warnings:?}"
+    );
+}

@@ -253,8 +253,13 @@ def detect(
         normals: the points' normals, array-like (n, 3) (the sign does not
             matter), overriding those of ``points``: for planes, a point
             joins a plane only if its normal is within 36.9 degrees of the
-            plane's, and the data's orientations come from them. Rows of
-            zeros or NaN are missing normals. Lines ignore them.
+            plane's, and the data's orientations come from them unless
+            their modes explain less of the cloud than those of normals
+            estimated from the points (noisy or smoothed normals: then
+            from the estimated ones, with an :class:`AnisoAlphaWarning`
+            and ``parameters["normals"]["modes_from"] == "estimated"``).
+            Normals that disagree with the points are not used at all.
+            Rows of zeros or NaN are missing normals. Lines ignore them.
         ignore_normals: estimate every normal from its neighbourhood even
             when ``points`` has normals (``--ignore-normals``).
         threads: threads to use (default: all cores); the result does not
@@ -288,7 +293,8 @@ def detect(
         ``part_labels`` (planes or segments), the ``structures``, the
         ``planes`` or ``segments`` (equation, inliers, outline), the
         ``parameters`` used. What the CLI prints as a warning (normals
-        given but not used, a very large run) is issued as an
+        given but not used, or used for the gate alone, a very large run)
+        is issued as an
         :class:`AnisoAlphaWarning`.
 
     Raises:

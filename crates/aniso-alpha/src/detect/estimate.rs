@@ -476,14 +476,76 @@ pub fn estimate(kind: StructureKind, points: &[[f64; 3]], given: &Given, m2: u32
 pub const NORMALS_AGREEMENT_MIN: f64 = 0.5;
 
 /// How the normals given with the points compare with the points' own
-/// geometry ([`estimate_oriented`]).
+/// geometry ([`estimate_oriented`]). Each use of the given normals is
+/// compared with the same use of the normals estimated from the points,
+/// and the given ones are used only where they do at least as well:
+///
+/// 1. **Agreement**: a majority of the locally planar points must have
+///    their given normal within [`CONE_DEG`] of their neighbourhood's
+///    ([`NORMALS_AGREEMENT_MIN`]); otherwise they are not used at all.
+/// 2. **Orientation modes**: the modes of the given normals must explain
+///    at least as much of the cloud ([`Estimate::explained`]) as those of
+///    the estimated normals; otherwise the modes come from the estimated
+///    normals. Normals estimated over too few neighbours scatter, and
+///    normals smoothed across a few spacings blur, the peaks of their
+///    planes: Open3D's normals within 3 spacings of a depth frame lose its
+///    table's mode (explaining 9% of the frame against 99%).
+/// 3. **The claims' gate** (a point joins a plane only if its normal is
+///    within 36.9° of the plane's, [`Detector::normals`]): the given
+///    normals gate the claims whenever they pass step 1, wherever the modes
+///    come from. Normals that are accurate where the points' own
+///    neighbourhoods blend two faces keep a window frame's or a ledge's
+///    points off the façade (CGAL's building: F1 0.929 with its normals'
+///    gate, 0.863 without); noisy ones turn away some points of the very
+///    planes they lie on (docs/method.md §8, "Normals given with the
+///    points", gives both measures).
+///
+/// [`Detector::normals`]: crate::detect::Detector::normals
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GivenNormals {
     /// Of the locally planar points with a usable given normal, the share
     /// whose given normal is within [`CONE_DEG`] of the PCA normal.
     pub agreement: f64,
-    /// Whether they are used: `agreement` ≥ [`NORMALS_AGREEMENT_MIN`].
+    /// Where the agreement was reached: the share of the cloud that the
+    /// modes of the given normals explain, and the share that the modes of
+    /// the estimated normals explain ([`Estimate::explained`]).
+    pub explained: Option<(f64, f64)>,
+    /// Whether the orientation modes come from the given normals (step 2).
     pub used: bool,
+    /// Whether the given normals gate the claims of planes (step 3: they
+    /// passed step 1).
+    pub gate: bool,
+}
+
+impl GivenNormals {
+    /// Whether the given normals are used for nothing.
+    pub fn ignored(&self) -> bool {
+        !self.used && !self.gate
+    }
+
+    /// What the given normals were not used for, and why (empty when they
+    /// were used for both the orientations and the gate).
+    pub fn ignored_reason(&self) -> String {
+        let Some((given, own)) = self.explained else {
+            return format!(
+                "only {:.0}% of the locally planar points have their given normal within 25 \
+                 degrees of their neighbourhood's (at least half must); normals estimated instead",
+                100.0 * self.agreement
+            );
+        };
+        if self.used {
+            return String::new();
+        }
+        format!(
+            "the orientation modes of the given normals explain {:.0}% of the points, those of \
+             normals estimated from the points {:.0}% (the given normals are noisier, or \
+             smoothed across edges), so the orientations come from the estimated normals; the \
+             given ones still keep a point off a plane across its normal (--ignore-normals: \
+             not at all)",
+            100.0 * given,
+            100.0 * own
+        )
+    }
 }
 
 /// [`estimate`] for points with given unit normals (zero where missing):
@@ -501,29 +563,46 @@ pub fn estimate_oriented(
     m2: u32,
 ) -> (Estimate, Option<GivenNormals>) {
     let mut shapes = shapes_for(points, kind);
-    let mut check = None;
-    if let (StructureKind::Planes, Some(normals)) = (kind, normals) {
-        let given = normals_agreement(&shapes, normals);
-        if given.used {
-            for (s, n) in shapes.iter_mut().zip(normals) {
-                if *n != [0.0; 3] {
-                    s.normal = *n;
-                }
-            }
-        }
-        check = Some(given);
-    }
-    let surface = match kind {
-        StructureKind::Lines => Some(surface_points(
-            &shapes,
-            &shapes_for(points, StructureKind::Planes),
-        )),
-        StructureKind::Planes => None,
+    let (StructureKind::Planes, Some(normals)) = (kind, normals) else {
+        let surface = (kind == StructureKind::Lines)
+            .then(|| surface_points(&shapes, &shapes_for(points, StructureKind::Planes)));
+        return (
+            estimate_with(kind, points, &shapes, surface.as_deref(), given, m2, None),
+            None,
+        );
     };
-    (
-        estimate_with(kind, points, &shapes, surface.as_deref(), given, m2),
-        check,
-    )
+    let mut g = normals_agreement(&shapes, normals);
+    if !g.used {
+        return (
+            estimate_with(kind, points, &shapes, None, given, m2, None),
+            Some(g),
+        );
+    }
+    // The modes of the estimated normals, then of the given ones in their
+    // place (the estimated normals kept aside, 12 bytes a point, to be put
+    // back if they win): one copy of the local shapes, one search at a time.
+    let of_own = mode_search(kind, points, &shapes, &|_| false);
+    let own_normals: Vec<[f32; 3]> = shapes.iter().map(|s| s.normal).collect();
+    for (s, n) in shapes.iter_mut().zip(normals) {
+        if *n != [0.0; 3] {
+            s.normal = *n;
+        }
+    }
+    let of_given = mode_search(kind, points, &shapes, &|_| false);
+    g.explained = Some((of_given.explained, of_own.explained));
+    g.used = of_given.explained >= of_own.explained;
+    let search = if g.used {
+        drop((of_own, own_normals));
+        of_given
+    } else {
+        drop(of_given);
+        for (s, n) in shapes.iter_mut().zip(own_normals) {
+            s.normal = n;
+        }
+        of_own
+    };
+    let e = estimate_with(kind, points, &shapes, None, given, m2, Some(search));
+    (e, Some(g))
 }
 
 /// How given unit normals (zero where missing) agree with the geometry of
@@ -548,7 +627,60 @@ fn normals_agreement(shapes: &[LocalShape], normals: &[[f32; 3]]) -> GivenNormal
     }
     let agreement = agree as f64 / planar.max(1) as f64;
     let used = planar > 0 && agreement >= NORMALS_AGREEMENT_MIN;
-    GivenNormals { agreement, used }
+    GivenNormals {
+        agreement,
+        explained: None,
+        used,
+        gate: used,
+    }
+}
+
+/// The modes of the local shapes' axes, their members and the share of
+/// the cloud they explain ([`Estimate::explained`]).
+struct ModeSearch {
+    found: Vec<Mode>,
+    members: Vec<Vec<u32>>,
+    explained: f64,
+}
+
+/// The mode search of [`estimate_with`] over `shapes`, leaving out the
+/// points flagged by `off`: the modes of the structure-like points' axes
+/// (their noise sets the kernel's reach), each mode's members, and the
+/// share of the cloud they explain.
+fn mode_search(
+    kind: StructureKind,
+    points: &[[f64; 3]],
+    shapes: &[LocalShape],
+    off: &(dyn Fn(usize) -> bool + Sync),
+) -> ModeSearch {
+    let (structure, spacing_median) = structure_and_spacing(kind, shapes, off);
+    let (_, noise) = spacing_and_noise(kind, shapes, &structure, (spacing_median, 0.0));
+    let found = concentrated_modes(kind, points, shapes, (&structure, noise), off);
+    let members = mode_members(kind, shapes, &found, off);
+    let explained = explained_share(kind, shapes, &members, off);
+    ModeSearch {
+        found,
+        members,
+        explained,
+    }
+}
+
+/// The structure-like points (score ≥ [`SCORE_MIN`], not `off`) and the
+/// median of every finite spacing.
+fn structure_and_spacing(
+    kind: StructureKind,
+    shapes: &[LocalShape],
+    off: &dyn Fn(usize) -> bool,
+) -> (Vec<u32>, f64) {
+    let mut all_spacing: Vec<f32> = shapes
+        .iter()
+        .map(|s| s.spacing)
+        .filter(|s| s.is_finite())
+        .collect();
+    let structure = (0..shapes.len() as u32)
+        .filter(|&i| shapes[i as usize].score(kind) >= SCORE_MIN && !off(i as usize))
+        .collect();
+    (structure, quantile(&mut all_spacing, 0.5))
 }
 
 /// The points of surfaces, for lines: a point whose neighbourhood, at the
@@ -626,7 +758,7 @@ pub fn estimate_from(
     given: &Given,
     m2: u32,
 ) -> Estimate {
-    estimate_with(kind, points, shapes, None, given, m2)
+    estimate_with(kind, points, shapes, None, given, m2, None)
 }
 
 /// [`estimate_from`], leaving out the points flagged in `surface` (for
@@ -639,23 +771,18 @@ fn estimate_with(
     surface: Option<&[bool]>,
     given: &Given,
     m2: u32,
+    searched: Option<ModeSearch>,
 ) -> Estimate {
     let n = points.len();
     let off = |i: usize| surface.is_some_and(|s| s[i]);
-    let mut all_spacing: Vec<f32> = shapes
-        .iter()
-        .map(|s| s.spacing)
-        .filter(|s| s.is_finite())
-        .collect();
-    let spacing_median = quantile(&mut all_spacing, 0.5);
-    let structure: Vec<u32> = (0..n as u32)
-        .filter(|&i| shapes[i as usize].score(kind) >= SCORE_MIN && !off(i as usize))
-        .collect();
+    let (structure, spacing_median) = structure_and_spacing(kind, shapes, &off);
     let (spacing, noise) = spacing_and_noise(kind, shapes, &structure, (spacing_median, 0.0));
     let (alpha_p, lambda2_p, lambda3_p, min_size_p) = cloud_params(kind, spacing, noise, given);
-    let found = concentrated_modes(kind, points, shapes, (&structure, noise), &off);
-    let member_of = mode_members(kind, shapes, &found, &off);
-    let explained = explained_share(kind, shapes, &member_of, &off);
+    let ModeSearch {
+        found,
+        members: member_of,
+        explained,
+    } = searched.unwrap_or_else(|| mode_search(kind, points, shapes, &off));
     let mode_scans: Vec<ModeScan> = found
         .into_iter()
         .zip(member_of)

@@ -270,7 +270,8 @@ impl Detector {
             None => d.set = OrientationSet::Data(e.modes.clone()),
         }
         d.estimate = Some(Box::new(e));
-        d.normals = normals.filter(|_| given_normals.is_some_and(|g| g.used));
+        d.normals = normals.filter(|_| given_normals.is_some_and(|g| g.gate));
+
         d.given_normals = given_normals;
         Ok(d)
     }
@@ -583,7 +584,7 @@ impl Detector {
         let gate = match (self.kind, &self.normals) {
             (StructureKind::Planes, Some(n)) => {
                 let used = match self.given_normals {
-                    Some(g) => g.used,
+                    Some(g) => g.gate,
                     None => check_normals_agreement(points, n).used,
                 };
                 used.then(|| n.clone())
