@@ -371,8 +371,9 @@ pub fn region_warnings(run: &crate::detect::regions::RegionRun) -> Vec<String> {
         out.push(format!(
             "the input's normals disagree with its points in {} of {} region(s): fewer than half of \
              a region's locally planar points have their given normal within 25 degrees of their \
-             neighbourhood's, or the orientation modes of the given normals explain less of the \
-             region than those of normals estimated from its points; normals estimated there instead",
+             neighbourhood's (normals estimated there instead), or the orientation modes of the \
+             given normals explain less of the region than those of normals estimated from its \
+             points (the orientations come from the estimated normals there)",
             run.normals_ignored, run.regions
         ));
     }

@@ -98,7 +98,7 @@ pub fn parameters_json(d: &Detector) -> Value {
                 "usable": n,
                 "agreement": g.map(|g| num(g.agreement)),
                 "explained": g.and_then(|g| g.explained).map(explained),
-                "modes_from": if g.is_none_or(|g| g.used) { "input" } else { "estimated" },
+                "modes_from": g.map(|g| if g.used { "input" } else { "estimated" }),
                 "gate": true,
             }),
             (StructureKind::Planes, None, Some(g)) => json!({

@@ -271,7 +271,6 @@ impl Detector {
         }
         d.estimate = Some(Box::new(e));
         d.normals = normals.filter(|_| given_normals.is_some_and(|g| g.gate));
-
         d.given_normals = given_normals;
         Ok(d)
     }

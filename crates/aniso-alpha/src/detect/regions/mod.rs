@@ -127,8 +127,9 @@ pub struct RegionRun {
     /// estimate from): their points are background.
     pub skipped: usize,
     /// Regions whose detector did not use the normals given with the
-    /// points (they disagree with the region's geometry: normals estimated
-    /// there instead).
+    /// points in full (they disagree with the region's geometry: normals
+    /// estimated there instead; or their modes explain less of it: the
+    /// orientations from estimated normals there).
     pub normals_ignored: usize,
 }
 
@@ -167,8 +168,9 @@ pub struct RegionStep {
     pub part_angle: f64,
     /// Lines (k = 1) rather than planes.
     pub lines: bool,
-    /// The normals given with the points were not used (they disagree
-    /// with the region's geometry).
+    /// The normals given with the points were not used in full
+    /// ([`crate::detect::GivenNormals`]: for neither or only one of the
+    /// orientations and the claims' gate).
     pub normals_ignored: bool,
 }
 
