@@ -847,7 +847,7 @@ fn summary(
             det.labels.len()
         ));
     }
-    if let Some(g) = d.given_normals().filter(|g| !(g.used && g.gate)) {
+    if let Some(g) = d.given_normals().filter(|g| !g.in_full()) {
         o.push_str(&format!(
             "  normals: the input's were {}: {}\n",
             if g.ignored() {

@@ -627,59 +627,14 @@ fn detect_uses_the_inputs_normals() {
     assert_eq!(source, "estimated");
 }
 
-#[test]
-fn detect_ignores_normals_that_disagree_with_the_points() {
-    // Three perpendicular walls whose PLY gives every point the normal
-    // 0 0 1 (a placeholder): `detect` warns, estimates the normals, and
-    // says so in the report.
-    let dir = TempDir::new("e2e", "bad-normals");
-    let mut rng = SplitMix64::new(6);
-    let mut rows = Vec::new();
-    for i in 1..40 {
-        for j in 1..40 {
-            let (u, v) = (i as f64 * 0.1, j as f64 * 0.1);
-            let mut e = || 0.01 * (rng.uniform() - 0.5);
-            for p in [[u, v, e()], [e(), u, v], [u, e(), v]] {
-                rows.push(format!("{} {} {} 0 0 1", p[0], p[1], p[2]));
-            }
-        }
-    }
-    let ply = format!(
-        "ply\nformat ascii 1.0\nelement vertex {}\nproperty double x\nproperty double y\n\
-         property double z\nproperty float nx\nproperty float ny\nproperty float nz\nend_header\n{}\n",
-        rows.len(),
-        rows.join("\n")
-    );
-    let input = dir.file("corner.ply", ply.as_bytes());
-    let report = dir.path("r.json");
-    let o = ok(&[
-        "detect",
-        input.to_str().unwrap(),
-        "--structure",
-        "planes",
-        "--report",
-        report.to_str().unwrap(),
-    ]);
-    let stderr = String::from_utf8_lossy(&o.stderr);
-    assert!(stderr.contains("normals disagree"), "{stderr}");
-    let r: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(report).unwrap()).unwrap();
-    let n = &r["parameters"]["normals"];
-    assert_eq!(n["source"], "estimated");
-    assert_eq!(n["input_ignored"], true);
-    assert!(n["agreement"].as_f64().unwrap() < 0.5);
-    assert!(String::from_utf8_lossy(&o.stdout).contains("normals: the input's were ignored"));
-}
-
-#[test]
-fn detect_takes_the_modes_from_estimated_normals_when_the_given_ones_scatter() {
-    // Three perpendicular walls whose PLY gives each point its wall's
-    // normal tilted 10-22 degrees at random (normals over too few
-    // neighbours): they agree with the points, but their modes explain
-    // less of the cloud than the estimated normals' modes, so `detect`
-    // warns, scans the estimated normals' modes, still gates the claims
-    // with the given normals, and finds the three walls.
-    let dir = TempDir::new("e2e", "scattered-normals");
+/// Three perpendicular walls (a 0.1 m grid, 1 cm of noise), each point
+/// with the normal `normal(wall, rng)` (wall 0: z = 0, 1: x = 0, 2: y = 0),
+/// written as an ASCII PLY in `dir` and run through `detect --structure
+/// planes --report`: the run's output and its report.
+fn corner_with_normals(
+    dir: &TempDir,
+    mut normal: impl FnMut(usize, &mut SplitMix64) -> [f64; 3],
+) -> (std::process::Output, serde_json::Value) {
     let mut rng = SplitMix64::new(6);
     let mut rows = Vec::new();
     for i in 1..40 {
@@ -688,14 +643,7 @@ fn detect_takes_the_modes_from_estimated_normals_when_the_given_ones_scatter() {
             let mut e = || 0.01 * (rng.uniform() - 0.5);
             let points = [[u, v, e()], [e(), u, v], [u, e(), v]];
             for (w, p) in points.iter().enumerate() {
-                let tilt = (10.0 + 12.0 * rng.uniform()).to_radians();
-                let turn = std::f64::consts::TAU * rng.uniform();
-                let (a, b) = (tilt.sin() * turn.cos(), tilt.sin() * turn.sin());
-                let n = match w {
-                    0 => [a, b, tilt.cos()],
-                    1 => [tilt.cos(), a, b],
-                    _ => [a, tilt.cos(), b],
-                };
+                let n = normal(w, &mut rng);
                 rows.push(format!(
                     "{} {} {} {} {} {}",
                     p[0], p[1], p[2], n[0], n[1], n[2]
@@ -719,13 +667,50 @@ fn detect_takes_the_modes_from_estimated_normals_when_the_given_ones_scatter() {
         "--report",
         report.to_str().unwrap(),
     ]);
+    let r = serde_json::from_str(&std::fs::read_to_string(report).unwrap()).unwrap();
+    (o, r)
+}
+
+#[test]
+fn detect_ignores_normals_that_disagree_with_the_points() {
+    // Three perpendicular walls whose PLY gives every point the normal
+    // 0 0 1 (a placeholder): `detect` warns, estimates the normals, and
+    // says so in the report.
+    let dir = TempDir::new("e2e", "bad-normals");
+    let (o, r) = corner_with_normals(&dir, |_, _| [0.0, 0.0, 1.0]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(stderr.contains("normals disagree"), "{stderr}");
+    let n = &r["parameters"]["normals"];
+    assert_eq!(n["source"], "estimated");
+    assert_eq!(n["input_ignored"], true);
+    assert!(n["agreement"].as_f64().unwrap() < 0.5);
+    assert!(String::from_utf8_lossy(&o.stdout).contains("normals: the input's were ignored"));
+}
+
+#[test]
+fn detect_takes_the_modes_from_estimated_normals_when_the_given_ones_scatter() {
+    // Three perpendicular walls whose PLY gives each point its wall's
+    // normal tilted 10-22 degrees at random (normals over too few
+    // neighbours): they agree with the points, but their modes explain
+    // less of the cloud than the estimated normals' modes, so `detect`
+    // warns, scans the estimated normals' modes, still gates the claims
+    // with the given normals, and finds the three walls.
+    let dir = TempDir::new("e2e", "scattered-normals");
+    let (o, r) = corner_with_normals(&dir, |w, rng| {
+        let tilt = (10.0 + 12.0 * rng.uniform()).to_radians();
+        let turn = std::f64::consts::TAU * rng.uniform();
+        let (a, b) = (tilt.sin() * turn.cos(), tilt.sin() * turn.sin());
+        match w {
+            0 => [a, b, tilt.cos()],
+            1 => [tilt.cos(), a, b],
+            _ => [a, tilt.cos(), b],
+        }
+    });
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(
         stderr.contains("do worse than normals estimated"),
         "{stderr}"
     );
-    let r: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(report).unwrap()).unwrap();
     let n = &r["parameters"]["normals"];
     assert_eq!(n["source"], "input");
     assert_eq!(n["modes_from"], "estimated");

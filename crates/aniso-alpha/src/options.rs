@@ -320,7 +320,7 @@ pub fn run_warnings(
     style: Style,
 ) -> Vec<String> {
     let mut out = Vec::new();
-    if let Some(g) = detector.given_normals().filter(|g| !(g.used && g.gate)) {
+    if let Some(g) = detector.given_normals().filter(|g| !g.in_full()) {
         let lead = match g.explained {
             Some(_) => "the input's normals do worse than normals estimated from the points",
             None => "the input's normals disagree with its points",

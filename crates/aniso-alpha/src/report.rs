@@ -98,7 +98,7 @@ pub fn parameters_json(d: &Detector) -> Value {
                 "usable": n,
                 "agreement": g.map(|g| num(g.agreement)),
                 "explained": g.and_then(|g| g.explained).map(explained),
-                "modes_from": g.map(|g| if g.used { "input" } else { "estimated" }),
+                "modes_from": g.map(|g| g.modes_from()),
                 "gate": true,
             }),
             (StructureKind::Planes, None, Some(g)) => json!({
@@ -106,7 +106,7 @@ pub fn parameters_json(d: &Detector) -> Value {
                 "input_ignored": true,
                 "agreement": num(g.agreement),
                 "explained": g.explained.map(explained),
-                "modes_from": if g.used { "input" } else { "estimated" },
+                "modes_from": g.modes_from(),
                 "gate": false,
                 "reason": g.ignored_reason(),
             }),

@@ -523,6 +523,21 @@ impl GivenNormals {
         !self.used && !self.gate
     }
 
+    /// Whether the given normals are used for both the orientations and
+    /// the claims' gate.
+    pub fn in_full(&self) -> bool {
+        self.used && self.gate
+    }
+
+    /// Where the orientation modes come from: `"input"` or `"estimated"`.
+    pub fn modes_from(&self) -> &'static str {
+        if self.used {
+            "input"
+        } else {
+            "estimated"
+        }
+    }
+
     /// What the given normals were not used for, and why (empty when they
     /// were used for both the orientations and the gate).
     pub fn ignored_reason(&self) -> String {

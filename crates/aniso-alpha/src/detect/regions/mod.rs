@@ -182,9 +182,7 @@ pub struct RegionStep {
 /// # Errors
 /// As [`Detector::run`].
 pub fn region_step(detector: Detector, sub: &[[f64; 3]]) -> Result<RegionStep, DetectError> {
-    let ignored = detector
-        .given_normals()
-        .is_some_and(|g| !(g.used && g.gate));
+    let ignored = detector.given_normals().is_some_and(|g| !g.in_full());
     let part_angle = detector.part_angle_degrees();
     let det = detector.outlines(false).run(sub)?;
     let mut step = step_of(&det, part_angle);
