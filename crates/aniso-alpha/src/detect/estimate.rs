@@ -596,14 +596,15 @@ pub fn estimate_oriented(
     // The modes of the estimated normals, then of the given ones in their
     // place (the estimated normals kept aside, 12 bytes a point, to be put
     // back if they win): one copy of the local shapes, one search at a time.
-    let of_own = mode_search(kind, points, &shapes, &|_| false);
+    let structure = StructureLike::of(kind, &shapes, &|_| false);
+    let of_own = mode_search(kind, points, &shapes, &structure, &|_| false);
     let own_normals: Vec<[f32; 3]> = shapes.iter().map(|s| s.normal).collect();
     for (s, n) in shapes.iter_mut().zip(normals) {
         if *n != [0.0; 3] {
             s.normal = *n;
         }
     }
-    let of_given = mode_search(kind, points, &shapes, &|_| false);
+    let of_given = mode_search(kind, points, &shapes, &structure, &|_| false);
     g.explained = Some((of_given.explained, of_own.explained));
     g.used = of_given.explained >= of_own.explained;
     let search = if g.used {
@@ -616,7 +617,15 @@ pub fn estimate_oriented(
         }
         of_own
     };
-    let e = estimate_with(kind, points, &shapes, None, given, m2, Some(search));
+    let e = estimate_with(
+        kind,
+        points,
+        &shapes,
+        None,
+        given,
+        m2,
+        Some((structure, search)),
+    );
     (e, Some(g))
 }
 
@@ -658,6 +667,44 @@ struct ModeSearch {
     explained: f64,
 }
 
+/// The structure-like points of a cloud (score ≥ [`SCORE_MIN`], not left
+/// out) and the scales measured on them. They depend on the local shapes'
+/// scores, spacings and spreads, not on their axes: one value serves every
+/// mode search over the same shapes, whichever normals they carry.
+struct StructureLike {
+    /// The structure-like points (indices into the cloud).
+    ids: Vec<u32>,
+    /// The median of every finite nearest-neighbour spacing.
+    spacing_median: f64,
+    /// The spacing d of the structure-like points ([`spacing_and_noise`]).
+    spacing: f64,
+    /// Their noise σ.
+    noise: f64,
+}
+
+impl StructureLike {
+    /// The structure-like points of `shapes` not flagged by `off`, and
+    /// their scales.
+    fn of(kind: StructureKind, shapes: &[LocalShape], off: &dyn Fn(usize) -> bool) -> Self {
+        let mut all_spacing: Vec<f32> = shapes
+            .iter()
+            .map(|s| s.spacing)
+            .filter(|s| s.is_finite())
+            .collect();
+        let spacing_median = quantile(&mut all_spacing, 0.5);
+        let ids: Vec<u32> = (0..shapes.len() as u32)
+            .filter(|&i| shapes[i as usize].score(kind) >= SCORE_MIN && !off(i as usize))
+            .collect();
+        let (spacing, noise) = spacing_and_noise(kind, shapes, &ids, (spacing_median, 0.0));
+        StructureLike {
+            ids,
+            spacing_median,
+            spacing,
+            noise,
+        }
+    }
+}
+
 /// The mode search of [`estimate_with`] over `shapes`, leaving out the
 /// points flagged by `off`: the modes of the structure-like points' axes
 /// (their noise sets the kernel's reach), each mode's members, and the
@@ -666,11 +713,10 @@ fn mode_search(
     kind: StructureKind,
     points: &[[f64; 3]],
     shapes: &[LocalShape],
+    structure: &StructureLike,
     off: &(dyn Fn(usize) -> bool + Sync),
 ) -> ModeSearch {
-    let (structure, spacing_median) = structure_and_spacing(kind, shapes, off);
-    let (_, noise) = spacing_and_noise(kind, shapes, &structure, (spacing_median, 0.0));
-    let found = concentrated_modes(kind, points, shapes, (&structure, noise), off);
+    let found = concentrated_modes(kind, points, shapes, (&structure.ids, structure.noise), off);
     let members = mode_members(kind, shapes, &found, off);
     let explained = explained_share(kind, shapes, &members, off);
     ModeSearch {
@@ -678,24 +724,6 @@ fn mode_search(
         members,
         explained,
     }
-}
-
-/// The structure-like points (score ≥ [`SCORE_MIN`], not `off`) and the
-/// median of every finite spacing.
-fn structure_and_spacing(
-    kind: StructureKind,
-    shapes: &[LocalShape],
-    off: &dyn Fn(usize) -> bool,
-) -> (Vec<u32>, f64) {
-    let mut all_spacing: Vec<f32> = shapes
-        .iter()
-        .map(|s| s.spacing)
-        .filter(|s| s.is_finite())
-        .collect();
-    let structure = (0..shapes.len() as u32)
-        .filter(|&i| shapes[i as usize].score(kind) >= SCORE_MIN && !off(i as usize))
-        .collect();
-    (structure, quantile(&mut all_spacing, 0.5))
 }
 
 /// The points of surfaces, for lines: a point whose neighbourhood, at the
@@ -786,18 +814,27 @@ fn estimate_with(
     surface: Option<&[bool]>,
     given: &Given,
     m2: u32,
-    searched: Option<ModeSearch>,
+    searched: Option<(StructureLike, ModeSearch)>,
 ) -> Estimate {
     let n = points.len();
     let off = |i: usize| surface.is_some_and(|s| s[i]);
-    let (structure, spacing_median) = structure_and_spacing(kind, shapes, &off);
-    let (spacing, noise) = spacing_and_noise(kind, shapes, &structure, (spacing_median, 0.0));
+    let (structure, search) = searched.unwrap_or_else(|| {
+        let structure = StructureLike::of(kind, shapes, &off);
+        let search = mode_search(kind, points, shapes, &structure, &off);
+        (structure, search)
+    });
+    let StructureLike {
+        ids: structure,
+        spacing_median,
+        spacing,
+        noise,
+    } = structure;
     let (alpha_p, lambda2_p, lambda3_p, min_size_p) = cloud_params(kind, spacing, noise, given);
     let ModeSearch {
         found,
         members: member_of,
         explained,
-    } = searched.unwrap_or_else(|| mode_search(kind, points, shapes, &off));
+    } = search;
     let mode_scans: Vec<ModeScan> = found
         .into_iter()
         .zip(member_of)
