@@ -4,6 +4,7 @@ structures (so structures cross tile borders and must come out whole), from
 every kind of source (array, point file, list of LAS tiles, Dask array)."""
 
 import contextlib
+import faulthandler
 import os
 import struct
 import time
@@ -22,6 +23,19 @@ else:
 from aniso_alpha import distributed  # noqa: E402
 
 
+# A test of this module that runs longer than this (they take seconds) is
+# hung, in Dask or in the driver: every thread's stack goes to stderr and the
+# process exits with an error, so a hang fails the run at once and says where.
+HUNG_AFTER_S = 300
+
+
+@pytest.fixture(autouse=True)
+def hang_watchdog():
+    faulthandler.dump_traceback_later(HUNG_AFTER_S, exit=True)
+    yield
+    faulthandler.cancel_dump_traceback_later()
+
+
 @pytest.fixture(scope="module")
 def client():
     from dask.distributed import Client, LocalCluster
@@ -31,8 +45,8 @@ def client():
     )
     c = Client(cluster)
     yield c
-    c.close()
-    cluster.close()
+    c.close(timeout=60)
+    cluster.close(timeout=60)
 
 
 def room(seed=3):
@@ -228,8 +242,8 @@ def killing_cluster(marker, always=False, task="_run_tile"):
         try:
             settle(c, 2)
         finally:
-            c.close()
-            cluster.close()
+            c.close(timeout=60)
+            cluster.close(timeout=60)
 
 
 def settle(c, n_workers, timeout=60.0):
