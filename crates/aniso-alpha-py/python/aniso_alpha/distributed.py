@@ -388,10 +388,12 @@ def _run(
 
     def scatter(data: Any, broadcast: bool = False) -> Any:
         """``client.scatter`` of one object, again (after a pause) when a
-        worker it was sent to is lost on the way."""
+        worker it was sent to is lost on the way. Each scatter has a key of
+        its own (``hash=False``): a tile sent again after its worker was
+        lost does not reuse the key the scheduler is still forgetting."""
         for attempt in range(1, TILE_ATTEMPTS + 1):
             try:
-                return client.scatter([data], broadcast=broadcast)[0]
+                return client.scatter([data], broadcast=broadcast, hash=False)[0]
             except lost_errors:
                 if attempt == TILE_ATTEMPTS:
                     raise

@@ -6,8 +6,9 @@
 //!
 //! **Scales.** A neighbourhood is the [`NEIGHBOURS`] nearest points of a
 //! subsample: scale 0 uses every point, scale j keeps one point in 4^j
-//! (chosen by a hash of its index, so the subsample has no grid pattern of
-//! its own). On a surface, 4× fewer points make the same number of
+//! (chosen by a hash of its rank in the order of positions, so the
+//! subsample has no grid pattern of its own and does not depend on the
+//! order the points are listed in). On a surface, 4× fewer points make the same number of
 //! neighbours reach 2× farther, so the scales double the radius: a noisy
 //! wall or a thick pole, which looks like a blob at the sampling scale,
 //! looks like a plane or a line a few scales up. Scales stop at
@@ -130,7 +131,7 @@ impl LocalShape {
     }
 }
 
-/// A well-mixed 64-bit hash of a point index (splitmix64's finaliser), for
+/// A well-mixed 64-bit hash of a point's rank (splitmix64's finaliser), for
 /// subsamples without a pattern of their own.
 fn mix(i: u64) -> u64 {
     let mut z = i.wrapping_add(0x9e37_79b9_7f4a_7c15);
@@ -139,12 +140,35 @@ fn mix(i: u64) -> u64 {
     z ^ (z >> 31)
 }
 
-/// The indices kept at scale `j`: one point in 4^j.
-fn subsample(n: usize, j: usize) -> Vec<u32> {
+/// The points' indices in the order of their positions: by x, then y, then
+/// z (ties, which are copies of one position, by index). It does not
+/// depend on the order the points were given in, nor on a shift or a
+/// positive scaling of the coordinates, so neither do the subsamples drawn
+/// along it.
+fn position_order(points: &[[f64; 3]]) -> Vec<u32> {
+    let mut order: Vec<u32> = (0..points.len() as u32).collect();
+    crate::par::sort_unstable_by(&mut order, |&a, &b| {
+        let (p, q) = (&points[a as usize], &points[b as usize]);
+        p[0].total_cmp(&q[0])
+            .then(p[1].total_cmp(&q[1]))
+            .then(p[2].total_cmp(&q[2]))
+            .then(a.cmp(&b))
+    });
+    order
+}
+
+/// The indices kept at scale `j` (ascending): one point in 4^j, the point
+/// of rank r in [`position_order`] kept when `mix(r)` is a multiple of 4^j.
+fn subsample(order: &[u32], j: usize) -> Vec<u32> {
     let keep = 1u64 << (2 * j);
-    (0..n as u32)
-        .filter(|&i| mix(u64::from(i)) % keep == 0)
-        .collect()
+    let mut ids: Vec<u32> = order
+        .iter()
+        .enumerate()
+        .filter(|&(r, _)| mix(r as u64) % keep == 0)
+        .map(|(_, &i)| i)
+        .collect();
+    ids.sort_unstable();
+    ids
 }
 
 /// Eigen-decomposition of a symmetric 3×3 matrix in closed form (the
@@ -388,18 +412,19 @@ fn finest_shape(points: &[[f64; 3]], q: &[f64; 3], nb: &[(f64, u32)]) -> LocalSh
 /// 16-nearest queries in all, however many scales there are. A point whose
 /// score at scale 0 already reaches [`GOOD`] looks no further.
 pub fn local_shapes(points: &[[f64; 3]], kind: StructureKind) -> Vec<LocalShape> {
-    let n = points.len();
-    // Nested subsamples (mix(i) % 4^j == 0 implies the same for j − 1).
+    // Nested subsamples (mix(r) % 4^j == 0 implies the same for j − 1).
+    let by_position = position_order(points);
     let mut samples: Vec<Vec<u32>> = vec![Vec::new()];
     let mut trees: Vec<KdTree> = vec![KdTree::new(points, None)];
     for j in 1..MAX_SCALES {
-        let ids = subsample(n, j);
+        let ids = subsample(&by_position, j);
         if ids.len() < 4 * NEIGHBOURS {
             break;
         }
         trees.push(KdTree::new(points, Some(ids.clone())));
         samples.push(ids);
     }
+    drop(by_position);
     let scales = trees.len();
     // Shapes of the subsample points at their own scale, and the link from
     // each point of subsample j − 1 to its nearest point of subsample j.

@@ -3,12 +3,14 @@
 //! opposite are the same (a normal has no sign).
 //!
 //! Mean shift with a flat kernel of angular radius `h`:
-//! 1. at most [`MAX_SAMPLES`] axes are drawn: every axis when there are
-//!    fewer; otherwise one at random from each of [`MAX_SAMPLES`] equal
-//!    runs of the input (jittered strata, from a fixed seed, so
-//!    deterministic). A plain stride would alias with any period in the
-//!    input's order: three walls' points interleaved, 10,443 of them, drew
-//!    a stride of 3 and every sample from one wall;
+//! 1. the axes are sorted (by their first component, then the second, the
+//!    third), so that nothing below depends on the order they were given
+//!    in; at most [`MAX_SAMPLES`] of them are drawn: every axis when there
+//!    are fewer; otherwise one at random from each of [`MAX_SAMPLES`]
+//!    equal runs of the sorted axes (jittered strata, from a fixed seed, so
+//!    deterministic). A plain stride over the input's order would alias
+//!    with any period in it: three walls' points interleaved, 10,443 of
+//!    them, drew a stride of 3 and every sample from one wall;
 //! 2. the density at a sample is the number of samples within `h` of it
 //!    (either sign), counted with a kd-tree over the samples and their
 //!    opposites;
@@ -83,7 +85,7 @@ pub fn canonical(u: [f64; 3]) -> [f64; 3] {
     }
 }
 
-/// One axis from each of [`MAX_SAMPLES`] equal runs of `valid`, drawn at
+/// One axis from each of [`MAX_SAMPLES`] equal runs of `valid` (sorted), drawn at
 /// random within its run from a fixed seed (every axis when there are no
 /// more than [`MAX_SAMPLES`]).
 fn strata(valid: &[[f64; 3]]) -> Vec<[f64; 3]> {
@@ -103,10 +105,15 @@ fn strata(valid: &[[f64; 3]]) -> Vec<[f64; 3]> {
 /// The modes of `axes` (unit vectors; zero or non-finite ones are skipped)
 /// for a kernel of angular radius `h` radians (see the module doc).
 pub fn modes(axes: &[[f64; 3]], h: f64, min_support: usize) -> Vec<Mode> {
-    let valid: Vec<[f64; 3]> = axes.iter().filter_map(|&a| unit(a)).collect();
+    let mut valid: Vec<[f64; 3]> = axes.iter().filter_map(|&a| unit(a)).collect();
     if valid.is_empty() {
         return Vec::new();
     }
+    crate::par::sort_unstable_by(&mut valid, |a, b| {
+        a[0].total_cmp(&b[0])
+            .then(a[1].total_cmp(&b[1]))
+            .then(a[2].total_cmp(&b[2]))
+    });
     let samples = strata(&valid);
     let ns = samples.len();
     // Both signs in one tree: index t < ns is +sample t, ≥ ns its opposite.

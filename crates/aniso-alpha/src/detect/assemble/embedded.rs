@@ -23,6 +23,19 @@
 //! through a crossbar, is not a sheet along it), hold at least as many
 //! points as the line and at least half of the points around it.
 //!
+//! The same test runs a second time on the near surroundings, within
+//! [`NEAR_TUBES`] claim radii of the axis. A line whose claim tube lies
+//! along a crease (the foot of a façade, where ground meets wall) holds a
+//! strip of both surfaces, and both go on beyond the tube; but a long
+//! crease's surroundings of radius L hold the whole street around it
+//! (the far façade, cars, trees), so its two sheets fall short of half.
+//! Near the axis nothing but the two surfaces lies: the annulus from τ to
+//! 3τ is twice the tube's width, so surfaces that go on at the tube's
+//! density hold twice the line's points there, and at least as many
+//! where their density falls off by half. A pole or a cable has nothing
+//! within a few claim radii (the ground at a pole's foot is left out
+//! with the span's ends).
+//!
 //! Rows are lines too: three coplanar parallel cables with nothing else
 //! around them lie inside their "surface" as well. So the stage runs in
 //! the automatic mode only (`Regime::drops_lines_inside_surfaces`), and
@@ -40,6 +53,9 @@ use crate::par::map_ranges;
 
 /// Share of the span at each end left out of the surroundings.
 const END_SHARE: f64 = 0.1;
+
+/// Radius of the near surroundings, in claim radii.
+const NEAR_TUBES: f64 = 3.0;
 
 /// Drops the line parts that lie inside a surface (module doc); how many
 /// went. Parts in parallel.
@@ -68,14 +84,32 @@ fn in_surface(p: &Draft, tau: f64, cloud: &Cloud<'_>, placed: &mut Vec<Placed>) 
     let super::Primitive::Line(f) = &p.fit else {
         return false;
     };
-    let points = cloud.points();
-    let (t0, t1) = span(f, &p.members, points);
+    let (t0, t1) = span(f, &p.members, cloud.points());
     let length = t1 - t0;
     if length.is_nan() || length <= 0.0 {
         return false;
     }
+    let near = NEAR_TUBES * tau;
+    on_sheets_within(p, f, (t0, t1), length, tau, cloud, placed)
+        || (near < length && on_sheets_within(p, f, (t0, t1), near, tau, cloud, placed))
+}
+
+/// Whether the points around the line part `p` (axis `f`, span
+/// `(t0, t1)`) within `radius` of its axis lie on at most two sheets that
+/// hold at least as many points as the line and half of those around it
+/// (module doc).
+fn on_sheets_within(
+    p: &Draft,
+    f: &super::super::fit::LineFit,
+    (t0, t1): (f64, f64),
+    radius: f64,
+    tau: f64,
+    cloud: &Cloud<'_>,
+    placed: &mut Vec<Placed>,
+) -> bool {
+    let points = cloud.points();
+    let length = t1 - t0;
     let (lo, hi) = (t0 + END_SHARE * length, t1 - END_SHARE * length);
-    let radius = length;
     let mid = 0.5 * (t0 + t1);
     let centre = [0, 1, 2].map(|k| f.centroid[k] + mid * f.direction[k]);
     let reach = (radius * radius + 0.25 * (hi - lo) * (hi - lo)).sqrt();
@@ -164,15 +198,43 @@ fn best_half_plane(placed: &[Placed], taken: &[bool], tol: f64) -> Option<f64> {
     if !any {
         return None;
     }
-    let (mut run, mut best, mut at) = (0i64, i64::MIN, 0usize);
-    for (i, d) in diff.iter().take(ANGLE_BINS).enumerate() {
-        run += d;
-        if run > best {
-            best = run;
-            at = i;
+    let mut run = 0i64;
+    let counts: Vec<i64> = diff[..ANGLE_BINS]
+        .iter()
+        .map(|d| {
+            run += d;
+            run
+        })
+        .collect();
+    Some((middle_of_widest_peak(&counts) + 0.5) * width - PI)
+}
+
+/// The middle (a bin index, fractional, in `[0, n)`) of the longest run of
+/// bins holding the highest count in the circular histogram `counts`: a
+/// half-plane's points count over a range of angles (each within its
+/// tolerance), and the middle of that range holds them with the most room.
+fn middle_of_widest_peak(counts: &[i64]) -> f64 {
+    let n = counts.len();
+    let best = counts.iter().copied().max().unwrap_or(0);
+    // Start after a bin below the peak, so that no run is cut in two by
+    // the wrap; every bin at the peak: any angle will do.
+    let Some(below) = counts.iter().position(|&c| c != best) else {
+        return 0.0;
+    };
+    let (mut widest, mut from) = (0usize, 0usize);
+    let mut len = 0;
+    for k in 1..=n {
+        let i = (below + k) % n;
+        if counts[i] == best {
+            len += 1;
+            if len > widest {
+                (widest, from) = (len, i + n + 1 - len);
+            }
+        } else {
+            len = 0;
         }
     }
-    Some((at as f64 + 0.5) * width - PI)
+    (from as f64 + 0.5 * (widest as f64 - 1.0)) % n as f64
 }
 
 /// The standard deviation of `xs` (0 for fewer than two).
@@ -234,6 +296,60 @@ mod tests {
             pts.extend(line_at(-(r as f64) * 0.4, 0.0));
         }
         assert!(run(&pts, (0..40).collect(), 0.01));
+    }
+
+    #[test]
+    fn the_half_plane_is_the_middle_of_the_widest_peak() {
+        assert_eq!(middle_of_widest_peak(&[0, 2, 2, 2, 0, 2, 1]), 2.0);
+        // A peak across the wrap: bins 6, 0, 1.
+        assert_eq!(middle_of_widest_peak(&[3, 3, 0, 1, 0, 0, 3]), 0.0);
+        assert_eq!(middle_of_widest_peak(&[3, 0, 0, 1, 0, 3, 3]), 6.0);
+        assert_eq!(middle_of_widest_peak(&[1, 1, 1]), 0.0);
+    }
+
+    #[test]
+    fn a_crease_in_clutter_lies_in_its_surfaces() {
+        // The foot of a wall sampled on a 0.05 grid: the part is the strip
+        // of both surfaces within its claim radius 0.1 of the crease (3 rows
+        // of ground, 2 of wall), and both surfaces go on to 0.5.
+        let tau = 0.1;
+        let mut pts = Vec::new();
+        for r in 0..3 {
+            pts.extend(line_at(-(r as f64) * 0.05, 0.0));
+        }
+        for r in 1..=2 {
+            pts.extend(line_at(0.0, r as f64 * 0.05));
+        }
+        let members: Vec<u32> = (0..pts.len() as u32).collect();
+        for r in 3..=10 {
+            pts.extend(line_at(-(r as f64) * 0.05, 0.0));
+            pts.extend(line_at(0.0, r as f64 * 0.05));
+        }
+        // Clutter in the street, out of both surfaces' reach from the axis:
+        // more than the sheets hold within the line's length.
+        let mut s = 777u64;
+        let mut rnd = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..2000 {
+            pts.push([rnd() * 1.95, -0.4 - rnd() * 1.3, 0.4 + rnd() * 1.3]);
+        }
+        let copies = Copies::none(pts.len());
+        let cloud = Cloud::new(&pts, &copies);
+        let part = Draft::line(&pts, members.clone(), 0, (tau, 0.1)).0;
+        let super::super::Primitive::Line(f) = &part.fit else {
+            panic!("a line part");
+        };
+        let ends = span(f, &part.members, &pts);
+        let length = ends.1 - ends.0;
+        // Within the line's length the clutter outweighs the sheets...
+        let far = on_sheets_within(&part, f, ends, length, tau, &cloud, &mut Vec::new());
+        assert!(!far, "the far surroundings alone hold the crease");
+        // ...near the axis the two surfaces hold it.
+        assert!(run(&pts, members, tau));
     }
 
     #[test]
