@@ -663,6 +663,19 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
         Some(input) => common::kept_points(&cloud, input, args.background_classes)?,
         None => None,
     };
+    // A labelled LAS output cannot hold an organized cloud's NaN rows:
+    // said before the run, not after it.
+    let las_out = paths.output.as_ref().filter(|p| {
+        let ext = p
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase());
+        paths.labelled_output && matches!(ext.as_deref(), Some("las" | "laz"))
+    });
+    if let Some(out) = las_out {
+        if cloud.finite_rows().is_some() {
+            return Err(CliError::in_file(out, io::NO_RETURN_IN_LAS));
+        }
+    }
     let subset: Option<Vec<[f64; 3]>> = keep
         .as_ref()
         .map(|k| k.iter().map(|&i| cloud.points[i as usize]).collect());

@@ -95,6 +95,15 @@ pub fn run(args: &ViewArgs, timings: &mut Timings) -> Result<(), CliError> {
         }
         None => None,
     };
+    // An organized cloud's points without a return (NaN) are not drawn.
+    let (cloud, labels, parts) = match cloud.finite_rows() {
+        None => (cloud, labels, parts),
+        Some(rows) => {
+            let pick =
+                |l: Option<Vec<i64>>| l.map(|l| rows.iter().map(|&i| l[i as usize]).collect());
+            (cloud.select(&rows), pick(labels), pick(parts))
+        }
+    };
     let title = args.input.file_name().map_or_else(
         || args.input.display().to_string(),
         |f| f.to_string_lossy().into_owned(),

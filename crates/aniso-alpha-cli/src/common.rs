@@ -451,17 +451,27 @@ pub fn cloud_output(path: &Path) -> Result<CloudOutput, CliError> {
     }
 }
 
-/// The points a detection runs on when LAS classes are excluded
-/// (`--background-classes`): indices into the input, ascending. `None`
-/// keeps every point. The classes come from the cloud's `classification`
-/// attribute (LAS, or a PLY/PCD property of that name).
+/// The points a detection runs on: indices into the input, ascending;
+/// `None` keeps every point. Left out: an organized cloud's points without
+/// a return (NaN coordinates, [`PointCloud::finite_rows`]), and the LAS
+/// classes of `--background-classes`, read from the cloud's
+/// `classification` attribute (LAS, or a PLY/PCD property of that name).
 pub fn kept_points(
     cloud: &PointCloud,
     input: &Path,
     exclude: Option<aio::ClassSet>,
 ) -> Result<Option<Vec<u32>>, CliError> {
+    let finite = cloud.finite_rows();
+    if let Some(rows) = &finite {
+        info(format_args!(
+            "{}: {} of {} points have no return (NaN coordinates of an organized cloud): labelled -1",
+            display_input(input),
+            cloud.points.len() - rows.len(),
+            cloud.points.len()
+        ));
+    }
     let Some(exclude) = exclude else {
-        return Ok(None);
+        return Ok(finite);
     };
     let class = cloud
         .attributes
@@ -475,7 +485,10 @@ pub fn kept_points(
         })?;
     let n = u32::try_from(cloud.points.len())
         .map_err(|_| CliError::in_file(input, "more than 2^32 - 1 points"))?;
-    let keep: Vec<u32> = (0..n)
+    let rows = finite.unwrap_or_else(|| (0..n).collect());
+    let before = rows.len();
+    let keep: Vec<u32> = rows
+        .into_iter()
         .filter(|&i| {
             let c = class.values.get_f64(i as usize);
             !(0.0..=255.0).contains(&c) || !exclude.contains(c as u8)
@@ -484,8 +497,8 @@ pub fn kept_points(
     info(format_args!(
         "{}: {} of {} points excluded by --background-classes (labelled -1)",
         display_input(input),
-        cloud.points.len() - keep.len(),
-        cloud.points.len()
+        before - keep.len(),
+        before
     ));
     Ok(Some(keep))
 }

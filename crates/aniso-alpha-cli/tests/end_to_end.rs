@@ -804,3 +804,115 @@ fn labels_alone_skip_the_outlines_and_keep_the_labels() {
         assert!(p["triangles"].as_u64().unwrap_or(0) > 0, "{p}");
     }
 }
+
+#[test]
+fn detect_labels_an_organized_clouds_pixels_without_a_return_background() {
+    // Three perpendicular walls seen as a 117 × 39 depth image (a PCD with
+    // HEIGHT > 1, as PCL writes a Kinect frame): every 7th pixel and the
+    // image's first column have no return (NaN). `detect` says how many,
+    // runs on the others, and writes one label per pixel, -1 for those.
+    let dir = TempDir::new("e2e", "organized-pcd");
+    let mut rng = SplitMix64::new(7);
+    let (width, height) = (117usize, 39usize);
+    let mut rows = Vec::new();
+    let mut no_return = Vec::new();
+    for j in 0..height {
+        for i in 0..width {
+            let row = rows.len();
+            let (w, k) = (i / 39, i % 39);
+            let (u, v) = ((k + 1) as f64 * 0.1, (j + 1) as f64 * 0.1);
+            let e = 0.01 * (rng.uniform() - 0.5);
+            let p = match w {
+                0 => [u, v, e],
+                1 => [e, u, v],
+                _ => [u, e, v],
+            };
+            if i == 0 || row % 7 == 3 {
+                no_return.push(row);
+                rows.push("nan nan nan".to_string());
+            } else {
+                rows.push(format!("{} {} {}", p[0], p[1], p[2]));
+            }
+        }
+    }
+    let pcd = format!(
+        "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH {width}\n\
+         HEIGHT {height}\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {}\nDATA ascii\n{}\n",
+        width * height,
+        rows.join("\n")
+    );
+    let input = dir.file("frame.pcd", pcd.as_bytes());
+    let input = input.to_str().unwrap();
+    let labels = dir.path("labels.txt");
+    let parts = dir.path("parts.txt");
+    let ply = dir.path("out.ply");
+    let o = ok(&[
+        "detect",
+        input,
+        "--structure",
+        "planes",
+        "--labels",
+        labels.to_str().unwrap(),
+        "--part-labels",
+        parts.to_str().unwrap(),
+        "--output",
+        ply.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    let absent = no_return.len();
+    assert!(
+        stderr.contains(&format!(
+            "{absent} of {} points have no return (NaN coordinates of an organized cloud): labelled -1",
+            width * height
+        )),
+        "{stderr}"
+    );
+    let ints = |p: &Path| -> Vec<i64> {
+        let text = std::fs::read_to_string(p).unwrap();
+        text.lines().map(|l| l.parse().unwrap()).collect()
+    };
+    let ids = ints(&parts);
+    assert_eq!(ids.len(), width * height, "one label per pixel");
+    assert_eq!(ints(&labels).len(), width * height);
+    assert!(no_return.iter().all(|&r| ids[r] == -1));
+    // The three walls: each holds most of its pixels with a return.
+    let mut sizes = std::collections::BTreeMap::new();
+    for &id in ids.iter().filter(|&&id| id >= 0) {
+        *sizes.entry(id).or_insert(0usize) += 1;
+    }
+    let big = sizes.values().filter(|&&s| s > 1100).count();
+    assert_eq!(big, 3, "{sizes:?}");
+    // The labelled PLY keeps every row.
+    let text = std::fs::read(&ply).unwrap();
+    let head = String::from_utf8_lossy(&text[..text.len().min(400)]).into_owned();
+    assert!(
+        head.contains(&format!("element vertex {}", width * height)),
+        "{head}"
+    );
+
+    // A labelled LAS cannot hold the NaN rows: refused before the run,
+    // nothing written.
+    let las = dir.path("out.las");
+    let o = run_in(
+        None,
+        &[
+            "detect",
+            input,
+            "--structure",
+            "planes",
+            "--output",
+            las.to_str().unwrap(),
+        ],
+    );
+    assert_eq!(o.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        stderr.contains("cannot hold points without a return"),
+        "{stderr}"
+    );
+    assert!(
+        !stderr.contains("structure(s)"),
+        "refused before the run: {stderr}"
+    );
+    assert!(!las.exists());
+}

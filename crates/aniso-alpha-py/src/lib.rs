@@ -29,7 +29,7 @@ use aniso_alpha::delaunay::Triangulation;
 use aniso_alpha::detect::Detection;
 use aniso_alpha::io::{
     las_point_count, read_las_range, read_las_range_records, read_points, write_labelled_cloud,
-    Attribute, Format, Labelled, LasSource, PointCloud, ReadOptions,
+    Attribute, Format, Labelled, LasSource, PointCloud, ReadOptions, ReadWarning,
 };
 use aniso_alpha::options::{run_warnings, Style};
 use aniso_alpha::report::{part_meshes, PartMeshes};
@@ -265,7 +265,8 @@ pub struct PyLas {
 /// What `read` returns: points (float64 (n, 3)), the attributes as (name,
 /// 1-D array of the file's type) in file order, the normals (float64 (n,
 /// 3)) when the file gives them, the reader's warnings, a LAS/LAZ file's
-/// records, and the format's name.
+/// records, the format's name, and when an organized cloud's points
+/// without a return were left out, the file row of each point kept.
 type ReadOut<'py> = (
     Bound<'py, PyArray2<f64>>,
     Vec<(String, Bound<'py, PyAny>)>,
@@ -273,6 +274,7 @@ type ReadOut<'py> = (
     Vec<String>,
     Option<PyLas>,
     &'static str,
+    Option<Bound<'py, PyArray1<i64>>>,
 );
 
 /// The points of a point file in file order, with every attribute the
@@ -290,7 +292,7 @@ fn read(
     start: Option<u64>,
     count: Option<u64>,
 ) -> PyResult<ReadOut<'_>> {
-    let (cloud, format) = detached(py, 1, |_| {
+    let (cloud, format, rows) = detached(py, 1, |_| {
         let options = ReadOptions {
             attributes,
             ..ReadOptions::default()
@@ -307,13 +309,32 @@ fn read(
             (s, c) => read_las_range(&path, s.unwrap_or(0), c.unwrap_or(u64::MAX), &options),
         }
         .map_err(io_error)?;
-        Ok((cloud, format))
+        // An organized cloud's points without a return (NaN) are left
+        // out, as Open3D's reader does; their rows are kept.
+        let (cloud, rows) = match cloud.finite_rows() {
+            None => (cloud, None),
+            Some(rows) => {
+                let mut kept = cloud.select(&rows);
+                kept.warnings = cloud.warnings;
+                (kept, Some(rows))
+            }
+        };
+        Ok((cloud, format, rows))
     })?;
     let normals = match format {
         Format::Ply | Format::Pcd => cloud.normals().map(|n| rows_to_numpy(py, n)),
         _ => None,
     };
-    let warnings = cloud.warnings.iter().map(|w| w.to_string()).collect();
+    let mut warnings: Vec<String> = cloud.warnings.iter().map(|w| w.to_string()).collect();
+    if rows.is_some() {
+        if let Some(w) = warnings
+            .iter_mut()
+            .zip(&cloud.warnings)
+            .find_map(|(w, r)| matches!(r, ReadWarning::NoReturn { .. }).then_some(w))
+        {
+            w.push_str(": left out of the Cloud (Cloud.rows: each point's row in the file)");
+        }
+    }
     let las = cloud.las.map(|l| PyLas { las: Arc::from(l) });
     let attrs = cloud
         .attributes
@@ -334,6 +355,12 @@ fn read(
         warnings,
         las,
         name,
+        rows.map(|r| {
+            r.into_iter()
+                .map(i64::from)
+                .collect::<Vec<_>>()
+                .into_pyarray(py)
+        }),
     ))
 }
 

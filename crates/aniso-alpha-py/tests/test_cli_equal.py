@@ -199,3 +199,51 @@ def test_a_ladder_too_large_is_declined_with_a_warning():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert aa.detect(pts[:4000], "planes").warnings == []
+
+
+def test_an_organized_pcd_gives_the_clis_labels_per_pixel(cli, tmp_path):
+    # A 60 x 40 depth image of two perpendicular planes (an organized PCD,
+    # HEIGHT > 1), with pixels without a return (NaN) as PCL writes them:
+    # `read` leaves them out and says so, `Cloud.rows` maps the points back
+    # to the pixels, and the labels per pixel equal the CLI's file.
+    rng = np.random.default_rng(4)
+    width, height = 60, 40
+    u, v = np.meshgrid(np.arange(width) * 0.05, np.arange(height) * 0.05)
+    u, v = u.ravel(), v.ravel()
+    floor = u < 1.5
+    pts = np.where(
+        floor[:, None],
+        np.c_[u, v, np.zeros_like(u)],
+        np.c_[np.full_like(u, 1.5), v, u - 1.5],
+    ) + rng.normal(0, 0.002, (width * height, 3))
+    absent = rng.random(width * height) < 0.1
+    pts[absent] = np.nan
+    header = (
+        "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
+        f"WIDTH {width}\nHEIGHT {height}\nVIEWPOINT 0 0 0 1 0 0 0\n"
+        f"POINTS {width * height}\nDATA binary\n"
+    )
+    path = tmp_path / "frame.pcd"
+    path.write_bytes(header.encode() + pts.astype("<f4").tobytes())
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        cloud = aa.read(path)
+    said = [str(w.message) for w in caught if issubclass(w.category, aa.AnisoAlphaWarning)]
+    assert any(
+        f"{absent.sum()} of {width * height} points of the organized cloud have no return" in m
+        and "Cloud.rows" in m
+        for m in said
+    ), said
+    assert len(cloud) == width * height - absent.sum()
+    np.testing.assert_array_equal(cloud.rows, np.flatnonzero(~absent))
+    assert np.isfinite(cloud.points).all()
+
+    det = aa.detect(cloud, "planes")
+    per_pixel = np.full(width * height, -1)
+    per_pixel[cloud.rows] = det.part_labels
+    run_cli(cli, "detect", path, "--structure", "planes", "--part-labels", tmp_path / "p.txt")
+    np.testing.assert_array_equal(per_pixel, read_ints(tmp_path / "p.txt"))
+    assert len(det.planes) == 2
+    # A file with no such rows has none.
+    assert aa.read(FIXTURES / "grid_6.xyz").rows is None

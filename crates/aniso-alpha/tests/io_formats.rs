@@ -6,8 +6,9 @@ use crate::common;
 use common::TempDir;
 
 use aniso_alpha::io::{
-    read_labels, read_pcd_bytes, read_ply_bytes, read_points, read_points_bytes, write_labels,
-    write_obj, write_ply, ClassSet, IoError, Mesh, PlyEncoding, ReadOptions,
+    read_labels, read_pcd_bytes, read_ply_bytes, read_points, read_points_bytes,
+    write_labelled_cloud, write_labels, write_obj, write_ply, ClassSet, IoError, Labelled, Mesh,
+    PlyEncoding, PointCloud, ReadOptions, ReadWarning,
 };
 
 fn tmp_dir(name: &str) -> TempDir {
@@ -386,6 +387,92 @@ fn pcd_ascii_binary_compressed() {
             e.to_string().starts_with("c.pcd") && e.to_string().contains(want),
             "{e} / {want}"
         );
+    }
+}
+
+/// A PCD header of `width` × `height` points of x y z, `data` ascii or
+/// binary.
+fn organized_header(data: &str, width: usize, height: usize) -> String {
+    format!(
+        "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH {width}\n\
+         HEIGHT {height}\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {}\nDATA {data}\n",
+        width * height
+    )
+}
+
+#[test]
+fn an_organized_pcd_keeps_its_pixels_without_a_return_as_nan_rows() {
+    let none = ReadOptions::default();
+    // A 3 × 2 depth image (ascii, as PCL writes it) with two pixels
+    // without a return: every row is kept, in file order.
+    let ascii =
+        organized_header("ascii", 3, 2) + "0 0 1\nnan nan nan\n2 0 1\n0 1 1\n1 1 1\nnan nan nan\n";
+    let c = read_pcd_bytes(Path::new("o.pcd"), ascii.as_bytes(), &none).unwrap();
+    assert_eq!(c.points.len(), 6);
+    assert!(c.points[1].iter().all(|v| v.is_nan()) && c.points[5][2].is_nan());
+    assert_eq!(c.points[4], [1.0, 1.0, 1.0]);
+    assert_eq!(c.finite_rows(), Some(vec![0, 2, 3, 4]));
+    assert_eq!(c.warnings, [ReadWarning::NoReturn { count: 2, of: 6 }]);
+    assert_eq!(
+        c.warnings[0].to_string(),
+        "2 of 6 points of the organized cloud have no return (NaN coordinates)"
+    );
+    let kept = c.select(&[0, 4]);
+    assert_eq!(kept.points, [[0.0, 0.0, 1.0], [1.0, 1.0, 1.0]]);
+    assert_eq!(kept.finite_rows(), None);
+
+    // The same image binary: the same rows.
+    let mut bin = organized_header("binary", 3, 2).into_bytes();
+    for p in &c.points {
+        for v in p {
+            bin.extend_from_slice(&(*v as f32).to_le_bytes());
+        }
+    }
+    let b = read_pcd_bytes(Path::new("o.pcd"), &bin, &none).unwrap();
+    assert_eq!(b.finite_rows(), c.finite_rows());
+    assert_eq!(b.points[3], c.points[3]);
+
+    // One row (HEIGHT 1) is no image: NaN stays an input error (SPEC §1),
+    // and an image with no return at all is refused.
+    let flat = organized_header("ascii", 6, 1) + "0 0 1\nnan nan nan\n2 0 1\n0 1 1\n1 1 1\n1 2 1\n";
+    let e = read_pcd_bytes(Path::new("o.pcd"), flat.as_bytes(), &none).unwrap_err();
+    assert!(e.to_string().contains("non-finite"), "{e}");
+    let empty = organized_header("ascii", 1, 2) + "nan nan nan\nnan nan nan\n";
+    let e = read_pcd_bytes(Path::new("o.pcd"), empty.as_bytes(), &none).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("every point of the organized cloud is NaN"),
+        "{e}"
+    );
+    // Every other reader's cloud is finite: no rows to leave out.
+    let t = read_points_bytes(Path::new("t.xyz"), b"0 0 0\n1 0 0\n", &none).unwrap();
+    assert_eq!(t.finite_rows(), None);
+}
+
+#[test]
+fn a_cloud_with_nan_rows_is_written_as_ply_and_refused_as_las() {
+    let dir = tmp_dir("nan-rows");
+    let cloud = PointCloud {
+        points: vec![[0.0, 0.0, 0.0], [f64::NAN; 3], [1.0, 0.0, 0.0]],
+        ..PointCloud::default()
+    };
+    let ids = [0, -1, 0];
+    let ply = dir.path("o.ply");
+    write_labelled_cloud(&ply, &cloud, &Labelled::new(&ids, &ids)).unwrap();
+    let back = read_points(&ply, &ReadOptions::default());
+    // The PLY keeps every row, NaN where there was no return (as PCL and
+    // CloudCompare write such clouds); a PLY is no organized cloud, so
+    // reading it back refuses the NaN (SPEC §1).
+    assert!(back.unwrap_err().to_string().contains("non-finite"));
+    for name in ["o.las", "o.laz"] {
+        let out = dir.path(name);
+        let e = write_labelled_cloud(&out, &cloud, &Labelled::new(&ids, &ids)).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("cannot hold points without a return"),
+            "{e}"
+        );
+        assert!(!out.exists(), "{name}: nothing is written");
     }
 }
 

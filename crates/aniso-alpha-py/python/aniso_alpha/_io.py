@@ -55,6 +55,13 @@ class Cloud:
         path: the file read, or ``None``.
         format: ``"text"``, ``"ply"``, ``"las"`` (LAS or LAZ), ``"pcd"`` or
             ``"e57"``.
+        rows: int64 (n,), each point's row in the file, when some rows
+            were left out: an organized PCD cloud's (``HEIGHT`` > 1, a
+            depth image's) pixels without a return, whose coordinates are
+            NaN (as Open3D's reader leaves them out); ``None`` otherwise.
+            ``image = np.full(width * height, -1); image[cloud.rows] =
+            det.labels`` gives the labels per pixel, as the CLI's
+            ``--labels`` file holds them.
 
     A ``Cloud`` is array-like: ``np.asarray(cloud)`` is its points, so
     :func:`aniso_alpha.delaunay` and friends take it as they took the
@@ -69,6 +76,7 @@ class Cloud:
     # A LAS/LAZ file's header, VLRs and records: `write` copies every
     # record byte for byte while the point count is the file's.
     _las: Optional[Any] = field(default=None, repr=False)
+    rows: Optional[NDArray[np.int64]] = None
 
     def __len__(self) -> int:
         return len(self.points)
@@ -111,8 +119,9 @@ def read(
 
     Returns:
         a :class:`Cloud`. What the reader guessed (a text file's first
-        line taken as a header, E57 points skipped) is issued as an
-        :class:`AnisoAlphaWarning`, as the CLI prints it.
+        line taken as a header, E57 points skipped, an organized PCD
+        cloud's points without a return left out: :attr:`Cloud.rows`) is
+        issued as an :class:`AnisoAlphaWarning`, as the CLI prints it.
 
     Raises:
         OSError: the file cannot be opened (``FileNotFoundError``...).
@@ -137,11 +146,11 @@ def read(
     for name, v in (("start", start), ("count", count)):
         if v is not None and not (isinstance(v, (int, np.integer)) and v >= 0):
             raise ValueError(f"{name} must be a non-negative integer, got {v!r}")
-    points, attrs, normals, messages, las, fmt = _native.read(
+    points, attrs, normals, messages, las, fmt, rows = _native.read(
         p, attributes, None if start is None else int(start), None if count is None else int(count)
     )
     _warn([f"{p}: {m}" for m in messages])
-    return Cloud(points, normals, dict(attrs), p, fmt, las)
+    return Cloud(points, normals, dict(attrs), p, fmt, las, rows)
 
 
 def _labels_of(

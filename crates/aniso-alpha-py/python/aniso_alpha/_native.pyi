@@ -191,8 +191,11 @@ def read(
     List[str],
     Optional[LasSource],
     str,
+    Optional[NDArray[np.int64]],
 ]:
-    """(points, attributes, normals, warnings, LAS source, format name)."""
+    """(points, attributes, normals, warnings, LAS source, format name, the
+    file row of each point when an organized cloud's points without a
+    return were left out)."""
 
 def read_las_records(path: str, start: int, count: int) -> Tuple[NDArray[np.float64], LasSource]:
     """The points start..start + count of a LAS/LAZ file and their records."""

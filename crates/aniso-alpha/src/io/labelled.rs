@@ -61,6 +61,11 @@ impl<'a> Labelled<'a> {
 /// is kept as `input_structure` / `input_part`.
 const ADDED: [&str; 2] = ["structure", "part"];
 
+/// Why a cloud with points of NaN coordinates (an organized cloud's
+/// pixels without a return) is not written as LAS.
+pub const NO_RETURN_IN_LAS: &str = "LAS/LAZ cannot hold points without a return (NaN coordinates \
+     of an organized cloud): write the labelled cloud as .ply, which keeps every row";
+
 /// Writes `cloud` with its structure and part ids, atomically, in the
 /// format of `path`'s extension: `.las`, `.laz` (cargo feature `las`) or
 /// `.ply` (binary). See the module docs for what is kept.
@@ -113,6 +118,7 @@ pub fn write_labelled_cloud(
         .unwrap_or_default();
     match ext.as_str() {
         "ply" => write_ply_labelled(path, cloud, labelled),
+        "las" | "laz" if cloud.finite_rows().is_some() => Err(invalid(NO_RETURN_IN_LAS.into())),
         "las" | "laz" => write_las_labelled(path, cloud, labelled, ext == "laz"),
         _ => Err(IoError::UnknownFormat {
             path: path.to_path_buf(),

@@ -58,7 +58,7 @@ pub use atomic::{
 };
 pub use attributes::{Attribute, AttributeType, LasSource, Values, Vlr};
 pub use error::IoError;
-pub use labelled::{write_labelled_cloud, Labelled};
+pub use labelled::{write_labelled_cloud, Labelled, NO_RETURN_IN_LAS};
 pub use labels::{read_labels, read_labels_bytes, write_labels};
 #[cfg(feature = "las")]
 pub use las_write::LasLabelWriter;
@@ -107,6 +107,17 @@ pub enum ReadWarning {
         /// Why.
         reason: &'static str,
     },
+    /// An organized PCD cloud (HEIGHT > 1, a depth image's pixels) holds
+    /// pixels without a return, as PCL writes them: points of NaN
+    /// coordinates. They are kept, so that row i is still the file's
+    /// point i ([`PointCloud::finite_rows`] gives the others); `detect`
+    /// labels them -1.
+    NoReturn {
+        /// Points without a return.
+        count: u64,
+        /// Points in the file.
+        of: u64,
+    },
 }
 
 impl std::fmt::Display for ReadWarning {
@@ -118,6 +129,10 @@ impl std::fmt::Display for ReadWarning {
             ReadWarning::SkippedPoints { count, reason } => {
                 write!(f, "{count} points skipped: {reason}")
             }
+            ReadWarning::NoReturn { count, of } => write!(
+                f,
+                "{count} of {of} points of the organized cloud have no return (NaN coordinates)"
+            ),
         }
     }
 }
@@ -128,6 +143,44 @@ impl std::fmt::Display for ReadWarning {
 pub const NORMAL_NAMES: [[&str; 3]; 2] = [["nx", "ny", "nz"], ["normal_x", "normal_y", "normal_z"]];
 
 impl PointCloud {
+    /// The rows whose three coordinates are finite, when some are not
+    /// (an organized PCD cloud's pixels without a return,
+    /// [`ReadWarning::NoReturn`]); `None` when every point is finite, as
+    /// every other reader guarantees.
+    pub fn finite_rows(&self) -> Option<Vec<u32>> {
+        let finite = |p: &[f64; 3]| p.iter().all(|v| v.is_finite());
+        if self.points.iter().all(finite) {
+            return None;
+        }
+        Some(
+            (0u32..)
+                .zip(&self.points)
+                .filter(|(_, p)| finite(p))
+                .map(|(i, _)| i)
+                .collect(),
+        )
+    }
+
+    /// The cloud of the points at `rows` (ascending), with their labels
+    /// and attributes; no LAS source (its records are the whole file's)
+    /// and no warnings.
+    pub fn select(&self, rows: &[u32]) -> PointCloud {
+        PointCloud {
+            points: rows.iter().map(|&i| self.points[i as usize]).collect(),
+            labels: self
+                .labels
+                .as_ref()
+                .map(|l| rows.iter().map(|&i| l[i as usize]).collect()),
+            attributes: self
+                .attributes
+                .iter()
+                .map(|a| Attribute::new(a.name.clone(), a.values.select(rows)))
+                .collect(),
+            las: None,
+            warnings: Vec::new(),
+        }
+    }
+
     /// The points' normals, when the file gives them and they were read
     /// with [`ReadOptions::attributes`]: the attributes named as in
     /// [`NORMAL_NAMES`] (case-insensitive), as read (not normalised; a

@@ -7,7 +7,7 @@ use super::error::show_token;
 use super::lzf;
 use super::ply::Scalar;
 use super::text::{parse_f64, parse_label};
-use super::{check_finite, non_empty, IoError, PointCloud};
+use super::{check_finite, non_empty, IoError, PointCloud, ReadWarning};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Data {
@@ -50,6 +50,9 @@ struct Header {
     data: Data,
     data_start: usize,
     lines: usize,
+    /// HEIGHT > 1: an organized cloud (a depth image's pixels), whose
+    /// pixels without a return are points of NaN coordinates.
+    organized: bool,
 }
 
 fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header, IoError> {
@@ -192,6 +195,7 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header, IoError> {
         data,
         data_start: pos,
         lines: line,
+        organized: height.is_some_and(|h| h > 1),
     })
 }
 
@@ -351,9 +355,15 @@ pub(crate) fn read_pcd(
                 ));
             }
             // Field f of point i starts at i * stride + offsets[f].
-            decode(path, data, h.points, xyz, label, keep, |f, i| {
-                i * stride + offsets[f]
-            })?
+            decode(
+                path,
+                data,
+                (h.points, h.organized),
+                xyz,
+                label,
+                keep,
+                |f, i| i * stride + offsets[f],
+            )?
         }
         Data::Compressed => {
             let word = |k: usize| -> Option<usize> {
@@ -389,12 +399,36 @@ pub(crate) fn read_pcd(
                 acc += f.bytes() * h.points;
             }
             let fb: Vec<usize> = h.fields.iter().map(Field::bytes).collect();
-            decode(path, &raw, h.points, xyz, label, keep, |f, i| {
-                base[f] + i * fb[f]
-            })?
+            decode(
+                path,
+                &raw,
+                (h.points, h.organized),
+                xyz,
+                label,
+                keep,
+                |f, i| base[f] + i * fb[f],
+            )?
         }
     };
-    non_empty(path, cloud)
+    let mut cloud = non_empty(path, cloud)?;
+    let absent = cloud.points.iter().filter(|p| !is_finite(p)).count();
+    if absent == cloud.points.len() {
+        return Err(IoError::format(
+            path,
+            "every point of the organized cloud is NaN (no return)",
+        ));
+    }
+    if absent > 0 {
+        cloud.warnings.push(ReadWarning::NoReturn {
+            count: absent as u64,
+            of: cloud.points.len() as u64,
+        });
+    }
+    Ok(cloud)
+}
+
+fn is_finite(p: &[f64; 3]) -> bool {
+    p.iter().all(|v| v.is_finite())
 }
 
 fn offsets(h: &Header) -> Vec<usize> {
@@ -422,7 +456,7 @@ struct Keep<'a> {
 fn decode(
     path: &Path,
     data: &[u8],
-    n: usize,
+    (n, organized): (usize, bool),
     xyz: [(usize, Scalar); 3],
     label: Option<(usize, Scalar)>,
     mut keep: Keep<'_>,
@@ -441,7 +475,9 @@ fn decode(
     };
     for i in 0..n {
         let p = [get(xyz[0], i)?, get(xyz[1], i)?, get(xyz[2], i)?];
-        check_finite(path, &p, i, None)?;
+        if !organized {
+            check_finite(path, &p, i, None)?;
+        }
         cloud.points.push(p);
         if let (Some(l), Some(out)) = (label, cloud.labels.as_mut()) {
             out.push(get(l, i)? as i64);
@@ -531,7 +567,9 @@ fn read_ascii(
             })
         };
         let p = [num(want[0])?, num(want[1])?, num(want[2])?];
-        check_finite(path, &p, cloud.points.len(), Some(ln))?;
+        if !h.organized {
+            check_finite(path, &p, cloud.points.len(), Some(ln))?;
+        }
         cloud.points.push(p);
         if let (Some(t), Some(out)) = (want_label, cloud.labels.as_mut()) {
             let v = parse_label(toks[t]).ok_or_else(|| {
