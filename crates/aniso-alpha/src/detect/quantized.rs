@@ -109,6 +109,10 @@ impl Quantization {
             .filter(|(_, p)| hash(p, 3) % every == 0)
             .map(|(i, _)| i)
             .collect();
+        if sample.is_empty() {
+            // Copies of a few points, none drawn: nothing to measure.
+            return Quantization::default();
+        }
         let mut axes = Vec::new();
         for axis in 0..3 {
             let Some(levels) = levels_of(points, axis, n / NEIGHBOURS) else {
@@ -385,6 +389,9 @@ mod tests {
         assert!(Quantization::of(&noisy).is_empty());
         // Too few points to tell.
         assert!(Quantization::of(&staircase(0.01, 0.05)[..20]).is_empty());
+        // Thousands of copies of two points: no panic, nothing found.
+        let copies: Vec<[f64; 3]> = (0..5000).map(|k| [0.0, 0.0, (k % 2) as f64]).collect();
+        assert!(Quantization::of(&copies).is_empty());
     }
 
     #[test]
