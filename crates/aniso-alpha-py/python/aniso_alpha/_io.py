@@ -58,7 +58,8 @@ class Cloud:
         rows: int64 (n,), each point's row in the file, when some rows
             were left out: an organized PCD cloud's (``HEIGHT`` > 1, a
             depth image's) pixels without a return, whose coordinates are
-            NaN (as Open3D's reader leaves them out); ``None`` otherwise.
+            NaN (as Open3D's reader leaves them out with
+            ``remove_nan_points=True``); ``None`` otherwise.
             ``image = np.full(width * height, -1); image[cloud.rows] =
             det.labels`` gives the labels per pixel, as the CLI's
             ``--labels`` file holds them.
