@@ -666,15 +666,10 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
     // A labelled LAS output cannot hold an organized cloud's NaN rows:
     // said before the run, not after it.
     let las_out = paths.output.as_ref().filter(|p| {
-        let ext = p
-            .extension()
-            .map(|e| e.to_string_lossy().to_ascii_lowercase());
-        paths.labelled_output && matches!(ext.as_deref(), Some("las" | "laz"))
+        paths.labelled_output && matches!(io::Format::from_path(p), Ok(io::Format::Las))
     });
-    if let Some(out) = las_out {
-        if cloud.finite_rows().is_some() {
-            return Err(CliError::in_file(out, io::NO_RETURN_IN_LAS));
-        }
+    if let Some(out) = las_out.filter(|_| !cloud.all_finite()) {
+        return Err(CliError::in_file(out, io::NO_RETURN_IN_LAS));
     }
     let subset: Option<Vec<[f64; 3]>> = keep
         .as_ref()

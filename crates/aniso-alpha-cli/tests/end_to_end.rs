@@ -605,11 +605,7 @@ fn detect_uses_the_inputs_normals() {
         ];
         args.extend(extra);
         ok(&args);
-        let parts: Vec<i64> = std::fs::read_to_string(parts)
-            .unwrap()
-            .lines()
-            .map(|l| l.parse().unwrap())
-            .collect();
+        let parts = common::read_ints(&parts);
         let report: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(report).unwrap()).unwrap();
         // The wall's part: the first wall point's; the frame points in it.
@@ -867,13 +863,9 @@ fn detect_labels_an_organized_clouds_pixels_without_a_return_background() {
         )),
         "{stderr}"
     );
-    let ints = |p: &Path| -> Vec<i64> {
-        let text = std::fs::read_to_string(p).unwrap();
-        text.lines().map(|l| l.parse().unwrap()).collect()
-    };
-    let ids = ints(&parts);
+    let ids = common::read_ints(&parts);
     assert_eq!(ids.len(), width * height, "one label per pixel");
-    assert_eq!(ints(&labels).len(), width * height);
+    assert_eq!(common::read_ints(&labels).len(), width * height);
     assert!(no_return.iter().all(|&r| ids[r] == -1));
     // The three walls: each holds most of its pixels with a return.
     let mut sizes = std::collections::BTreeMap::new();

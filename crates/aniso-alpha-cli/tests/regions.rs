@@ -6,7 +6,7 @@ use std::process::{Command, Output};
 
 use crate::common;
 use aniso_alpha::rng::SplitMix64;
-use common::TempDir;
+use common::{read_ints as ints, TempDir};
 
 const BIN: &str = env!("CARGO_BIN_EXE_aniso-alpha");
 
@@ -120,14 +120,6 @@ fn succeeded(o: &Output) {
         "{}",
         String::from_utf8_lossy(&o.stderr)
     );
-}
-
-fn ints(path: &Path) -> Vec<i64> {
-    std::fs::read_to_string(path)
-        .unwrap()
-        .lines()
-        .map(|l| l.parse().unwrap())
-        .collect()
 }
 
 #[test]

@@ -326,16 +326,16 @@ fn read(
         Format::Ply | Format::Pcd => cloud.normals().map(|n| rows_to_numpy(py, n)),
         _ => None,
     };
-    let mut warnings: Vec<String> = cloud.warnings.iter().map(|w| w.to_string()).collect();
-    if rows.is_some() {
-        if let Some(w) = warnings
-            .iter_mut()
-            .zip(&cloud.warnings)
-            .find_map(|(w, r)| matches!(r, ReadWarning::NoReturn { .. }).then_some(w))
-        {
-            w.push_str(": left out of the Cloud (Cloud.rows: each point's row in the file)");
-        }
-    }
+    let warnings = cloud
+        .warnings
+        .iter()
+        .map(|w| match w {
+            ReadWarning::NoReturn { .. } => {
+                format!("{w}: left out of the Cloud (Cloud.rows: each point's row in the file)")
+            }
+            _ => w.to_string(),
+        })
+        .collect();
     let las = cloud.las.map(|l| PyLas { las: Arc::from(l) });
     let attrs = cloud
         .attributes

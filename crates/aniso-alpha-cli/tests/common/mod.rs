@@ -12,3 +12,12 @@ pub use tempdir::TempDir;
 mod tools;
 #[allow(unused_imports)]
 pub use tools::{tool_missing, tools_required};
+
+/// One integer per line (a `--labels` or `--part-labels` file).
+pub fn read_ints(path: &std::path::Path) -> Vec<i64> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .map(|l| l.parse().unwrap())
+        .collect()
+}

@@ -118,7 +118,7 @@ pub fn write_labelled_cloud(
         .unwrap_or_default();
     match ext.as_str() {
         "ply" => write_ply_labelled(path, cloud, labelled),
-        "las" | "laz" if cloud.finite_rows().is_some() => Err(invalid(NO_RETURN_IN_LAS.into())),
+        "las" | "laz" if !cloud.all_finite() => Err(invalid(NO_RETURN_IN_LAS.into())),
         "las" | "laz" => write_las_labelled(path, cloud, labelled, ext == "laz"),
         _ => Err(IoError::UnknownFormat {
             path: path.to_path_buf(),

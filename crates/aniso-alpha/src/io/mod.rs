@@ -148,17 +148,22 @@ impl PointCloud {
     /// [`ReadWarning::NoReturn`]); `None` when every point is finite, as
     /// every other reader guarantees.
     pub fn finite_rows(&self) -> Option<Vec<u32>> {
-        let finite = |p: &[f64; 3]| p.iter().all(|v| v.is_finite());
-        if self.points.iter().all(finite) {
+        if self.all_finite() {
             return None;
         }
         Some(
             (0u32..)
                 .zip(&self.points)
-                .filter(|(_, p)| finite(p))
+                .filter(|(_, p)| is_finite(p))
                 .map(|(i, _)| i)
                 .collect(),
         )
+    }
+
+    /// Whether every point's three coordinates are finite (always, but
+    /// for an organized PCD cloud's pixels without a return).
+    pub fn all_finite(&self) -> bool {
+        self.points.iter().all(is_finite)
     }
 
     /// The cloud of the points at `rows` (ascending), with their labels
@@ -736,6 +741,12 @@ pub(crate) fn non_empty(path: &Path, cloud: PointCloud) -> Result<PointCloud, Io
     }
 }
 
+/// Whether all three coordinates of `p` are finite.
+#[inline]
+pub(crate) fn is_finite(p: &[f64; 3]) -> bool {
+    p[0].is_finite() && p[1].is_finite() && p[2].is_finite()
+}
+
 /// Fails with [`IoError::NonFinite`] unless all three coordinates are finite.
 #[inline]
 pub(crate) fn check_finite(
@@ -744,7 +755,7 @@ pub(crate) fn check_finite(
     index: usize,
     line: Option<usize>,
 ) -> Result<(), IoError> {
-    if p[0].is_finite() && p[1].is_finite() && p[2].is_finite() {
+    if is_finite(p) {
         Ok(())
     } else {
         Err(IoError::NonFinite {

@@ -7,7 +7,7 @@ use super::error::show_token;
 use super::lzf;
 use super::ply::Scalar;
 use super::text::{parse_f64, parse_label};
-use super::{check_finite, non_empty, IoError, PointCloud, ReadWarning};
+use super::{check_finite, is_finite, non_empty, IoError, PointCloud, ReadWarning};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Data {
@@ -425,10 +425,6 @@ pub(crate) fn read_pcd(
         });
     }
     Ok(cloud)
-}
-
-fn is_finite(p: &[f64; 3]) -> bool {
-    p.iter().all(|v| v.is_finite())
 }
 
 fn offsets(h: &Header) -> Vec<usize> {
