@@ -6,12 +6,13 @@ use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
+use aniso_alpha::detect::quantized::Quantization;
 use aniso_alpha::detect::StructureKind;
 use aniso_alpha::detect::{DetectError, Detection, Detector, OrientationSet, Primitive, Stage};
 use aniso_alpha::eval::{evaluate, Evaluation};
 use aniso_alpha::io::{self, write_scene, Mesh, PointCloud, ReadOptions};
 use aniso_alpha::options::{run_warnings, DetectOptions, SamplerChoice, Style};
-use aniso_alpha::report::{detection_json, part_meshes, PartMeshes};
+use aniso_alpha::report::{detection_json, part_meshes, quantized_json, PartMeshes};
 use aniso_alpha::synth::{Scene, SceneOptions};
 use clap::{Args, ValueEnum};
 use serde_json::json;
@@ -680,13 +681,22 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
         (n, _) => n,
     };
     let keep = keep.as_deref();
+    // Coordinates stored in steps coarser than a neighbourhood (a depth
+    // camera's): the run sees each point moved within its step; the
+    // outputs keep the input's coordinates.
+    let quantization = Quantization::of(points);
+    for line in quantization.describe() {
+        common::warn(format_args!("{name}: {line}"));
+    }
+    let dithered = (!quantization.is_empty()).then(|| quantization.dither(points));
+    let seen: &[[f64; 3]] = dithered.as_deref().unwrap_or(points);
     let whole = !paths.whole_outputs(args).is_empty();
     if let Some(side) = crate::cmd_regions::side(args.regions, whole, points) {
         let out = region_outputs(args, &paths);
         let input = crate::cmd_regions::RegionInput {
             name: &name,
             cloud: &cloud,
-            points,
+            points: seen,
             normals: normals.as_deref(),
             keep,
             side,
@@ -697,7 +707,7 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
     let n_input = cloud.points.len();
     let (detector, det, seconds) = detect_points(
         args,
-        points,
+        seen,
         normals.as_deref(),
         (example, paths.holds_outlines(args)),
         timings,
@@ -721,7 +731,8 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
         )
         .ok()
     });
-    let report = report_json(&name, &det, &detector, seconds, scores.as_ref());
+    let mut report = report_json(&name, &det, &detector, seconds, scores.as_ref());
+    report["parameters"]["quantized"] = quantized_json(&quantization);
     write_report_and_views(args, &paths, &name, &run, &report, timings)?;
 
     let mut out = summary(&name, &det, &detector, &report, seconds);

@@ -26,6 +26,7 @@ use std::sync::Arc;
 use aniso_alpha::alpha::AlphaComplex;
 use aniso_alpha::aniso::Anisotropy;
 use aniso_alpha::delaunay::Triangulation;
+use aniso_alpha::detect::quantized::Quantization;
 use aniso_alpha::detect::Detection;
 use aniso_alpha::io::{
     las_point_count, read_las_range, read_las_range_records, read_points, write_labelled_cloud,
@@ -238,18 +239,31 @@ fn detect<'py>(
     // would start a second pool.
     let callback = progress.map(progress::Callback::new);
     let (det, json, warnings) = detached(py, threads, |n| {
-        let mut detector = options::build(&options, pts, normals)?.outlines(outlines);
+        // Coordinates in steps coarser than a neighbourhood (a depth
+        // camera's) are seen dithered within their step, as the CLI sees
+        // them.
+        let quantization = Quantization::of(pts);
+        let dithered = (!quantization.is_empty()).then(|| quantization.dither(pts));
+        let seen = dithered.as_deref().unwrap_or(pts);
+        let mut detector = options::build(&options, seen, normals)?.outlines(outlines);
         if let Some(cb) = &callback {
             detector = detector.progress(cb.tick());
         }
-        let warnings = run_warnings(&options, &detector, pts.len(), n, Style::Python);
-        let det = detector.run(pts).map_err(|e| {
+        let mut warnings = quantization.describe();
+        warnings.extend(run_warnings(
+            &options,
+            &detector,
+            pts.len(),
+            n,
+            Style::Python,
+        ));
+        let det = detector.run(seen).map_err(|e| {
             callback
                 .as_ref()
                 .and_then(|cb| cb.error(&e))
                 .unwrap_or_else(|| value_error(e))
         })?;
-        let json = report::detection_json(&det, &detector);
+        let json = report::detection_json(&det, &detector, &quantization);
         Ok((det, json, warnings))
     })?;
     Ok(PyDetection::output(py, det, json, warnings))
@@ -310,8 +324,7 @@ fn read(
         }
         .map_err(io_error)?;
         // An organized cloud's points without a return (NaN) are left
-        // out, as Open3D's reader does with `remove_nan_points=True`; their rows
-        // are kept.
+        // out, as Open3D's reader does; their rows are kept.
         let (cloud, rows) = match cloud.finite_rows() {
             None => (cloud, None),
             Some(rows) => {

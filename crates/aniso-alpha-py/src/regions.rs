@@ -2,6 +2,7 @@
 //! (`aniso_alpha::detect::regions`), for clouds whose whole run would not
 //! fit in memory.
 
+use aniso_alpha::detect::quantized::Quantization;
 use aniso_alpha::detect::regions::{
     detect_by_regions_with_progress, region_step, wider_margin, RegionJoin, RegionPlan, RegionRun,
     RegionStep,
@@ -83,6 +84,12 @@ pub fn detect_regions<'py>(
     let input = DetectInput::extract(points, normals, threads)?;
     let (pts, normals, threads) = (input.points(), input.normals(), input.threads);
     let callback = progress.map(progress::Callback::new);
+    // Coordinates in steps coarser than a neighbourhood: the regions see
+    // them dithered, as `detect` does (the draw is per point, so every
+    // region sees the same points).
+    let quantization = detached(py, threads, |_| Ok(Quantization::of(pts)))?;
+    let dithered = (!quantization.is_empty()).then(|| quantization.dither(pts));
+    let pts = dithered.as_deref().unwrap_or(pts);
     let (run_side, side) = region_side(pts, side);
     let run = detached(py, threads, |_| {
         let build = |ids: &[u32], sub: &[[f64; 3]]| {
@@ -98,7 +105,9 @@ pub fn detect_regions<'py>(
                 .unwrap_or_else(|| value_error(e))
         })
     })?;
-    Ok((run_out(py, run), side))
+    let mut out = run_out(py, run);
+    out.7.splice(0..0, quantization.describe());
+    Ok((out, side))
 }
 
 /// The joined parts of a region run as rows ([`PartRow`]).

@@ -3,9 +3,13 @@
 //! --report` writes), of which the Python `Detection` keeps `structures`
 //! and `parameters`.
 
+use aniso_alpha::detect::quantized::Quantization;
 use aniso_alpha::detect::{Detection, Detector};
 
-/// The report as JSON text.
-pub fn detection_json(det: &Detection, detector: &Detector) -> String {
-    aniso_alpha::report::detection_json(det, detector).to_string()
+/// The report as JSON text, with the quantized axes the run saw dithered
+/// (`parameters.quantized`, as the CLI's report has them).
+pub fn detection_json(det: &Detection, detector: &Detector, quantization: &Quantization) -> String {
+    let mut r = aniso_alpha::report::detection_json(det, detector);
+    r["parameters"]["quantized"] = aniso_alpha::report::quantized_json(quantization);
+    r.to_string()
 }

@@ -5,6 +5,7 @@
 //! step's spec), without the plan or the rest of the cloud.
 
 use aniso_alpha::aniso::Anisotropy;
+use aniso_alpha::detect::quantized::Quantization;
 use aniso_alpha::detect::StructureKind;
 use aniso_alpha::detect::{Members, Plan, SplitJob, Step, TileOutput};
 use numpy::ndarray::Array3;
@@ -48,7 +49,13 @@ pub fn plan(
     let (pts, normals, threads) = (input.points(), input.normals(), input.threads);
     let (plan, warnings) = detached(py, threads, |n| {
         let detector = options::build(&options, pts, normals)?;
-        let warnings = run_warnings(&options, &detector, pts.len(), n, Style::Python);
+        let mut warnings = run_warnings(&options, &detector, pts.len(), n, Style::Python);
+        // The tiles run on the coordinates as given: a quantized cloud is
+        // not dithered here (its levels would have to travel with every
+        // tile), so its result is not `detect`'s; said, not hidden.
+        warnings.extend(Quantization::of(pts).describe().into_iter().map(|w| {
+            format!("{w}; not here: aniso_alpha.distributed runs on the coordinates as given, aa.detect and the CLI dither them")
+        }));
         Ok((detector.plan(pts, tile).map_err(value_error)?, warnings))
     })?;
     Ok(PyPlan { plan, warnings })
@@ -208,7 +215,8 @@ impl PyPlan {
         let plan = &self.plan;
         let (det, json) = detached(py, threads, |_| {
             let det = plan.finish(pts, outs).map_err(value_error)?;
-            let json = crate::report::detection_json(&det, plan.detector());
+            let json =
+                crate::report::detection_json(&det, plan.detector(), &Quantization::default());
             Ok((det, json))
         })?;
         Ok(PyDetection::output(py, det, json, self.warnings.clone()))

@@ -15,6 +15,7 @@
 //! ```
 
 use crate::detect::orientations::Sampler;
+use crate::detect::quantized::Quantization;
 use crate::detect::StructureKind;
 use crate::detect::{Detection, Detector, OrientationSet, Part, Primitive, Structure};
 use serde_json::{json, Value};
@@ -36,6 +37,18 @@ fn explained((given, estimated): (f64, f64)) -> Value {
 
 fn param(value: f64, estimated: bool, reason: &str) -> Value {
     json!({"value": num(value), "estimated": estimated, "reason": reason})
+}
+
+/// The `parameters.quantized` list: each axis whose coordinates lie on
+/// levels coarser than a point's neighbourhood, with the levels' median
+/// step and the neighbourhood's reach; the run saw its points dithered
+/// within their level ([`crate::detect::quantized`]). Empty for almost
+/// every cloud.
+pub fn quantized_json(q: &Quantization) -> Value {
+    q.axes
+        .iter()
+        .map(|a| json!({"axis": a.name(), "step": num(a.step), "reach": num(a.reach), "dithered": true}))
+        .collect()
 }
 
 /// The `parameters` object: every value used, whether it was estimated,

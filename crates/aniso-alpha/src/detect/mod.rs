@@ -13,7 +13,10 @@
 //! * [`significance`]: the a-contrario test's numbers of false alarms;
 //! * [`local`], [`modes`], [`estimate`]: the local shape of the cloud, the
 //!   modes of its normals or directions, and the parameters and data
-//!   orientation set estimated from them (method doc §8).
+//!   orientation set estimated from them (method doc §8);
+//! * [`quantized`]: coordinates stored in steps coarser than a point's
+//!   neighbourhood (a depth camera's), and the points moved within their
+//!   step before a run (method doc §8).
 //!
 //! The pipeline (private; its types are re-exported here):
 //!
@@ -60,6 +63,7 @@ pub mod orientations;
 mod outline;
 pub mod parts;
 mod prune;
+pub mod quantized;
 mod regime;
 pub mod regions;
 mod scan;

@@ -1,0 +1,626 @@
+//! Coordinates stored on levels coarser than a point's neighbourhood, and
+//! the points moved within their level (docs/method.md §8, "Quantized
+//! coordinates").
+//!
+//! A depth camera stores depth in steps (a Kinect's disparity: 12 mm apart
+//! at 2.5 m, where its pixels are 4 mm apart), so every surface of its
+//! frame is a staircase of flat terraces. The local shapes see the terrace,
+//! not the surface: on PCL's `capture0001.pcd` the noise came out 4e-11,
+//! every normal pointed along the depth axis, and the frame gave 476
+//! parts, one per terrace. A point's true position lies anywhere within
+//! its level (the quantization error is uniform over a step); moving each
+//! point by a uniform draw across its step (dithering) restores the noise
+//! the method assumes, σ = step/√12, and the terraces' surface.
+//!
+//! An axis counts as quantized when its levels are farther apart than the
+//! finest local shape reaches: the median of the points' level steps
+//! exceeds [`REACH_SPACINGS`] times their median nearest-neighbour
+//! distance (both over a sample of at most 1,024 points drawn by a hash
+//! of their coordinates), the radius of a point's [`NEIGHBOURS`] nearest
+//! points on a regular sampling such as a depth image's pixels (on a
+//! square grid the 16th nearest point is √5 ≈ 2.2 spacings away; the
+//! terraces themselves make the sampling uneven, so the reach is not
+//! measured on the cloud: on `capture0001` it came out 3 spacings).
+//! Then a point's neighbourhood lies on one level (a terrace), which no
+//! other sampling does: a regular grid's levels are one spacing apart, and
+//! a LAS file's 1 cm levels under a 10 cm spacing a tenth of one. A level
+//! holding a whole neighbourhood holds at least [`NEIGHBOURS`] points, so
+//! an axis with more distinct values than n / [`NEIGHBOURS`] is given up
+//! as soon as it has shown that many (a continuous axis costs n / 16 hash
+//! insertions; only an axis of few levels is indexed).
+//!
+//! Structures that each lie exactly on one value (three parallel lines 50
+//! apart, floors stacked at whole metres, flat roofs over a flat ground,
+//! as synthetic clouds often are) have coarse levels too, and dithering
+//! them would scatter them. Two tests tell a quantization from them, both
+//! from the method's model of it: the values spread over at least a step
+//! (Widrow's condition for a uniform quantization error; any two levels,
+//! or three of equal weight, spread over less), and the levels are the
+//! terraces of surfaces crossing them ([`terraces`]): seen along the axis
+//! (along the camera's rays for a depth), most points have mostly their
+//! own level around them, and where they meet another level its nearest
+//! point is on the next level up or down. Stacked structures fill each
+//! other's columns; roofs meet the ground several levels apart. On PCL's
+//! raw frames (`capture0001`–`0005`, `person`) a point's own level holds
+//! most of its column for 57–60% of the sample, and the next level is the
+//! nearest for 89–94% of those that meet one; on the stacked floors and
+//! lines of the tests, 0.2–22%, and for the roofs the next level is the
+//! nearest for 7%. PCL's `region_growing_rgb_tutorial.pcd` (a frame with
+//! many surfaces seen at a grazing angle, whose terraces are a pixel or
+//! two wide) has 32% on the first test and is left as it is. The depth
+//! frames of
+//! the corpus (mOSD, 0.6–1.3 m from the camera) have levels 0.9–1.3
+//! spacings apart and are left as they are; dithered anyway, the mean
+//! plane F1 of twelve train frames was unchanged (0.977).
+//!
+//! The draw is a hash of the point's coordinates (rounded to a thousandth
+//! of the reach), so copies of a point stay copies and the result does not
+//! depend on the points' order, on how a cloud is cut into tiles or
+//! regions, or on the file's number format. It does depend on the draw:
+//! where the dithered noise (step/√12, about a spacing at steps of 3.5
+//! spacings) brings the local normals near the mode search's
+//! concentration threshold, another draw can tip the estimate
+//! (docs/method.md §8).
+
+use crate::geometry::kdtree::KdTree;
+
+use super::local::NEIGHBOURS;
+
+/// At most this many points are asked for their nearest neighbour.
+const SPACING_SAMPLE: usize = 1024;
+
+/// The finest neighbourhood's radius ([`NEIGHBOURS`] points) in spacings,
+/// on a regular sampling: on a square grid the 16th nearest point is √5 ≈
+/// 2.2 spacings away.
+pub const REACH_SPACINGS: f64 = 2.0;
+
+/// One axis whose coordinates lie on levels coarser than the points'
+/// neighbourhoods.
+#[derive(Debug, Clone, PartialEq)]
+pub struct QuantizedAxis {
+    /// 0, 1, 2: x, y, z.
+    pub axis: usize,
+    /// The median over the sampled points of their level's step (the mean
+    /// of the gaps to the levels below and above).
+    pub step: f64,
+    /// [`REACH_SPACINGS`] times the median distance from a point to its
+    /// nearest other point (a sample of at most 1,024 points): the finest
+    /// neighbourhood's radius.
+    pub reach: f64,
+    /// The axis' distinct values, ascending.
+    levels: Vec<f64>,
+}
+
+impl QuantizedAxis {
+    /// The axis' name.
+    pub fn name(&self) -> &'static str {
+        ["x", "y", "z"][self.axis]
+    }
+
+    /// The step of the level holding `v` (one of [`Self::levels`]): the
+    /// mean of its gaps to the levels below and above (the one gap at an
+    /// end).
+    fn step_at(&self, v: f64) -> f64 {
+        step_at(&self.levels, v)
+    }
+}
+
+/// The quantized axes of a cloud, and the cloud moved within its levels.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Quantization {
+    /// The quantized axes (none for almost every cloud).
+    pub axes: Vec<QuantizedAxis>,
+}
+
+impl Quantization {
+    /// The axes of `points` whose levels are coarser than a
+    /// neighbourhood's reach, spread over more than a step, and terraces
+    /// side by side rather than structures stacked (none when the cloud
+    /// has fewer than 2·[`NEIGHBOURS`] points or a non-finite one).
+    pub fn of(points: &[[f64; 3]]) -> Quantization {
+        let n = points.len();
+        let finite = |p: &[f64; 3]| p.iter().all(|v| v.is_finite());
+        if n < 2 * NEIGHBOURS || !points.iter().all(finite) {
+            // Too few to tell; a non-finite point is the run's error to
+            // give.
+            return Quantization::default();
+        }
+        let every = n.div_ceil(SPACING_SAMPLE) as u64;
+        let sample: Vec<u32> = (0u32..)
+            .zip(points)
+            .filter(|(_, p)| hash(p, 3) % every == 0)
+            .map(|(i, _)| i)
+            .collect();
+        if sample.is_empty() {
+            // Copies of a few points, none drawn: nothing to measure.
+            return Quantization::default();
+        }
+        let mut axes = Vec::new();
+        for axis in 0..3 {
+            let Some(levels) = levels_of(points, axis, n / NEIGHBOURS) else {
+                continue;
+            };
+            if levels.len() < 2 {
+                continue;
+            }
+            let mut steps: Vec<f64> = sample
+                .iter()
+                .map(|&i| step_at(&levels, points[i as usize][axis]))
+                .collect();
+            let step = median(&mut steps);
+            // The median spacing is below step / REACH_SPACINGS exactly
+            // when more than half of the sample has a point that near.
+            if !near_for_most(points, &sample, step / REACH_SPACINGS) {
+                continue;
+            }
+            // Levels coarser than a neighbourhood are a quantization only
+            // where they are the steps of surfaces crossing them: values
+            // spread over more than a step, and terraces side by side.
+            if spread(points, &sample, axis) < step {
+                continue;
+            }
+            let reach = REACH_SPACINGS * spacing(points, &sample);
+            if !terraces(points, &sample, axis, &levels, reach) {
+                continue;
+            }
+            axes.push(QuantizedAxis {
+                axis,
+                step,
+                reach,
+                levels,
+            });
+        }
+        Quantization { axes }
+    }
+
+    /// Whether no axis is quantized.
+    pub fn is_empty(&self) -> bool {
+        self.axes.is_empty()
+    }
+
+    /// `points` moved, on each quantized axis, by a uniform draw across
+    /// the step of their level (centred on the level); the draw is a hash
+    /// of the point's coordinates, each rounded to a thousandth of the
+    /// reach (so that the same cloud written as float32 or as text is
+    /// drawn alike), and the axis. A value that is not one of the levels
+    /// (another cloud's) takes the step of the nearest one.
+    pub fn dither(&self, points: &[[f64; 3]]) -> Vec<[f64; 3]> {
+        let Some(grain) = self.axes.first().map(|a| a.reach / 1000.0) else {
+            return points.to_vec();
+        };
+        points
+            .iter()
+            .map(|p| {
+                let key = p.map(|v| (v / grain).round());
+                let mut q = *p;
+                for a in &self.axes {
+                    let u = unit(&key, a.axis);
+                    q[a.axis] = p[a.axis] + (u - 0.5) * a.step_at(p[a.axis]);
+                }
+                q
+            })
+            .collect()
+    }
+
+    /// One line per quantized axis, for the CLI's warning and Python's.
+    pub fn describe(&self) -> Vec<String> {
+        self.axes
+            .iter()
+            .map(|a| {
+                format!(
+                    "the {} coordinates lie on levels {:.4} apart (median), farther than a point's \
+                     {} nearest neighbours reach ({:.4}, {} spacings): a depth camera's steps; each \
+                     point is moved within its level (dithered) so that its surface, not the step, \
+                     is seen",
+                    a.name(),
+                    a.step,
+                    NEIGHBOURS,
+                    a.reach,
+                    REACH_SPACINGS
+                )
+            })
+            .collect()
+    }
+}
+
+/// The distinct values of `axis`, ascending, or `None` as soon as there
+/// are more than `most` of them: a continuous axis is given up after
+/// `most` + 1 distinct values are seen, without sorting the cloud.
+fn levels_of(points: &[[f64; 3]], axis: usize, most: usize) -> Option<Vec<f64>> {
+    let mut seen = std::collections::HashSet::with_capacity(most.min(1 << 16) + 1);
+    for p in points {
+        // +0.0 for -0.0: one level.
+        seen.insert((p[axis] + 0.0).to_bits());
+        if seen.len() > most {
+            return None;
+        }
+    }
+    let mut v: Vec<f64> = seen.into_iter().map(f64::from_bits).collect();
+    v.sort_unstable_by(f64::total_cmp);
+    Some(v)
+}
+
+/// The step of the level nearest to `v` among `levels` (ascending, at
+/// least two): the mean of its gaps to the levels below and above, or the
+/// one gap at an end.
+fn step_at(levels: &[f64], v: f64) -> f64 {
+    let i = levels.partition_point(|&l| l < v).min(levels.len() - 1);
+    let i = if i > 0 && (v - levels[i - 1]).abs() < (levels[i] - v).abs() {
+        i - 1
+    } else {
+        i
+    };
+    let below = (i > 0).then(|| levels[i] - levels[i - 1]);
+    let above = (i + 1 < levels.len()).then(|| levels[i + 1] - levels[i]);
+    match (below, above) {
+        (Some(b), Some(a)) => 0.5 * (a + b),
+        (Some(g), None) | (None, Some(g)) => g,
+        (None, None) => 0.0,
+    }
+}
+
+/// Whether more than half of the points at `sample` have another point
+/// (not a copy) nearer than `r`: whether their median distance to the
+/// nearest other point is below `r`. A grid of cells of side `r` over the
+/// points, sorted by cell, and the 27 cells around each sampled point.
+fn near_for_most(points: &[[f64; 3]], sample: &[u32], r: f64) -> bool {
+    if r.is_nan() || r <= 0.0 {
+        return false;
+    }
+    let cell = |p: &[f64; 3], off: [i64; 3]| -> u64 {
+        let c = |a: usize| ((p[a] / r).floor() as i64 + off[a]) as f64;
+        hash(&[c(0), c(1), c(2)], 5)
+    };
+    // Only the points in the cells around the sample are indexed.
+    const AROUND: std::ops::Range<i64> = 0..27;
+    let around = |o: i64| [o % 3 - 1, o / 3 % 3 - 1, o / 9 - 1];
+    let wanted: std::collections::HashSet<u64> = sample
+        .iter()
+        .flat_map(|&i| AROUND.map(move |o| (i, o)))
+        .map(|(i, o)| cell(&points[i as usize], around(o)))
+        .collect();
+    let mut grid: Vec<(u64, u32)> = (0u32..)
+        .zip(points)
+        .map(|(i, p)| (cell(p, [0; 3]), i))
+        .filter(|(key, _)| wanted.contains(key))
+        .collect();
+    grid.sort_unstable_by_key(|e| e.0);
+    let r2 = r * r;
+    let has_near = |&i: &u32| {
+        let p = &points[i as usize];
+        AROUND.into_iter().any(|o| {
+            let key = cell(p, around(o));
+            let from = grid.partition_point(|e| e.0 < key);
+            grid[from..]
+                .iter()
+                .take_while(|e| e.0 == key)
+                .any(|&(_, j)| {
+                    let q = &points[j as usize];
+                    let d2 = (0..3).map(|a| (p[a] - q[a]).powi(2)).sum::<f64>();
+                    d2 > 0.0 && d2 < r2
+                })
+        })
+    };
+    2 * sample.iter().filter(|i| has_near(i)).count() > sample.len()
+}
+
+/// The standard deviation of the `axis` coordinates of the points at
+/// `sample`. Widrow's quantization theorem: a quantization error is
+/// uniform over the step (the model the dither restores) when the values
+/// spread over at least a step; a few structures each lying on one value
+/// (two floors, three parallel lines) spread over less.
+fn spread(points: &[[f64; 3]], sample: &[u32], axis: usize) -> f64 {
+    let n = sample.len() as f64;
+    let mean = sample
+        .iter()
+        .map(|&i| points[i as usize][axis])
+        .sum::<f64>()
+        / n;
+    let var = sample
+        .iter()
+        .map(|&i| (points[i as usize][axis] - mean).powi(2))
+        .sum::<f64>()
+        / n;
+    var.sqrt()
+}
+
+/// Whether the levels of `axis` are the terraces of surfaces crossing
+/// them, side by side across the axis, rather than structures stacked
+/// along it. Seen along its column (the points within `reach` of it
+/// across the axis), a point of a terrace has mostly its own level around
+/// it, and where it meets another level, the nearest is the next one up
+/// or down: the staircase of one surface. Stacked structures (parallel
+/// lines, floors) fill each other's columns; flat roofs at a few heights
+/// over the ground meet it several levels apart. Both must hold for more
+/// than half of the sample (of those that meet another level, for the
+/// second). Where every level is positive, the axis is a depth seen from
+/// a camera at the origin (a depth frame in its own coordinates, the only
+/// way one axis of a scan is quantized), and the columns are the camera's
+/// rays: the points' directions, scaled to the sample's median depth.
+fn terraces(points: &[[f64; 3]], sample: &[u32], axis: usize, levels: &[f64], reach: f64) -> bool {
+    if reach.is_nan() || reach <= 0.0 {
+        return false;
+    }
+    let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+    let depth = levels[0] > 0.0;
+    let mut values: Vec<f64> = sample.iter().map(|&i| points[i as usize][axis]).collect();
+    let scale = median(&mut values);
+    // A point's place across the axis: on its ray for a depth.
+    let across = |p: &[f64; 3]| -> [f64; 2] {
+        if depth {
+            [p[u] / p[axis] * scale, p[v] / p[axis] * scale]
+        } else {
+            [p[u], p[v]]
+        }
+    };
+    let cell = |p: &[f64; 3], du: i64, dv: i64| -> u64 {
+        let a = across(p);
+        let c = |x: f64, d: i64| ((x / reach).floor() as i64 + d) as f64;
+        hash(&[c(a[0], du), c(a[1], dv), 0.0], 7)
+    };
+    const AROUND: [(i64, i64); 9] = [
+        (-1, -1),
+        (-1, 0),
+        (-1, 1),
+        (0, -1),
+        (0, 0),
+        (0, 1),
+        (1, -1),
+        (1, 0),
+        (1, 1),
+    ];
+    // Only the points in the columns' cells are indexed; a point's own
+    // column leaves it out.
+    let wanted: std::collections::HashSet<u64> = sample
+        .iter()
+        .flat_map(|&i| AROUND.map(|(du, dv)| cell(&points[i as usize], du, dv)))
+        .collect();
+    let mut grid: Vec<(u64, u32)> = (0u32..)
+        .zip(points)
+        .map(|(i, p)| (cell(p, 0, 0), i))
+        .filter(|(key, _)| wanted.contains(key))
+        .collect();
+    grid.sort_unstable_by_key(|e| e.0);
+    let level = |x: f64| levels.partition_point(|&l| l < x);
+    let r2 = reach * reach;
+    let (mut own_most, mut meeting, mut next_level) = (0usize, 0usize, 0usize);
+    for &i in sample {
+        let p = &points[i as usize];
+        let (k, pa) = (level(p[axis]), across(p));
+        let (mut same, mut other) = (0usize, 0usize);
+        // The other level nearest across: (distance², levels apart).
+        let mut nearest = (f64::INFINITY, 0usize);
+        for (du, dv) in AROUND {
+            let key = cell(p, du, dv);
+            let from = grid.partition_point(|e| e.0 < key);
+            for &(_, j) in grid[from..].iter().take_while(|e| e.0 == key) {
+                let q = &points[j as usize];
+                let qa = across(q);
+                let d2 = (pa[0] - qa[0]).powi(2) + (pa[1] - qa[1]).powi(2);
+                if d2 >= r2 || j == i {
+                    continue;
+                }
+                if q[axis] == p[axis] {
+                    same += 1;
+                } else {
+                    other += 1;
+                    // Of levels equally near (stacked exactly), the
+                    // farthest apart.
+                    let apart = level(q[axis]).abs_diff(k);
+                    if d2 < nearest.0 || (d2 == nearest.0 && apart > nearest.1) {
+                        nearest = (d2, apart);
+                    }
+                }
+            }
+        }
+        own_most += usize::from(other < same);
+        if other > 0 {
+            meeting += 1;
+            next_level += usize::from(nearest.1 == 1);
+        }
+    }
+    2 * own_most > sample.len() && 2 * next_level > meeting
+}
+
+/// The median distance from a point at `sample` to its nearest other
+/// point (copies skipped): the cloud's spacing, for the report.
+fn spacing(points: &[[f64; 3]], sample: &[u32]) -> f64 {
+    let tree = KdTree::new(points, None);
+    let mut out = Vec::with_capacity(NEIGHBOURS);
+    let mut near: Vec<f64> = sample
+        .iter()
+        .filter_map(|&i| {
+            let p = &points[i as usize];
+            // The point itself and its nearest; more only past copies.
+            for k in [2, NEIGHBOURS] {
+                tree.nearest(p, k, &mut out);
+                if let Some(d2) = out.iter().map(|&(d2, _)| d2).find(|&d2| d2 > 0.0) {
+                    return Some(d2.sqrt());
+                }
+            }
+            None
+        })
+        .collect();
+    if near.is_empty() {
+        return 0.0;
+    }
+    median(&mut near)
+}
+
+/// The median of `v` (not empty), the upper one of an even count.
+fn median(v: &mut [f64]) -> f64 {
+    let mid = v.len() / 2;
+    *v.select_nth_unstable_by(mid, f64::total_cmp).1
+}
+
+/// A well-mixed hash of a point's coordinates and a salt (splitmix64's
+/// finaliser over the bits).
+fn hash(p: &[f64; 3], salt: u64) -> u64 {
+    let mut h = salt.wrapping_mul(0x9e37_79b9_7f4a_7c15);
+    for v in p {
+        let mut z = (h ^ v.to_bits()).wrapping_add(0x9e37_79b9_7f4a_7c15);
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        h = z ^ (z >> 31);
+    }
+    h
+}
+
+/// A uniform draw in [0, 1) from a point's coordinates and an axis.
+fn unit(p: &[f64; 3], axis: usize) -> f64 {
+    (hash(p, axis as u64) >> 11) as f64 / (1u64 << 53) as f64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::SplitMix64;
+
+    /// A slanted plane z = 0.5·x + 0.2·y sampled on a grid of spacing d,
+    /// its z rounded to levels `step` apart.
+    fn staircase(d: f64, step: f64) -> Vec<[f64; 3]> {
+        let mut pts = Vec::new();
+        for i in 0..80 {
+            for j in 0..80 {
+                let (x, y) = (i as f64 * d, j as f64 * d);
+                let z = 0.5 * x + 0.2 * y;
+                pts.push([x, y, (z / step).round() * step]);
+            }
+        }
+        pts
+    }
+
+    #[test]
+    fn a_staircase_is_quantized_and_its_dither_restores_the_plane() {
+        let pts = staircase(0.01, 0.05);
+        let q = Quantization::of(&pts);
+        assert_eq!(q.axes.len(), 1, "{q:?}");
+        let a = &q.axes[0];
+        assert_eq!(a.axis, 2);
+        assert!((a.step - 0.05).abs() < 1e-9, "{}", a.step);
+        assert!(a.reach < a.step, "{a:?}");
+        let moved = q.dither(&pts);
+        // Each point stays within half a step of its level, and x, y stay.
+        for (p, m) in pts.iter().zip(&moved) {
+            assert_eq!((p[0], p[1]), (m[0], m[1]));
+            assert!((p[2] - m[2]).abs() <= 0.025 + 1e-12);
+        }
+        // The dither is uniform across the step: its spread is step/√12.
+        let r: Vec<f64> = pts.iter().zip(&moved).map(|(p, m)| m[2] - p[2]).collect();
+        let mean = r.iter().sum::<f64>() / r.len() as f64;
+        let sd = (r.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / r.len() as f64).sqrt();
+        assert!(
+            mean.abs() < 1e-3 && (sd - 0.05 / 12f64.sqrt()).abs() < 1e-3,
+            "{mean} {sd}"
+        );
+        // The same draw for the same point, in any order, and in a part of
+        // the cloud (a tile) as in the whole.
+        let rev: Vec<[f64; 3]> = pts.iter().rev().copied().collect();
+        let back: Vec<[f64; 3]> = q.dither(&rev).into_iter().rev().collect();
+        assert_eq!(back, moved);
+        assert_eq!(q.dither(&pts[100..200]), moved[100..200]);
+    }
+
+    #[test]
+    fn grids_fine_levels_and_noise_are_not_quantized() {
+        // A regular grid: its x and y levels are one spacing apart.
+        let grid: Vec<[f64; 3]> = (0..2500)
+            .map(|k| [(k % 50) as f64, (k / 50) as f64, 0.0])
+            .collect();
+        assert!(Quantization::of(&grid).is_empty());
+        // Levels a tenth of the spacing apart (a LAS file's 1 cm under a
+        // 10 cm spacing): the neighbourhoods span many levels.
+        assert!(Quantization::of(&staircase(0.1, 0.01)).is_empty());
+        // Continuous noise: every value distinct.
+        let mut rng = SplitMix64::new(3);
+        let noisy: Vec<[f64; 3]> = (0..3000)
+            .map(|_| [rng.uniform(), rng.uniform(), 0.01 * rng.uniform()])
+            .collect();
+        assert!(Quantization::of(&noisy).is_empty());
+        // Too few points to tell.
+        assert!(Quantization::of(&staircase(0.01, 0.05)[..20]).is_empty());
+        // Thousands of copies of two points: no panic, nothing found.
+        let copies: Vec<[f64; 3]> = (0..5000).map(|k| [0.0, 0.0, (k % 2) as f64]).collect();
+        assert!(Quantization::of(&copies).is_empty());
+    }
+
+    #[test]
+    fn structures_each_on_one_value_are_not_quantized() {
+        // Three parallel lines 50 apart (the Python `detect` example):
+        // y on three levels, far coarser than the points' spacing.
+        let lines: Vec<[f64; 3]> = (0..90)
+            .map(|k| [(k % 30) as f64 * 100.0 / 29.0, 50.0 * (k / 30) as f64, 0.0])
+            .collect();
+        assert!(Quantization::of(&lines).is_empty());
+        // Six such lines, random along, from y = 50 (every level positive:
+        // the columns are rays from the origin).
+        let mut rng = SplitMix64::new(5);
+        let lines: Vec<[f64; 3]> = (0..6000)
+            .map(|k| [100.0 * rng.uniform(), 50.0 * (1 + k % 6) as f64, 0.0])
+            .collect();
+        assert!(Quantization::of(&lines).is_empty());
+        // Floors stacked 3 apart, random across: 2, 3 (each spreads over
+        // less than a step) and 6 (they fill each other's columns), from
+        // the ground and from 3 up (rays).
+        for (floors, from) in [(2, 0.0), (3, 0.0), (6, 0.0), (6, 3.0)] {
+            let pts: Vec<[f64; 3]> = (0..floors * 2000)
+                .map(|k| {
+                    let z = from + 3.0 * (k % floors) as f64;
+                    [10.0 * rng.uniform(), 10.0 * rng.uniform(), z]
+                })
+                .collect();
+            assert!(
+                Quantization::of(&pts).is_empty(),
+                "{floors} floors from {from}"
+            );
+        }
+        // Flat roofs 3, 6, ..., 18 high on 6 blocks of a flat ground, each
+        // exactly level: the roofs meet the ground several levels apart.
+        let city: Vec<[f64; 3]> = (0..12000)
+            .map(|_| {
+                let (x, y) = (60.0 * rng.uniform(), 10.0 * rng.uniform());
+                let block = (x / 10.0).floor();
+                let on_roof = (x - 10.0 * block - 5.0).abs() < 3.0 && (y - 5.0).abs() < 3.0;
+                [x, y, if on_roof { 3.0 * (block + 1.0) } else { 0.0 }]
+            })
+            .collect();
+        assert!(Quantization::of(&city).is_empty());
+        // The oracle can fail: the same ground as one slanted staircase.
+        let slope: Vec<[f64; 3]> = (0..12000)
+            .map(|_| {
+                let (x, y) = (60.0 * rng.uniform(), 10.0 * rng.uniform());
+                [x, y, (0.3 * x / 3.0).round() * 3.0]
+            })
+            .collect();
+        assert_eq!(Quantization::of(&slope).axes.len(), 1);
+        // And a depth frame: a wall and a floor seen from a camera at the
+        // origin (pixels 1/500 rad apart), depth in steps of 25 mm (a
+        // Kinect's at 3 m, where its pixels are 6 mm apart).
+        let mut frame = Vec::new();
+        for i in 0..160 {
+            for j in 0..120 {
+                let (a, b) = ((i as f64 - 80.0) / 500.0, (j as f64 - 60.0) / 500.0);
+                // The floor y = 0.2 where the ray meets it first; else the
+                // wall z = 3.
+                let t = if b > 0.0 { (0.2 / b).min(3.0) } else { 3.0 };
+                let z = (t / 0.025).round() * 0.025;
+                frame.push([a * z, b * z, z]);
+            }
+        }
+        let q = Quantization::of(&frame);
+        assert_eq!(q.axes.len(), 1, "{q:?}");
+        assert_eq!(q.axes[0].axis, 2);
+    }
+
+    #[test]
+    fn a_levels_step_is_its_gaps_mean() {
+        let levels = [0.0, 1.0, 3.0, 7.0];
+        assert_eq!(step_at(&levels, 0.0), 1.0);
+        assert_eq!(step_at(&levels, 1.0), 1.5);
+        assert_eq!(step_at(&levels, 3.0), 3.0);
+        assert_eq!(step_at(&levels, 7.0), 4.0);
+        // A value between levels takes the nearest one's step.
+        assert_eq!(step_at(&levels, 2.4), 3.0);
+        assert_eq!(step_at(&levels, -5.0), 1.0);
+    }
+}
