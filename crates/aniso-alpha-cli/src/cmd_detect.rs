@@ -688,8 +688,8 @@ pub fn run(args: &DetectArgs, timings: &mut Timings) -> Result<(), CliError> {
     for line in quantization.describe() {
         common::warn(format_args!("{name}: {line}"));
     }
-    let dithered = (!quantization.is_empty()).then(|| quantization.dither(points));
-    let seen: &[[f64; 3]] = dithered.as_deref().unwrap_or(points);
+    let seen = quantization.seen(points);
+    let seen: &[[f64; 3]] = &seen;
     let whole = !paths.whole_outputs(args).is_empty();
     if let Some(side) = crate::cmd_regions::side(args.regions, whole, points) {
         let out = region_outputs(args, &paths);

@@ -27,6 +27,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
 
 use aniso_alpha::detect::fit::{fit_line_indices, fit_plane_indices};
+use aniso_alpha::rng::mix;
 use base64::Engine as _;
 use serde_json::{json, Value};
 
@@ -401,14 +402,6 @@ pub(crate) fn outline_of_points(
             rms: f.rms_residual,
         })
     }
-}
-
-/// A deterministic pseudo-random key (splitmix64).
-fn mix(mut x: u64) -> u64 {
-    x = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
-    x = (x ^ (x >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    x = (x ^ (x >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    x ^ (x >> 31)
 }
 
 /// Keeps `keep` of `members` chosen by a fixed pseudo-random key, in their

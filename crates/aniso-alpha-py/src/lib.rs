@@ -243,8 +243,8 @@ fn detect<'py>(
         // camera's) are seen dithered within their step, as the CLI sees
         // them.
         let quantization = Quantization::of(pts);
-        let dithered = (!quantization.is_empty()).then(|| quantization.dither(pts));
-        let seen = dithered.as_deref().unwrap_or(pts);
+        let seen = quantization.seen(pts);
+        let seen: &[[f64; 3]] = &seen;
         let mut detector = options::build(&options, seen, normals)?.outlines(outlines);
         if let Some(cb) = &callback {
             detector = detector.progress(cb.tick());
@@ -324,7 +324,8 @@ fn read(
         }
         .map_err(io_error)?;
         // An organized cloud's points without a return (NaN) are left
-        // out, as Open3D's reader does; their rows are kept.
+        // out, as Open3D's reader does with `remove_nan_points=True`; their
+        // rows are kept.
         let (cloud, rows) = match cloud.finite_rows() {
             None => (cloud, None),
             Some(rows) => {

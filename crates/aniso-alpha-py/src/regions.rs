@@ -88,8 +88,8 @@ pub fn detect_regions<'py>(
     // them dithered, as `detect` does (the draw is per point, so every
     // region sees the same points).
     let quantization = detached(py, threads, |_| Ok(Quantization::of(pts)))?;
-    let dithered = (!quantization.is_empty()).then(|| quantization.dither(pts));
-    let pts = dithered.as_deref().unwrap_or(pts);
+    let seen = quantization.seen(pts);
+    let pts: &[[f64; 3]] = &seen;
     let (run_side, side) = region_side(pts, side);
     let run = detached(py, threads, |_| {
         let build = |ids: &[u32], sub: &[[f64; 3]]| {

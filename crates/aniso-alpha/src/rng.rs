@@ -16,6 +16,23 @@
 //! assert!(a.below(10) < 10);
 //! ```
 
+/// SplitMix64's output function: `x` advanced by the generator's constant
+/// and hashed by its finaliser. A well-mixed hash of a 64-bit key, for
+/// draws tied to a point's rank or coordinates rather than to a stream.
+#[inline]
+pub fn mix(x: u64) -> u64 {
+    let mut z = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// A double in `[0, 1)` from the top 53 of 64 random bits.
+#[inline]
+pub fn unit(bits: u64) -> f64 {
+    (bits >> 11) as f64 / (1u64 << 53) as f64
+}
+
 /// SplitMix64 (Steele, Lea and Flood, 2014): a 64-bit state advanced by a
 /// constant and hashed into each output.
 #[derive(Clone, Debug)]
@@ -30,17 +47,15 @@ impl SplitMix64 {
     /// The next 64 random bits.
     #[inline]
     pub fn next_u64(&mut self) -> u64 {
+        let z = mix(self.0);
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
+        z
     }
 
     /// A double drawn uniformly from `[0, 1)` (53 random bits).
     #[inline]
     pub fn uniform(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+        unit(self.next_u64())
     }
 
     /// An integer in `0..n` (`n > 0`; by remainder, so very slightly biased

@@ -37,6 +37,7 @@
 use super::StructureKind;
 use crate::geometry::kdtree::{KdTree, LeafBatch};
 use crate::geometry::{cross, dot, sub};
+use crate::rng::mix;
 
 /// Neighbours per neighbourhood: the usual choice for PCA normals (CGAL's
 /// examples use 12–24, PCL's 10–30): enough for a stable covariance of 3
@@ -129,15 +130,6 @@ impl LocalShape {
             StructureKind::Lines => self.direction,
         }
     }
-}
-
-/// A well-mixed 64-bit hash of a point's rank (splitmix64's finaliser), for
-/// subsamples without a pattern of their own.
-fn mix(i: u64) -> u64 {
-    let mut z = i.wrapping_add(0x9e37_79b9_7f4a_7c15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
 }
 
 /// The points' indices in the order of their positions: by x, then y, then
@@ -501,7 +493,7 @@ mod tests {
         let mut i = seed;
         move || {
             i += 1;
-            (mix(i) >> 11) as f64 / (1u64 << 53) as f64
+            crate::rng::unit(mix(i))
         }
     }
 

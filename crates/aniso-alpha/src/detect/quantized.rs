@@ -62,7 +62,10 @@
 //! concentration threshold, another draw can tip the estimate
 //! (docs/method.md §8).
 
+use std::borrow::Cow;
+
 use crate::geometry::kdtree::KdTree;
+use crate::rng;
 
 use super::local::NEIGHBOURS;
 
@@ -136,6 +139,9 @@ impl Quantization {
             return Quantization::default();
         }
         let mut axes = Vec::new();
+        // The finest neighbourhood's radius, measured once, for the axes
+        // that get that far.
+        let mut reach = None;
         for axis in 0..3 {
             let Some(levels) = levels_of(points, axis, n / NEIGHBOURS) else {
                 continue;
@@ -159,7 +165,7 @@ impl Quantization {
             if spread(points, &sample, axis) < step {
                 continue;
             }
-            let reach = REACH_SPACINGS * spacing(points, &sample);
+            let reach = *reach.get_or_insert_with(|| REACH_SPACINGS * spacing(points, &sample));
             if !terraces(points, &sample, axis, &levels, reach) {
                 continue;
             }
@@ -200,6 +206,16 @@ impl Quantization {
                 q
             })
             .collect()
+    }
+
+    /// The points a run sees: `points` dithered ([`Self::dither`]) where
+    /// an axis is quantized, else `points` themselves.
+    pub fn seen<'a>(&self, points: &'a [[f64; 3]]) -> Cow<'a, [[f64; 3]]> {
+        if self.is_empty() {
+            Cow::Borrowed(points)
+        } else {
+            Cow::Owned(self.dither(points))
+        }
     }
 
     /// One line per quantized axis, for the CLI's warning and Python's.
@@ -271,34 +287,19 @@ fn near_for_most(points: &[[f64; 3]], sample: &[u32], r: f64) -> bool {
         let c = |a: usize| ((p[a] / r).floor() as i64 + off[a]) as f64;
         hash(&[c(0), c(1), c(2)], 5)
     };
-    // Only the points in the cells around the sample are indexed.
-    const AROUND: std::ops::Range<i64> = 0..27;
-    let around = |o: i64| [o % 3 - 1, o / 3 % 3 - 1, o / 9 - 1];
-    let wanted: std::collections::HashSet<u64> = sample
-        .iter()
-        .flat_map(|&i| AROUND.map(move |o| (i, o)))
-        .map(|(i, o)| cell(&points[i as usize], around(o)))
+    let around: Vec<[i64; 3]> = (0..27)
+        .map(|o: i64| [o % 3 - 1, o / 3 % 3 - 1, o / 9 - 1])
         .collect();
-    let mut grid: Vec<(u64, u32)> = (0u32..)
-        .zip(points)
-        .map(|(i, p)| (cell(p, [0; 3]), i))
-        .filter(|(key, _)| wanted.contains(key))
-        .collect();
-    grid.sort_unstable_by_key(|e| e.0);
+    let grid = CellIndex::around(points, sample, &around, cell);
     let r2 = r * r;
     let has_near = |&i: &u32| {
         let p = &points[i as usize];
-        AROUND.into_iter().any(|o| {
-            let key = cell(p, around(o));
-            let from = grid.partition_point(|e| e.0 < key);
-            grid[from..]
-                .iter()
-                .take_while(|e| e.0 == key)
-                .any(|&(_, j)| {
-                    let q = &points[j as usize];
-                    let d2 = (0..3).map(|a| (p[a] - q[a]).powi(2)).sum::<f64>();
-                    d2 > 0.0 && d2 < r2
-                })
+        around.iter().any(|&o| {
+            grid.points_in(cell(p, o)).any(|j| {
+                let q = &points[j as usize];
+                let d2 = (0..3).map(|a| (p[a] - q[a]).powi(2)).sum::<f64>();
+                d2 > 0.0 && d2 < r2
+            })
         })
     };
     2 * sample.iter().filter(|i| has_near(i)).count() > sample.len()
@@ -369,18 +370,7 @@ fn terraces(points: &[[f64; 3]], sample: &[u32], axis: usize, levels: &[f64], re
         (1, 0),
         (1, 1),
     ];
-    // Only the points in the columns' cells are indexed; a point's own
-    // column leaves it out.
-    let wanted: std::collections::HashSet<u64> = sample
-        .iter()
-        .flat_map(|&i| AROUND.map(|(du, dv)| cell(&points[i as usize], du, dv)))
-        .collect();
-    let mut grid: Vec<(u64, u32)> = (0u32..)
-        .zip(points)
-        .map(|(i, p)| (cell(p, 0, 0), i))
-        .filter(|(key, _)| wanted.contains(key))
-        .collect();
-    grid.sort_unstable_by_key(|e| e.0);
+    let grid = CellIndex::around(points, sample, &AROUND, |p, (du, dv)| cell(p, du, dv));
     let level = |x: f64| levels.partition_point(|&l| l < x);
     let r2 = reach * reach;
     let (mut own_most, mut meeting, mut next_level) = (0usize, 0usize, 0usize);
@@ -391,9 +381,8 @@ fn terraces(points: &[[f64; 3]], sample: &[u32], axis: usize, levels: &[f64], re
         // The other level nearest across: (distance², levels apart).
         let mut nearest = (f64::INFINITY, 0usize);
         for (du, dv) in AROUND {
-            let key = cell(p, du, dv);
-            let from = grid.partition_point(|e| e.0 < key);
-            for &(_, j) in grid[from..].iter().take_while(|e| e.0 == key) {
+            // A point's own column leaves it out.
+            for j in grid.points_in(cell(p, du, dv)) {
                 let q = &points[j as usize];
                 let qa = across(q);
                 let d2 = (pa[0] - qa[0]).powi(2) + (pa[1] - qa[1]).powi(2);
@@ -454,21 +443,56 @@ fn median(v: &mut [f64]) -> f64 {
 }
 
 /// A well-mixed hash of a point's coordinates and a salt (splitmix64's
-/// finaliser over the bits).
+/// output function chained over the bits).
 fn hash(p: &[f64; 3], salt: u64) -> u64 {
     let mut h = salt.wrapping_mul(0x9e37_79b9_7f4a_7c15);
     for v in p {
-        let mut z = (h ^ v.to_bits()).wrapping_add(0x9e37_79b9_7f4a_7c15);
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        h = z ^ (z >> 31);
+        h = rng::mix(h ^ v.to_bits());
     }
     h
 }
 
 /// A uniform draw in [0, 1) from a point's coordinates and an axis.
 fn unit(p: &[f64; 3], axis: usize) -> f64 {
-    (hash(p, axis as u64) >> 11) as f64 / (1u64 << 53) as f64
+    rng::unit(hash(p, axis as u64))
+}
+
+/// The points in the cells around some sampled points, sorted by cell: a
+/// grid that indexes only where it will be asked.
+struct CellIndex(Vec<(u64, u32)>);
+
+impl CellIndex {
+    /// The points whose cell is one of those at `offsets` from a point at
+    /// `sample`; `cell(p, o)` is the key of the cell `o` away from `p`'s
+    /// (`O::default()`: its own).
+    fn around<O: Copy + Default>(
+        points: &[[f64; 3]],
+        sample: &[u32],
+        offsets: &[O],
+        cell: impl Fn(&[f64; 3], O) -> u64,
+    ) -> CellIndex {
+        let wanted: std::collections::HashSet<u64> = sample
+            .iter()
+            .flat_map(|&i| offsets.iter().map(move |&o| (i, o)))
+            .map(|(i, o)| cell(&points[i as usize], o))
+            .collect();
+        let mut grid: Vec<(u64, u32)> = (0u32..)
+            .zip(points)
+            .map(|(i, p)| (cell(p, O::default()), i))
+            .filter(|(key, _)| wanted.contains(key))
+            .collect();
+        grid.sort_unstable_by_key(|e| e.0);
+        CellIndex(grid)
+    }
+
+    /// The points of the cell `key`.
+    fn points_in(&self, key: u64) -> impl Iterator<Item = u32> + '_ {
+        let from = self.0.partition_point(|e| e.0 < key);
+        self.0[from..]
+            .iter()
+            .take_while(move |e| e.0 == key)
+            .map(|e| e.1)
+    }
 }
 
 #[cfg(test)]
