@@ -8,8 +8,16 @@ metres away stores them (a Kinect's steps: about 1 spacing at 1 m, 3-5 at
 one thread; the table gives the plane F1 and the labelled planes of >= 1,000
 points found as one part (scripts/bench_real.py's `score`), per step size.
 
+With --peer, CGAL's Efficient RANSAC (scripts/peers/cgal_shapes.cpp) runs on
+the same files in the same run, with presets as scripts/bench_corpus.py
+gives them (CGAL's defaults; epsilon 1, 2 and 3 times the frame's `noise`
+(manifest) or half the step, whichever is larger: the quantization error
+is up to half a step; cluster epsilon 3 spacings; min points 100), its
+best preset by F1 per frame and step (an upper bound for the peer).
+
     python3 scripts/eval_quantized.py --bin BEFORE --bin AFTER \\
-        --scans mosd_learn0,mosd_learn5 [--steps 0,2,3,5] [--corpus DIR]
+        --scans mosd_learn0,mosd_learn5 [--steps 0,2,3,5] [--corpus DIR] \\
+        [--peer /work/peers-bin/cgal_shapes]
 
 Step 0 is the frame as scanned. BENCHMARKS.md, "Depth frames as PCL writes
 them", has the figures of the train and held-out frames.
@@ -29,7 +37,9 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "corpus"))
 sys.path.insert(0, HERE)
 from bench_real import score  # noqa: E402
-from common import PREPARED, read_ply  # noqa: E402
+from common import PREPARED, load_manifest, read_ply  # noqa: E402
+
+RANSAC = "CGAL Efficient RANSAC (best preset)"
 
 
 def requantized(points, spacing, k):
@@ -43,6 +53,22 @@ def requantized(points, spacing, k):
     out = points * (z / points[:, 2])[:, None]
     out[:, 2] = z
     return out
+
+
+def ransac_best(peer, xyz, truth, noise, spacing, step):
+    """CGAL's Efficient RANSAC on `xyz` with each preset; the best score."""
+    eps = max(noise, step / 2)
+    presets = [[]] + [["--epsilon", f"{f * eps:.6g}", "--cluster-epsilon", f"{3 * spacing:.6g}",
+                       "--min-points", "100"] for f in (1, 2, 3)]
+    best = None
+    out = f"{xyz}.ransac.txt"
+    for p in presets:
+        subprocess.run([peer, "ransac", xyz, out, *p], check=True,
+                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        s = score(truth, np.loadtxt(out, dtype=np.int64))
+        if best is None or s["f1"] > best["f1"]:
+            best = s
+    return best
 
 
 def run_scan(name, args, tmp):
@@ -63,6 +89,9 @@ def run_scan(name, args, tmp):
             )
             s = score(truth, np.loadtxt(out, dtype=np.int64))
             rows[(k, b)] = (s["f1"], s["found"], s["big"])
+        if args.peer:
+            s = ransac_best(args.peer, xyz, truth, args.noise[name], spacing, k * spacing)
+            rows[(k, RANSAC)] = (s["f1"], s["found"], s["big"])
     return name, rows
 
 
@@ -72,7 +101,9 @@ def main():
     ap.add_argument("--scans", required=True, help="prepared depth frames, comma-separated")
     ap.add_argument("--steps", default="0,2,3,5", help="step sizes in spacings (0: as scanned)")
     ap.add_argument("--corpus", default=PREPARED, help="prepared scans ($ANISO_ALPHA_CORPUS/prepared)")
+    ap.add_argument("--peer", help="the CGAL peer binary (scripts/peers/cgal_shapes.cpp): RANSAC too")
     args = ap.parse_args()
+    args.noise = {s["name"]: s["noise"] for s in load_manifest()["scans"]}
     args.steps = [int(k) for k in args.steps.split(",")]
     totals = {}
     with tempfile.TemporaryDirectory() as tmp, ThreadPoolExecutor(2) as pool:
@@ -82,9 +113,10 @@ def main():
                 totals.setdefault(key, []).append(v)
     print("| steps of | binary | mean F1 | found |")
     print("|---:|---|---:|---:|")
-    for (k, b), v in sorted(totals.items()):
+    for (k, b), v in sorted(totals.items(), key=lambda e: (e[0][0], str(e[0][1]))):
         v = np.array(v)
-        print(f"| {k or 'as scanned'} | {args.bin[b]} | {v[:, 0].mean():.4f} | {int(v[:, 1].sum())}/{int(v[:, 2].sum())} |")
+        who = b if b == RANSAC else args.bin[b]
+        print(f"| {k or 'as scanned'} | {who} | {v[:, 0].mean():.4f} | {int(v[:, 1].sum())}/{int(v[:, 2].sum())} |")
 
 
 if __name__ == "__main__":
