@@ -47,7 +47,7 @@ fn param(value: f64, estimated: bool, reason: &str) -> Value {
 pub fn quantized_json(q: &Quantization) -> Value {
     q.axes
         .iter()
-        .map(|a| json!({"axis": a.name(), "step": num(a.step), "reach": num(a.reach), "dithered": true}))
+        .map(|a| json!({"axis": a.name(), "step": num(a.step), "reach": num(a.reach), "coarse": a.coarse, "terraced": num(a.terraced), "dithered": true}))
         .collect()
 }
 

@@ -45,13 +45,27 @@
 //! most of its column for 57–60% of the sample, and the next level is the
 //! nearest for 89–94% of those that meet one; on the stacked floors and
 //! lines of the tests, 0.2–22%, and for the roofs the next level is the
-//! nearest for 7%. PCL's `region_growing_rgb_tutorial.pcd` (a frame with
-//! many surfaces seen at a grazing angle, whose terraces are a pixel or
-//! two wide) has 32% on the first test and is left as it is. The depth
-//! frames of
-//! the corpus (mOSD, 0.6–1.3 m from the camera) have levels 0.9–1.3
-//! spacings apart and are left as they are; dithered anyway, the mean
-//! plane F1 of twelve train frames was unchanged (0.977).
+//! nearest for 7%.
+//!
+//! Levels finer than the reach still hold a neighbourhood where a surface
+//! is seen nearly face-on: a terrace is the step over the surface's slope
+//! across the axis wide. A stereo camera's depth (uniform steps of
+//! disparity, so of 1/z) makes the far wall of PCL's
+//! `table_scene_mug_stereo_textured.pcd` a stack of exactly flat parts
+//! (199 parts in 62 structures) while its median step is 0.6 of a
+//! spacing. So an axis whose values spread over many steps
+//! ([`MANY_STEPS`]: a surface crossing them, not a few structures each on
+//! one value) is also quantized when its terraces are side by side in
+//! part of the cloud: of the sampled points held by their own level that
+//! meet another one, at least [`NEIGHBOURS`], and more than half of them
+//! meet the next level nearest. PCL's stereo frame (16% of its sample
+//! held), its structured-light `milk_cartoon_all_small_clorox.pcd` (13%),
+//! its `region_growing_rgb_tutorial.pcd` (32%, terraces a pixel or two
+//! wide at a grazing angle, which the majority missed) and the corpus'
+//! mOSD frames (levels 0.9–1.3 spacings apart, 3–9% held) are dithered
+//! this way; the stereo frame then gives 93 parts in 21 structures, none
+//! exactly flat. The tests' roofs at 60 heights over a ground spread over
+//! many steps but meet the ground many levels apart, and are left alone.
 //!
 //! The draw is a hash of the point's coordinates (rounded to a thousandth
 //! of the reach), so copies of a point stay copies and the result does not
@@ -77,6 +91,15 @@ const SPACING_SAMPLE: usize = 1024;
 /// 2.2 spacings away.
 pub const REACH_SPACINGS: f64 = 2.0;
 
+/// Steps over which an axis' values must spread (standard deviation)
+/// for levels finer than a neighbourhood to be asked whether some of
+/// them are terraces: [`NEIGHBOURS`]. A surface crossing a depth camera's
+/// levels crosses hundreds of them (the spread over the median step:
+/// 20–35 on PCL's Kinect captures, 70–100 on the mOSD frames, 250 and
+/// 1,000 on PCL's structured-light and stereo frames); a few structures
+/// each on one value spread over a few (six stacked floors or lines: 1.7).
+pub const MANY_STEPS: f64 = NEIGHBOURS as f64;
+
 /// One axis whose coordinates lie on levels coarser than the points'
 /// neighbourhoods.
 #[derive(Debug, Clone, PartialEq)]
@@ -90,6 +113,15 @@ pub struct QuantizedAxis {
     /// nearest other point (a sample of at most 1,024 points): the finest
     /// neighbourhood's radius.
     pub reach: f64,
+    /// The share of the sampled points whose own level holds most of
+    /// their column (within [`Self::reach`] across the axis): the points
+    /// on terraces wider than a neighbourhood.
+    pub terraced: f64,
+    /// Whether the levels are coarser than a neighbourhood for most
+    /// points (the median step over [`REACH_SPACINGS`] exceeds the median
+    /// spacing); else the terraces are wide only where surfaces are seen
+    /// nearly face-on.
+    pub coarse: bool,
     /// The axis' distinct values, ascending.
     levels: Vec<f64>,
 }
@@ -154,25 +186,37 @@ impl Quantization {
                 .map(|&i| step_at(&levels, points[i as usize][axis]))
                 .collect();
             let step = median(&mut steps);
-            // The median spacing is below step / REACH_SPACINGS exactly
-            // when more than half of the sample has a point that near.
-            if !near_for_most(points, &sample, step / REACH_SPACINGS) {
-                continue;
-            }
             // Levels coarser than a neighbourhood are a quantization only
             // where they are the steps of surfaces crossing them: values
-            // spread over more than a step, and terraces side by side.
-            if spread(points, &sample, axis) < step {
+            // spread over more than a step (Widrow's condition), and
+            // terraces side by side.
+            let spread = spread(points, &sample, axis);
+            if spread < step {
+                continue;
+            }
+            // The median spacing is below step / REACH_SPACINGS exactly
+            // when more than half of the sample has a point that near:
+            // then most neighbourhoods lie on one level.
+            let coarse = near_for_most(points, &sample, step / REACH_SPACINGS);
+            // Values spread over many steps are a surface crossing them,
+            // not a few structures each on one value: then the terraces
+            // need only be wider than a neighbourhood in part of the
+            // cloud (on the surfaces seen nearly face-on).
+            let many = spread >= MANY_STEPS * step;
+            if !coarse && !many {
                 continue;
             }
             let reach = *reach.get_or_insert_with(|| REACH_SPACINGS * spacing(points, &sample));
-            if !terraces(points, &sample, axis, &levels, reach) {
+            let t = Terraces::of(points, &sample, axis, &levels, reach);
+            if !((coarse && t.side_by_side()) || (many && t.in_part())) {
                 continue;
             }
             axes.push(QuantizedAxis {
                 axis,
                 step,
                 reach,
+                terraced: t.held_share(),
+                coarse,
                 levels,
             });
         }
@@ -223,16 +267,28 @@ impl Quantization {
         self.axes
             .iter()
             .map(|a| {
+                let how = if a.coarse {
+                    format!(
+                        "farther than a point's {} nearest neighbours reach ({:.4}, {} spacings)",
+                        NEIGHBOURS, a.reach, REACH_SPACINGS
+                    )
+                } else {
+                    format!(
+                        "finer than a point's {} nearest neighbours reach ({:.4}, {} spacings), \
+                         but {:.0}% of the points lie on terraces wider than that (surfaces seen \
+                         nearly face-on)",
+                        NEIGHBOURS,
+                        a.reach,
+                        REACH_SPACINGS,
+                        100.0 * a.terraced
+                    )
+                };
                 format!(
-                    "the {} coordinates lie on levels {:.4} apart (median), farther than a point's \
-                     {} nearest neighbours reach ({:.4}, {} spacings): a depth camera's steps; each \
-                     point is moved within its level (dithered) so that its surface, not the step, \
-                     is seen",
+                    "the {} coordinates lie on levels {:.4} apart (median), {how}: a depth \
+                     camera's steps; each point is moved within its level (dithered) so that its \
+                     surface, not the step, is seen",
                     a.name(),
                     a.step,
-                    NEIGHBOURS,
-                    a.reach,
-                    REACH_SPACINGS
                 )
             })
             .collect()
@@ -325,90 +381,136 @@ fn spread(points: &[[f64; 3]], sample: &[u32], axis: usize) -> f64 {
     var.sqrt()
 }
 
-/// Whether the levels of `axis` are the terraces of surfaces crossing
-/// them, side by side across the axis, rather than structures stacked
-/// along it. Seen along its column (the points within `reach` of it
-/// across the axis), a point of a terrace has mostly its own level around
-/// it, and where it meets another level, the nearest is the next one up
-/// or down: the staircase of one surface. Stacked structures (parallel
-/// lines, floors) fill each other's columns; flat roofs at a few heights
-/// over the ground meet it several levels apart. Both must hold for more
-/// than half of the sample (of those that meet another level, for the
-/// second). Where every level is positive, the axis is a depth seen from
-/// a camera at the origin (a depth frame in its own coordinates, the only
+/// How the levels of `axis` lie across it, seen along its columns (the
+/// points within `reach` of a sampled point across the axis): the
+/// terraces of surfaces crossing them, side by side, or structures
+/// stacked along it. A point of a terrace wider than its column has
+/// mostly its own level around it, and where it meets another level, the
+/// nearest is the next one up or down: the staircase of one surface.
+/// Stacked structures (parallel lines, floors) fill each other's columns;
+/// flat roofs at a few heights over the ground meet it several levels
+/// apart. Where every level is positive, the axis is a depth seen from a
+/// camera at the origin (a depth frame in its own coordinates, the only
 /// way one axis of a scan is quantized), and the columns are the camera's
 /// rays: the points' directions, scaled to the sample's median depth.
-fn terraces(points: &[[f64; 3]], sample: &[u32], axis: usize, levels: &[f64], reach: f64) -> bool {
-    if reach.is_nan() || reach <= 0.0 {
-        return false;
-    }
-    let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
-    let depth = levels[0] > 0.0;
-    let mut values: Vec<f64> = sample.iter().map(|&i| points[i as usize][axis]).collect();
-    let scale = median(&mut values);
-    // A point's place across the axis: on its ray for a depth.
-    let across = |p: &[f64; 3]| -> [f64; 2] {
-        if depth {
-            [p[u] / p[axis] * scale, p[v] / p[axis] * scale]
-        } else {
-            [p[u], p[v]]
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct Terraces {
+    /// The sampled points.
+    sample: usize,
+    /// Those whose own level holds most of their column (held).
+    held: usize,
+    /// Those that meet another level in their column.
+    meeting: usize,
+    /// Of those, the ones whose nearest other level is the next.
+    next: usize,
+    /// The held points that meet another level.
+    held_meeting: usize,
+    /// Of those, the ones whose nearest other level is the next.
+    held_next: usize,
+}
+
+impl Terraces {
+    fn of(points: &[[f64; 3]], sample: &[u32], axis: usize, levels: &[f64], reach: f64) -> Self {
+        let mut t = Terraces {
+            sample: sample.len(),
+            ..Terraces::default()
+        };
+        if reach.is_nan() || reach <= 0.0 {
+            return t;
         }
-    };
-    let cell = |p: &[f64; 3], du: i64, dv: i64| -> u64 {
-        let a = across(p);
-        let c = |x: f64, d: i64| ((x / reach).floor() as i64 + d) as f64;
-        hash(&[c(a[0], du), c(a[1], dv), 0.0], 7)
-    };
-    const AROUND: [(i64, i64); 9] = [
-        (-1, -1),
-        (-1, 0),
-        (-1, 1),
-        (0, -1),
-        (0, 0),
-        (0, 1),
-        (1, -1),
-        (1, 0),
-        (1, 1),
-    ];
-    let grid = CellIndex::around(points, sample, &AROUND, |p, (du, dv)| cell(p, du, dv));
-    let level = |x: f64| levels.partition_point(|&l| l < x);
-    let r2 = reach * reach;
-    let (mut own_most, mut meeting, mut next_level) = (0usize, 0usize, 0usize);
-    for &i in sample {
-        let p = &points[i as usize];
-        let (k, pa) = (level(p[axis]), across(p));
-        let (mut same, mut other) = (0usize, 0usize);
-        // The other level nearest across: (distance², levels apart).
-        let mut nearest = (f64::INFINITY, 0usize);
-        for (du, dv) in AROUND {
-            // A point's own column leaves it out.
-            for j in grid.points_in(cell(p, du, dv)) {
-                let q = &points[j as usize];
-                let qa = across(q);
-                let d2 = (pa[0] - qa[0]).powi(2) + (pa[1] - qa[1]).powi(2);
-                if d2 >= r2 || j == i {
-                    continue;
-                }
-                if q[axis] == p[axis] {
-                    same += 1;
-                } else {
-                    other += 1;
-                    // Of levels equally near (stacked exactly), the
-                    // farthest apart.
-                    let apart = level(q[axis]).abs_diff(k);
-                    if d2 < nearest.0 || (d2 == nearest.0 && apart > nearest.1) {
-                        nearest = (d2, apart);
+        let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+        let depth = levels[0] > 0.0;
+        let mut values: Vec<f64> = sample.iter().map(|&i| points[i as usize][axis]).collect();
+        let scale = median(&mut values);
+        // A point's place across the axis: on its ray for a depth.
+        let across = |p: &[f64; 3]| -> [f64; 2] {
+            if depth {
+                [p[u] / p[axis] * scale, p[v] / p[axis] * scale]
+            } else {
+                [p[u], p[v]]
+            }
+        };
+        let cell = |p: &[f64; 3], du: i64, dv: i64| -> u64 {
+            let a = across(p);
+            let c = |x: f64, d: i64| ((x / reach).floor() as i64 + d) as f64;
+            hash(&[c(a[0], du), c(a[1], dv), 0.0], 7)
+        };
+        const AROUND: [(i64, i64); 9] = [
+            (-1, -1),
+            (-1, 0),
+            (-1, 1),
+            (0, -1),
+            (0, 0),
+            (0, 1),
+            (1, -1),
+            (1, 0),
+            (1, 1),
+        ];
+        let grid = CellIndex::around(points, sample, &AROUND, |p, (du, dv)| cell(p, du, dv));
+        let level = |x: f64| levels.partition_point(|&l| l < x);
+        let r2 = reach * reach;
+        for &i in sample {
+            let p = &points[i as usize];
+            let (k, pa) = (level(p[axis]), across(p));
+            let (mut same, mut other) = (0usize, 0usize);
+            // The other level nearest across: (distance², levels apart).
+            let mut nearest = (f64::INFINITY, 0usize);
+            for (du, dv) in AROUND {
+                // A point's own column leaves it out.
+                for j in grid.points_in(cell(p, du, dv)) {
+                    let q = &points[j as usize];
+                    let qa = across(q);
+                    let d2 = (pa[0] - qa[0]).powi(2) + (pa[1] - qa[1]).powi(2);
+                    if d2 >= r2 || j == i {
+                        continue;
+                    }
+                    if q[axis] == p[axis] {
+                        same += 1;
+                    } else {
+                        other += 1;
+                        // Of levels equally near (stacked exactly), the
+                        // farthest apart.
+                        let apart = level(q[axis]).abs_diff(k);
+                        if d2 < nearest.0 || (d2 == nearest.0 && apart > nearest.1) {
+                            nearest = (d2, apart);
+                        }
                     }
                 }
             }
+            let held = other < same;
+            let next = usize::from(nearest.1 == 1);
+            t.held += usize::from(held);
+            if other > 0 {
+                t.meeting += 1;
+                t.next += next;
+                if held {
+                    t.held_meeting += 1;
+                    t.held_next += next;
+                }
+            }
         }
-        own_most += usize::from(other < same);
-        if other > 0 {
-            meeting += 1;
-            next_level += usize::from(nearest.1 == 1);
-        }
+        t
     }
-    2 * own_most > sample.len() && 2 * next_level > meeting
+
+    /// Terraces side by side over most of the cloud: more than half of the
+    /// sample held by its own level, and of the points that meet another
+    /// level, more than half meeting the next one nearest.
+    fn side_by_side(&self) -> bool {
+        2 * self.held > self.sample && 2 * self.next > self.meeting
+    }
+
+    /// Terraces side by side where a surface is seen nearly face-on: at
+    /// least [`NEIGHBOURS`] held points meet another level (a
+    /// neighbourhood's worth of terrace edges), and more than half of them
+    /// meet the next one nearest.
+    fn in_part(&self) -> bool {
+        self.held_meeting >= NEIGHBOURS && 2 * self.held_next > self.held_meeting
+    }
+
+    /// The share of the sample held by its own level.
+    fn held_share(&self) -> f64 {
+        self.held as f64 / self.sample.max(1) as f64
+    }
 }
 
 /// The median distance from a point at `sample` to its nearest other
@@ -634,6 +736,63 @@ mod tests {
         let q = Quantization::of(&frame);
         assert_eq!(q.axes.len(), 1, "{q:?}");
         assert_eq!(q.axes[0].axis, 2);
+    }
+
+    /// A wall z = 3 + 0.1·x (about 6° from face-on) over a floor y = 0.2,
+    /// seen from a camera at the origin with pixels 1/500 rad apart, its
+    /// depth stored as `depth(z)` (the point moved along its ray).
+    fn tilted_wall_frame(depth: impl Fn(f64) -> f64) -> Vec<[f64; 3]> {
+        let mut frame = Vec::new();
+        for i in 0..160 {
+            for j in 0..120 {
+                let (a, b) = ((i as f64 - 80.0) / 500.0, (j as f64 - 60.0) / 500.0);
+                let wall = 3.0 / (1.0 - 0.1 * a);
+                let t = if b > 0.0 { (0.2 / b).min(wall) } else { wall };
+                let z = depth(t);
+                frame.push([a * z, b * z, z]);
+            }
+        }
+        frame
+    }
+
+    #[test]
+    fn levels_finer_than_a_neighbourhood_are_quantized_where_they_make_terraces() {
+        // A stereo camera's depth: uniform steps of 1/z (disparity), 4 mm
+        // apart at 3 m where the pixels are 6 mm apart. The steps are
+        // finer than a neighbourhood, but the wall, nearly face-on, is a
+        // staircase of terraces 40 mm wide.
+        let q = 4.4e-4;
+        let frame = tilted_wall_frame(|t| 1.0 / ((1.0 / t / q).round() * q));
+        let found = Quantization::of(&frame);
+        assert_eq!(found.axes.len(), 1, "{found:?}");
+        let a = &found.axes[0];
+        assert_eq!(a.axis, 2);
+        assert!(!a.coarse && a.step < a.reach, "{a:?}");
+        assert!(a.terraced > 0.5, "{a:?}");
+        assert!(
+            found.describe()[0].contains("finer than"),
+            "{:?}",
+            found.describe()
+        );
+        // The oracle can fail: the same frame with its depth as measured
+        // (every value distinct) is not quantized.
+        assert!(Quantization::of(&tilted_wall_frame(|t| t)).is_empty());
+        // Flat roofs at 60 heights (values spread over many levels), each
+        // exactly level, on 8 × 8 blocks of a flat ground: held by their
+        // own level, they meet the ground many levels apart.
+        let mut rng = SplitMix64::new(11);
+        let heights: Vec<f64> = (0..64).map(|k| (1 + (k * 37) % 60) as f64).collect();
+        let city: Vec<[f64; 3]> = (0..40000)
+            .map(|_| {
+                let (x, y) = (80.0 * rng.uniform(), 80.0 * rng.uniform());
+                let (bx, by) = ((x / 10.0).floor(), (y / 10.0).floor());
+                let on_roof =
+                    (x - 10.0 * bx - 5.0).abs() < 3.5 && (y - 10.0 * by - 5.0).abs() < 3.5;
+                let h = heights[(8.0 * by + bx) as usize];
+                [x, y, if on_roof { h } else { 0.0 }]
+            })
+            .collect();
+        assert!(Quantization::of(&city).is_empty());
     }
 
     #[test]
