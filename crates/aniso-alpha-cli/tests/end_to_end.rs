@@ -1009,3 +1009,50 @@ fn detect_dithers_depth_quantized_in_steps_coarser_than_a_neighbourhood() {
     let found: std::collections::BTreeSet<i64> = labels.iter().copied().collect();
     assert_eq!(found, [0, 1, 2].into(), "{labels:?}");
 }
+
+#[test]
+fn detect_dithers_depth_in_fine_steps_where_a_surface_faces_the_camera() {
+    // A wall about 6 degrees from face-on, 3 m from a camera whose pixels
+    // are 1/500 rad apart (6 mm there), over a floor, its depth stored in
+    // uniform steps of 1/z (a stereo camera's disparity: 4 mm apart at 3
+    // m). The steps are finer than a neighbourhood, but the wall is a
+    // staircase of terraces 40 mm wide: quantized by the second rule,
+    // and the warning and the report say so.
+    let dir = TempDir::new("e2e", "fine_steps");
+    let q = 4.4e-4;
+    let mut rows = Vec::new();
+    for i in 0..160 {
+        for j in 0..120 {
+            let (a, b) = ((i as f64 - 80.0) / 500.0, (j as f64 - 60.0) / 500.0);
+            let wall = 3.0 / (1.0 - 0.1 * a);
+            let t: f64 = if b > 0.0 { (0.2 / b).min(wall) } else { wall };
+            let z = 1.0 / ((1.0 / t / q).round() * q);
+            rows.push(format!("{} {} {}", a * z, b * z, z));
+        }
+    }
+    let input = dir.file("frame.xyz", rows.join("\n").as_bytes());
+    let report = dir.path("r.json");
+    let o = ok(&[
+        "detect",
+        input.to_str().unwrap(),
+        "--structure",
+        "planes",
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        stderr.contains("the z coordinates lie on levels") && stderr.contains("finer than"),
+        "{stderr}"
+    );
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(report).unwrap()).unwrap();
+    let q = &r["parameters"]["quantized"];
+    assert_eq!(q.as_array().map(Vec::len), Some(1), "{q}");
+    assert_eq!(
+        (&q[0]["axis"], &q[0]["coarse"]),
+        (&"z".into(), &false.into()),
+        "{q}"
+    );
+    assert!(q[0]["terraced"].as_f64().unwrap() > 0.5, "{q}");
+}
