@@ -95,7 +95,7 @@ pub const REACH_SPACINGS: f64 = 2.0;
 /// for levels finer than a neighbourhood to be asked whether some of
 /// them are terraces: [`NEIGHBOURS`]. A surface crossing a depth camera's
 /// levels crosses hundreds of them (the spread over the median step:
-/// 20–35 on PCL's Kinect captures, 70–100 on the mOSD frames, 250 and
+/// 21–52 on PCL's Kinect frames, 70–100 on the mOSD frames, 250 and
 /// 1,000 on PCL's structured-light and stereo frames); a few structures
 /// each on one value spread over a few (six stacked floors or lines: 1.7).
 pub const MANY_STEPS: f64 = NEIGHBOURS as f64;
