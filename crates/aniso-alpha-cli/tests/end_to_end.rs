@@ -953,8 +953,7 @@ fn detect_dithers_depth_quantized_in_steps_coarser_than_a_neighbourhood() {
     assert_eq!(q.as_array().map(Vec::len), Some(1), "{q}");
     assert_eq!(q[0]["axis"], "z");
     assert!((q[0]["step"].as_f64().unwrap() - 0.03).abs() < 1e-9, "{q}");
-    let text = std::fs::read_to_string(parts).unwrap();
-    let ids: Vec<i64> = text.lines().map(|l| l.parse().unwrap()).collect();
+    let ids = common::read_ints(&parts);
     // Each face's points mostly in one part of its own.
     for side in [-1.0, 1.0] {
         let mut count = std::collections::BTreeMap::new();

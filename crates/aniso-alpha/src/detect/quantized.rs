@@ -36,7 +36,7 @@
 //! from the method's model of it: the values spread over at least a step
 //! (Widrow's condition for a uniform quantization error; any two levels,
 //! or three of equal weight, spread over less), and the levels are the
-//! terraces of surfaces crossing them (`terraces`): seen along the axis
+//! terraces of surfaces crossing them (`Terraces`): seen along the axis
 //! (along the camera's rays for a depth), most points have mostly their
 //! own level around them, and where they meet another level its nearest
 //! point is on the next level up or down. Stacked structures fill each
