@@ -837,9 +837,14 @@ fn summary(
         ));
     }
     if let OrientationSet::Data(modes) = d.orientations() {
+        let cover = modes.iter().filter(|m| m.cover).count();
+        let covering = match cover {
+            0 => String::new(),
+            c => format!(" and {c} direction(s) covering the normals no mode scans"),
+        };
         o.push_str(&format!(
-            "  orientations from the data: {} mode(s) of the local {}s, each with its own alpha and lambda (see --report)\n",
-            modes.len(),
+            "  orientations from the data: {} mode(s) of the local {}s{covering}, each with its own alpha and lambda (see --report)\n",
+            modes.len() - cover,
             if d.kind() == StructureKind::Planes { "normal" } else { "direction" }
         ));
         let thick: Vec<String> = modes

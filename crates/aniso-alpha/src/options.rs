@@ -331,11 +331,20 @@ pub fn run_warnings(
         .estimate()
         .and_then(|e| e.ladder_declined.map(|m| (e, m)))
     {
+        let cover = e.modes.iter().filter(|m| m.cover).count();
+        let instead = match e.kind {
+            crate::detect::StructureKind::Planes => format!(
+                "the modes were scanned instead, with {cover} direction(s) {}° apart covering the \
+                 normals of the points no mode scans",
+                crate::detect::estimate::COVER_STEP_DEG
+            ),
+            crate::detect::StructureKind::Lines => "the modes were scanned instead".to_string(),
+        };
         out.push(format!(
             "the modes of the cloud explain {:.0}% of its points (under half; {:.0}% look locally \
              {}), which calls for the scale ladder of sparse structures, but the scale ladder scans \
              at most {} points (it triangulates them once per rotation of its sampler) and {m} would \
-             take it: the modes were scanned instead; {}, {} and {} give the paper's sampled scan",
+             take it: {instead}; {}, {} and {} give the paper's sampled scan",
             100.0 * e.explained,
             100.0 * e.structured,
             e.kind.locally(),

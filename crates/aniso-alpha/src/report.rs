@@ -154,6 +154,7 @@ fn mode_json(m: &crate::detect::ModeScan) -> Value {
         "rotations": m.rotations.len(),
         "thinned_from": m.thinned_from,
         "cloud_scale": m.cloud_scale,
+        "cover": m.cover,
     })
 }
 

@@ -193,6 +193,8 @@ fn a_large_sparse_cloud_scans_its_modes_and_says_so() {
     );
     assert!(d.ladder().is_none());
     assert_eq!(e.ladder_declined, Some(n));
+    // Its local normals do not describe it: no cover either.
+    assert!(e.modes.iter().all(|m| !m.cover));
     let opts = DetectOptions::new(StructureKind::Planes);
     let w = run_warnings(&opts, &d, n, 1, Style::Cli);
     assert!(
@@ -261,4 +263,162 @@ fn the_estimate_does_not_depend_on_the_order_of_the_points() {
         m.points.sort_unstable();
     }
     assert_eq!(a, b);
+}
+
+/// The geodesic sphere of frequency `f`: the icosahedron's 20 faces each
+/// cut into f² triangles, their corners pushed onto the unit sphere.
+fn geodesic(f: usize) -> Vec<[[f64; 3]; 3]> {
+    let t = (1.0 + 5f64.sqrt()) / 2.0;
+    let v: Vec<[f64; 3]> = [
+        [-1.0, t, 0.0],
+        [1.0, t, 0.0],
+        [-1.0, -t, 0.0],
+        [1.0, -t, 0.0],
+        [0.0, -1.0, t],
+        [0.0, 1.0, t],
+        [0.0, -1.0, -t],
+        [0.0, 1.0, -t],
+        [t, 0.0, -1.0],
+        [t, 0.0, 1.0],
+        [-t, 0.0, -1.0],
+        [-t, 0.0, 1.0],
+    ]
+    .to_vec();
+    let faces = [
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    let unit = |p: [f64; 3]| {
+        let n = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+        p.map(|x| x / n)
+    };
+    let mut out = Vec::new();
+    for [a, b, c] in faces {
+        let (a, b, c) = (v[a], v[b], v[c]);
+        let at = |i: usize, j: usize| {
+            let (u, w) = (i as f64 / f as f64, j as f64 / f as f64);
+            unit([0, 1, 2].map(|k| a[k] + (b[k] - a[k]) * u + (c[k] - a[k]) * w))
+        };
+        for i in 0..f {
+            for j in 0..f - i {
+                out.push([at(i, j), at(i + 1, j), at(i, j + 1)]);
+                if i + j + 1 < f {
+                    out.push([at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)]);
+                }
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn a_large_cloud_whose_normals_form_no_mode_is_covered() {
+    // A geodesic dome of 80 facets, 18-20° between neighbours, 36,000
+    // points with noise of a tenth of their spacing across each facet:
+    // every point locally planar, but no peak of the normals holds a
+    // quarter of its cone, so the mode search keeps no mode that explains
+    // it, and there are more points than a ladder scans. The directions
+    // of the cover scan them (docs/method.md §8): each facet one part.
+    use aniso_alpha::detect::estimate::LADDER_MAX_POINTS;
+    use aniso_alpha::options::{run_warnings, DetectOptions, Style};
+    let tris = geodesic(2);
+    assert_eq!(tris.len(), 80);
+    let n = 36_000;
+    assert!(n > LADDER_MAX_POINTS);
+    let mut s = 11u64;
+    let mut next = move || {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (s >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    let cross = |a: [f64; 3], b: [f64; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    // Equal counts per facet (the facets' areas differ by under 20%).
+    let per = n / tris.len();
+    let area = 4.0 * std::f64::consts::PI / n as f64;
+    let noise = 0.1 * area.sqrt();
+    let mut pts = Vec::with_capacity(n);
+    let mut truth = Vec::with_capacity(n);
+    for (k, [a, b, c]) in tris.iter().enumerate() {
+        let (e1, e2) = (sub(*b, *a), sub(*c, *a));
+        let nv = cross(e1, e2);
+        let l = (nv[0] * nv[0] + nv[1] * nv[1] + nv[2] * nv[2]).sqrt();
+        for _ in 0..per {
+            let (mut u, mut w) = (next(), next());
+            if u + w > 1.0 {
+                (u, w) = (1.0 - u, 1.0 - w);
+            }
+            // A sum of uniforms: about Gaussian, of deviation `noise`.
+            let g = (0..12).map(|_| next()).sum::<f64>() - 6.0;
+            pts.push([0, 1, 2].map(|i| a[i] + e1[i] * u + e2[i] * w + nv[i] / l * noise * g));
+            truth.push(k);
+        }
+    }
+    let d = Detector::auto(StructureKind::Planes, &pts, &Given::default()).unwrap();
+    let e = d.estimate().unwrap();
+    assert!(
+        e.explained < 0.5 && e.structured > 0.9,
+        "{} {}",
+        e.explained,
+        e.structured
+    );
+    assert_eq!(e.ladder_declined, Some(pts.len()));
+    let cover = e.modes.iter().filter(|m| m.cover).count();
+    assert!(cover >= 40, "{cover} directions of the cover");
+    let w = run_warnings(
+        &DetectOptions::new(StructureKind::Planes),
+        &d,
+        n,
+        1,
+        Style::Cli,
+    );
+    assert!(
+        w.iter().any(|w| w.contains("covering the normals")),
+        "{w:?}"
+    );
+    let det = d.run(&pts).unwrap();
+    // A facet is found when one part holds at least half of it and at
+    // least half of that part is the facet's.
+    let parts = det.part_labels();
+    let mut found = 0;
+    for k in 0..tris.len() {
+        let mut count = std::collections::HashMap::new();
+        for (i, &p) in parts.iter().enumerate() {
+            if truth[i] == k && p >= 0 {
+                *count.entry(p).or_insert(0usize) += 1;
+            }
+        }
+        if let Some((&p, &c)) = count.iter().max_by_key(|&(p, c)| (*c, -p)) {
+            let size = parts.iter().filter(|&&q| q == p).count();
+            if 2 * c >= per && 2 * c > size {
+                found += 1;
+            }
+        }
+    }
+    assert!(found >= 76, "{found} of 80 facets found as one part");
 }

@@ -89,6 +89,21 @@
 //!    an estimate, chooses the scale of each structure. The levels share
 //!    each rotation's triangulation (the Delaunay tetrahedralization of
 //!    Q·P does not depend on α).
+//! 7. **Normals that form no mode: the cover** (planes). A cloud too large
+//!    for the ladder whose points are mostly structure-like (at least
+//!    [`EXPLAINED_MIN`] of them) but whose modes explain less than that
+//!    is not sparse: its local shapes describe it, but its normals spread
+//!    over many directions without peaks (a geodesic dome's facets, each
+//!    facing its own way; a rolling terrain; a rock face), so the mode
+//!    search keeps few modes or none. The points no mode scans are then
+//!    scanned along the directions of the ladder's sampler
+//!    ([`COVER_STEP_DEG`]): each direction is a mode whose members are
+//!    taken as a mode's are, with a margin of half the step (a facet whose
+//!    normals spread less than a quarter of the step lies whole in the
+//!    scan of the direction nearest to it, and a point is scanned about
+//!    twice, not about six times as with the modes' margin), kept where
+//!    its structure-like members reach a mode's support, and scanned at
+//!    their own spacing and noise. The report marks these `cover`.
 //!
 //! Explicit values override the estimates (for every mode); with α or λ
 //! given, no ladder.
@@ -202,6 +217,10 @@ pub struct ModeScan {
     /// For a thick plane (module doc, step 4c): its own spacing and noise
     /// gave λ = 1, and it is scanned at the cloud's.
     pub cloud_scale: bool,
+    /// Not a mode: a direction of the cover of the normals that no mode
+    /// scans (module doc, step 7); `support` is then its structure-like
+    /// members.
+    pub cover: bool,
 }
 
 /// What was estimated from a cloud.
@@ -306,6 +325,12 @@ pub const LADDER_LEVELS: [f64; 5] = [
 /// tilt atan(1/[`LAMBDA_MAX`]) = 7.1° that an ellipsoid of elongation
 /// λ_max tolerates.
 pub const LADDER_STEP_DEG: f64 = 10.0;
+
+/// The angular step of the cover of the normals no mode scans (module
+/// doc, step 7; degrees): the ladder's sampler, [`LADDER_STEP_DEG`], for
+/// the same reason (its largest gap, about 5°, is within the tilt that the
+/// flattest ellipsoid tolerates).
+pub const COVER_STEP_DEG: f64 = LADDER_STEP_DEG;
 
 fn quantile(v: &mut [f32], q: f64) -> f64 {
     if v.is_empty() {
@@ -745,7 +770,7 @@ fn mode_search(
     off: &(dyn Fn(usize) -> bool + Sync),
 ) -> ModeSearch {
     let found = concentrated_modes(kind, points, shapes, (&structure.ids, structure.noise), off);
-    let members = mode_members(kind, shapes, &found, off);
+    let members = mode_members(kind, shapes, &found, MARGIN_DEG, off);
     let explained = explained_share(kind, shapes, &members, off);
     ModeSearch {
         found,
@@ -904,6 +929,23 @@ fn estimate_with(
         None => (alpha_p, lambda2_p, lambda3_p),
         Some(l) => ladder_params(kind, l, (explained, structured), spacing_median),
     };
+    let mut mode_scans = mode_scans;
+    // The cover where the local shapes describe the cloud (most points
+    // are structure-like) but its normals form no modes that explain it.
+    if kind == StructureKind::Planes && ladder_declined.is_some() && structured >= EXPLAINED_MIN {
+        let cover = cover_scans(
+            kind,
+            points,
+            shapes,
+            &mode_scans,
+            structure.len(),
+            (spacing, noise),
+            given,
+            m2,
+            &off,
+        );
+        mode_scans.extend(cover);
+    }
     Estimate {
         kind,
         points: n,
@@ -1287,18 +1329,19 @@ impl Blends<'_> {
 }
 
 /// The members of each mode (module doc, step 3): a point joins the modes
-/// within the cone of its axis, except those more than [`MARGIN_DEG`]
-/// farther than its nearest mode (so the shoulders of a large mode, local
-/// maxima made by the blurred normals near its edges, do not scan its
-/// points again).
+/// within the cone of its axis, except those more than `margin_deg`
+/// farther than its nearest mode ([`MARGIN_DEG`] for the modes: so the
+/// shoulders of a large mode, local maxima made by the blurred normals
+/// near its edges, do not scan its points again).
 fn mode_members(
     kind: StructureKind,
     shapes: &[LocalShape],
     found: &[Mode],
+    margin_deg: f64,
     off: &(dyn Fn(usize) -> bool + Sync),
 ) -> Vec<Vec<u32>> {
     let cos_cone = CONE_DEG.to_radians().cos();
-    let margin = MARGIN_DEG.to_radians();
+    let margin = margin_deg.to_radians();
     // Chunks of points on the pool's threads, their lists joined in order.
     const CHUNK: usize = 1 << 13;
     let n = shapes.len();
@@ -1385,7 +1428,71 @@ fn mode_scan(
         rotations: mode_rotations(kind, m.axis, l2, l3, m2),
         thinned_from,
         cloud_scale,
+        cover: false,
     }
+}
+
+/// The cover of the normals that no mode scans (module doc, step 7): the
+/// directions of the Fibonacci sampler at [`COVER_STEP_DEG`], each a
+/// mode over the points that are members of none of `modes` (and not
+/// `off`), with members taken as a mode's are ([`mode_members`]: within
+/// the cone of the direction, and within half the step of the nearest
+/// one),
+/// kept where its structure-like members reach the support a mode needs
+/// (`structure_like` structure-like points in the cloud, as in
+/// [`concentrated_modes`]), and scanned at their own spacing and noise
+/// ([`mode_scan`], `cloud` their fallback).
+#[allow(clippy::too_many_arguments)]
+fn cover_scans(
+    kind: StructureKind,
+    points: &[[f64; 3]],
+    shapes: &[LocalShape],
+    modes: &[ModeScan],
+    structure_like: usize,
+    cloud: (f64, f64),
+    given: &Given,
+    m2: u32,
+    off: &(dyn Fn(usize) -> bool + Sync),
+) -> Vec<ModeScan> {
+    let mut scanned = vec![false; shapes.len()];
+    for m in modes {
+        for &i in &m.points {
+            scanned[i as usize] = true;
+        }
+    }
+    let left = |i: usize| off(i) || scanned[i];
+    let Ok(directions) = super::orientations::fibonacci_directions(COVER_STEP_DEG) else {
+        return Vec::new();
+    };
+    let cover: Vec<Mode> = directions
+        .into_iter()
+        .map(|axis| Mode { axis, support: 0 })
+        .collect();
+    let members = mode_members(kind, shapes, &cover, COVER_STEP_DEG / 2.0, &left);
+    let min_support = MODE_MIN_POINTS.max(structure_like / 1000);
+    let like = |i: &u32| shapes[*i as usize].score(kind) >= SCORE_MIN;
+    cover
+        .into_iter()
+        .zip(members)
+        .filter_map(|(m, members)| {
+            let core: Vec<u32> = members.iter().copied().filter(like).collect();
+            if core.len() < min_support {
+                return None;
+            }
+            let (d, sigma) = spacing_and_noise(kind, shapes, &core, cloud);
+            let support = core.len();
+            drop(core);
+            let mode = Mode {
+                axis: m.axis,
+                support,
+            };
+            let scan = mode_scan(kind, points, mode, members, (d, sigma), cloud, given, m2);
+            Some(ModeScan {
+                cover: true,
+                ..scan
+            })
+        })
+        .collect()
 }
 
 /// The share of the points that can be structure (not `off`) that are
