@@ -28,7 +28,7 @@ use super::same::{absorbed, Piece};
 use super::{part_of_candidates, Candidate, Draft, Footprint, Shape};
 use crate::par::map_each;
 use crate::unionfind::UnionFind;
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
 
 /// With normals given, a point joins a plane only if |n_p · n| is at least
 /// this: 0.8, an angle of 36.9°. It is the default `normal_threshold` of
@@ -68,7 +68,8 @@ impl Claims {
     /// a point claimed by two slices of one candidate is kept once. The
     /// claims do not depend on the slicing.
     pub(super) fn of(cands: &[Candidate], cloud: &Cloud<'_>, normals: Option<&[[f32; 3]]>) -> Self {
-        let per_slice = claim_slices(cands, cloud, normals, |i, d| (i, d));
+        let all: Vec<u32> = (0..cands.len() as u32).collect();
+        let per_slice = claim_slices(cands, &all, cloud, normals, |i, d| (i, d));
         // Each slice reports a point at most once, and two slices of a
         // candidate never the same point ([`for_near_in`]): no duplicate.
         let claims = by_point_then_candidate(
@@ -127,14 +128,20 @@ fn nearest<'a>(claims: impl Iterator<Item = &'a Claim>) -> Option<&'a Claim> {
     claims.min_by(|a, b| a.2.total_cmp(&b.2).then(a.1.cmp(&b.1)))
 }
 
-/// Which candidates claim a point together, without the distances: what
-/// the merging rounds of [`settle`] ask (which candidates share a point).
-/// Held as the distinct sets of two candidates or more that claim one
-/// point, each sorted, found by folding the claims into a trie of
-/// candidate sets ([`Sharing::of`]): 4 bytes a point and 16 a distinct
-/// set prefix, where a list of (point, candidate) pairs took 8 bytes a
-/// claim (11 claims a point on a depth frame, before the merge).
-struct Sharing(Vec<Box<[u32]>>);
+/// Which candidates claim each point, without the distances: what the
+/// merging rounds of [`settle`] ask (which candidates share a point).
+/// Held as the distinct sets of candidates that claim one point, each
+/// sorted, and per point the index of its set, found by folding the
+/// claims into a trie of candidate sets ([`Sharing::of`]): 4 bytes a point
+/// and 16 a distinct set prefix, where a list of (point, candidate) pairs
+/// took 8 bytes a claim (11 claims a point on a depth frame, before the
+/// merge).
+struct Sharing {
+    /// The distinct sets (the empty one and sets of one included).
+    sets: Vec<Box<[u32]>>,
+    /// Per point, the index of its set in `sets`.
+    at: Vec<u32>,
+}
 
 impl Sharing {
     /// The distinct sets of candidates of [`Claims::of`] at a point.
@@ -146,21 +153,98 @@ impl Sharing {
     /// stamped with the candidate), so that each claim costs two array
     /// reads, no hashing.
     fn of(cands: &[Candidate], cloud: &Cloud<'_>, normals: Option<&[[f32; 3]]>) -> Self {
-        let per_slice = claim_slices(cands, cloud, normals, |i, _| i);
-        Sharing(distinct_sets(cloud.points().len(), per_slice))
+        let all: Vec<u32> = (0..cands.len() as u32).collect();
+        let per_slice = claim_slices(cands, &all, cloud, normals, |i, _| i);
+        let (sets, at) = distinct_sets(cloud.points().len(), per_slice);
+        Sharing { sets, at }
     }
 
-    /// [`Claims::shared`] of the same candidates.
-    fn shared(&self, of: impl Fn(u32) -> Option<u32>) -> Vec<(u32, u32)> {
-        shared_pairs(self.0.iter().map(|s| s.iter().copied()), of)
+    /// The distinct pairs (a < b) of candidates claiming one point, of
+    /// which at least one is `changed`, sorted ([`shared_pairs`]).
+    fn shared(&self, changed: &[bool]) -> Vec<(u32, u32)> {
+        let sets = self
+            .sets
+            .iter()
+            .filter(|s| s.len() > 1 && s.iter().any(|&c| changed[c as usize]));
+        let mut pairs = shared_pairs(sets.map(|s| s.iter().copied()), Some);
+        pairs.retain(|&(a, b)| changed[a as usize] || changed[b as usize]);
+        pairs
+    }
+
+    /// The sharing of the candidates `cands` that a round of merging made
+    /// from the candidates of `self`: `kept[c]` is the new index of an old
+    /// candidate c kept as it was (`None`: merged into another), and
+    /// `changed` flags the new candidates made by a merge. A kept
+    /// candidate claims what it claimed, so only the changed ones claim
+    /// again ([`claim_slices`]); each point's set is its old one renumbered
+    /// without the merged candidates, with the changed ones that claim it.
+    /// The same sets as [`Sharing::of`] on `cands`.
+    fn after(
+        self,
+        cands: &[Candidate],
+        kept: &[Option<u32>],
+        changed: &[bool],
+        cloud: &Cloud<'_>,
+        normals: Option<&[[f32; 3]]>,
+    ) -> Self {
+        let which: Vec<u32> = (0..cands.len() as u32)
+            .filter(|&c| changed[c as usize])
+            .collect();
+        let mut fresh: Vec<(u32, u32)> = claim_slices(cands, &which, cloud, normals, |i, _| i)
+            .into_iter()
+            .flat_map(|(c, list)| list.into_iter().map(move |p| (p, c)))
+            .collect();
+        crate::par::sort_unstable(&mut fresh);
+        // The sets some point holds, renumbered: kept candidates keep their
+        // order, so each stays sorted (two may become equal, which costs
+        // their pairs nothing: `shared_pairs` gives each set's pairs once).
+        let mut index = vec![u32::MAX; self.sets.len()];
+        for &k in &self.at {
+            index[k as usize] = 0;
+        }
+        let mut sets: Vec<Box<[u32]>> = Vec::with_capacity(self.sets.len());
+        for (k, s) in self.sets.iter().enumerate() {
+            if index[k] == 0 {
+                index[k] = sets.len() as u32;
+                sets.push(s.iter().filter_map(|&c| kept[c as usize]).collect());
+            }
+        }
+        drop(self.sets);
+        let mut at: Vec<u32> = self.at;
+        for k in at.iter_mut() {
+            *k = index[*k as usize];
+        }
+        drop(index);
+        // The points the changed candidates claim: their sets, each new set
+        // once.
+        let mut ids: HashMap<Box<[u32]>, u32> = HashMap::new();
+        let mut set: Vec<u32> = Vec::new();
+        for here in fresh.chunk_by(|a, b| a.0 == b.0) {
+            let p = here[0].0 as usize;
+            set.clear();
+            set.extend_from_slice(&sets[at[p] as usize]);
+            set.extend(here.iter().map(|&(_, c)| c));
+            set.sort_unstable();
+            at[p] = match ids.get(set.as_slice()) {
+                Some(&k) => k,
+                None => {
+                    let k = sets.len() as u32;
+                    sets.push(set.as_slice().into());
+                    ids.insert(set.as_slice().into(), k);
+                    k
+                }
+            };
+        }
+        Sharing { sets, at }
     }
 }
 
-/// The distinct sets of two candidates or more that claim one of `n`
-/// points, each sorted, from lists of claimed points in candidate order
-/// (a candidate's, or one slice of a candidate's; each point at most once
-/// a candidate): [`Sharing::of`]'s trie. Each list is freed once folded.
-fn distinct_sets(n: usize, lists: Vec<(u32, Vec<u32>)>) -> Vec<Box<[u32]>> {
+/// The distinct sets of candidates that claim one of `n` points, each
+/// sorted (the empty set and sets of one included), and per point the
+/// index of its set, from lists of claimed points in candidate order (a
+/// candidate's, or one slice of a candidate's; each point at most once a
+/// candidate): [`Sharing::of`]'s trie. Each list is freed once folded.
+fn distinct_sets(n: usize, lists: Vec<(u32, Vec<u32>)>) -> (Vec<Box<[u32]>>, Vec<u32>) {
     const NONE: u32 = u32::MAX;
     // Node 0 is the empty set; a node is (parent, candidate).
     let mut at = vec![0u32; n];
@@ -178,24 +262,30 @@ fn distinct_sets(n: usize, lists: Vec<(u32, Vec<u32>)>) -> Vec<Box<[u32]>> {
         }
     }
     drop(child);
-    let mut used = vec![false; nodes.len()];
+    // The used nodes, numbered in node order.
+    let mut index = vec![NONE; nodes.len()];
     for &k in &at {
-        used[k as usize] = true;
+        index[k as usize] = 0;
     }
-    drop(at);
-    (0..nodes.len())
-        .filter(|&k| used[k] && nodes[k].0 != 0 && nodes[k].0 != NONE)
-        .map(|k| {
-            let mut set = Vec::new();
-            let mut k = k as u32;
-            while k != 0 {
-                set.push(nodes[k as usize].1);
-                k = nodes[k as usize].0;
-            }
-            set.reverse();
-            set.into_boxed_slice()
-        })
-        .collect()
+    let mut sets: Vec<Box<[u32]>> = Vec::new();
+    for k in 0..nodes.len() {
+        if index[k] == NONE {
+            continue;
+        }
+        index[k] = sets.len() as u32;
+        let mut set = Vec::new();
+        let mut j = k as u32;
+        while j != 0 {
+            set.push(nodes[j as usize].1);
+            j = nodes[j as usize].0;
+        }
+        set.reverse();
+        sets.push(set.into_boxed_slice());
+    }
+    for k in at.iter_mut() {
+        *k = index[*k as usize];
+    }
+    (sets, at)
 }
 
 /// The (candidate, first block, end block) of each slice of the
@@ -216,26 +306,31 @@ fn slices_of(blocks: &[usize]) -> Vec<(usize, usize, usize)> {
         .collect()
 }
 
-/// The claims of `cands` slice by slice ([`slices_of`] of their footprint
-/// blocks), each claim made by `make(point, distance)`, with the
-/// candidate of each slice: in parallel over the slices (so
+/// The claims of the candidates `which` (ascending indices into `cands`)
+/// slice by slice ([`slices_of`] of their footprint blocks), each claim
+/// made by `make(point, distance)`, with the candidate of each slice: in parallel over the slices (so
 /// that one large candidate, a scan's ground, is shared between threads),
 /// each point once ([`for_near_in`]).
 fn claim_slices<T: Send>(
     cands: &[Candidate],
+    which: &[u32],
     cloud: &Cloud<'_>,
     normals: Option<&[[f32; 3]]>,
     make: impl Fn(u32, f64) -> T + Sync,
 ) -> Vec<(u32, Vec<T>)> {
     // Counted first, each slice's boxes made by its own task: the boxes
     // of every candidate at once were the largest buffer of the claims.
-    let counts: Vec<usize> = cands
+    let counts: Vec<usize> = which
         .iter()
-        .map(|c| c.foot.near_block_count(c.tau))
+        .map(|&c| {
+            let c = &cands[c as usize];
+            c.foot.near_block_count(c.tau)
+        })
         .collect();
     let slices = slices_of(&counts);
     map_each(slices.len(), |k| {
-        let (ci, from, to) = slices[k];
+        let (wi, from, to) = slices[k];
+        let ci = which[wi] as usize;
         let c = &cands[ci];
         let agrees = normal_agreement(&c.fit, normals);
         let mut claims = Vec::new();
@@ -364,10 +459,17 @@ pub(super) fn settle<S: Shape>(
     let points = cloud.points();
     cloud.build_index();
     // The merging rounds ask only which candidates share points.
+    // A pair of candidates that a round left apart, neither of them
+    // changed since, would be left apart again: each round tests only the
+    // pairs with a candidate its merges made, and its sharing claims again
+    // for those alone.
     let mut sharing = Sharing::of(&cands, cloud, normals);
-    while let Some(groups) = duplicates::<S>(&cands, &sharing, angle_deg, points) {
-        cands = merged::<S>(cands, &groups, points);
-        sharing = Sharing::of(&cands, cloud, normals);
+    let mut changed = vec![true; cands.len()];
+    while let Some(groups) = duplicates::<S>(&cands, &sharing, &changed, angle_deg, points) {
+        let (next, kept, made) = merged::<S>(cands, &groups, points);
+        cands = next;
+        changed = made;
+        sharing = sharing.after(&cands, &kept, &changed, cloud, normals);
     }
     drop(sharing);
     let claims = Claims::of(&cands, cloud, normals);
@@ -385,7 +487,8 @@ struct Groups {
 }
 
 /// The groups of candidates that are one primitive and share claimed
-/// points, or `None` when no two are. An absorbed candidate ([`absorbed`])
+/// points (of which one at least is `changed`: the others were tested
+/// alike before), or `None` when no two are. An absorbed candidate ([`absorbed`])
 /// joins the one that absorbs it and no other. Two candidates of which
 /// one is in a group already join only if their groups are one primitive
 /// too ([`SoFar`]): the pairwise test alone chains two faces of a shallow
@@ -394,6 +497,7 @@ struct Groups {
 fn duplicates<S: Shape>(
     cands: &[Candidate],
     sharing: &Sharing,
+    changed: &[bool],
     angle_deg: f64,
     points: &[[f64; 3]],
 ) -> Option<Groups> {
@@ -401,7 +505,7 @@ fn duplicates<S: Shape>(
     let mut was_absorbed = vec![false; cands.len()];
     let mut so_far = SoFar::new(cands.len());
     let mut merged = false;
-    for (a, b) in sharing.shared(Some) {
+    for (a, b) in sharing.shared(changed) {
         let (ra, rb) = (uf.find(a), uf.find(b));
         if was_absorbed[a as usize] || was_absorbed[b as usize] || ra == rb {
             continue;
@@ -528,7 +632,14 @@ impl SoFar {
 /// One candidate per group: a group of one keeps its candidate; a larger
 /// one becomes the fit of its seeds with the largest claim radius and
 /// cell of the candidates not absorbed (dropped if it has no footprint).
-fn merged<S: Shape>(cands: Vec<Candidate>, groups: &Groups, points: &[[f64; 3]]) -> Vec<Candidate> {
+/// With the new candidates: the new index of each old candidate kept as
+/// it was (`None` for those merged), and which new ones a merge made.
+fn merged<S: Shape>(
+    cands: Vec<Candidate>,
+    groups: &Groups,
+    points: &[[f64; 3]],
+) -> (Vec<Candidate>, Vec<Option<u32>>, Vec<bool>) {
+    let n_old = cands.len();
     let mut old: Vec<Option<Candidate>> = cands.into_iter().map(Some).collect();
     let sets: Vec<Vec<(Candidate, bool)>> = groups
         .sets
@@ -545,8 +656,14 @@ fn merged<S: Shape>(cands: Vec<Candidate>, groups: &Groups, points: &[[f64; 3]])
         })
         .collect();
     drop(old);
+    let alone: Vec<Option<u32>> = groups
+        .sets
+        .iter()
+        .filter(|g| !g.is_empty())
+        .map(|g| (g.len() == 1).then_some(g[0]))
+        .collect();
     // Groups are independent: on the pool's threads, in order.
-    crate::par::map_owned(sets, |mut group| {
+    let made = crate::par::map_owned(sets, |mut group| {
         if group.len() == 1 {
             return group.pop().map(|(c, _)| c);
         }
@@ -574,10 +691,19 @@ fn merged<S: Shape>(cands: Vec<Candidate>, groups: &Groups, points: &[[f64; 3]])
             seeds,
             foot,
         })
-    })
-    .into_iter()
-    .flatten()
-    .collect()
+    });
+    let mut kept = vec![None; n_old];
+    let mut changed = Vec::with_capacity(made.len());
+    let mut out = Vec::with_capacity(made.len());
+    for (cand, alone) in made.into_iter().zip(alone) {
+        let Some(cand) = cand else { continue };
+        if let Some(c) = alone {
+            kept[c as usize] = Some(out.len() as u32);
+        }
+        changed.push(alone.is_none());
+        out.push(cand);
+    }
+    (out, kept, changed)
 }
 
 /// Refits each candidate with more than k members on them (its footprint
@@ -764,15 +890,15 @@ mod tests {
             lists.push((c, mine));
             lists.push((c, rest));
         }
-        let mut want: Vec<Box<[u32]>> = sets
-            .into_iter()
-            .filter(|s| s.len() > 1)
-            .map(Vec::into_boxed_slice)
-            .collect();
+        let (got_sets, at) = distinct_sets(300, lists);
+        for (p, set) in sets.iter().enumerate() {
+            assert_eq!(&*got_sets[at[p] as usize], set.as_slice(), "point {p}");
+        }
+        let mut want: Vec<Box<[u32]>> = sets.into_iter().map(Vec::into_boxed_slice).collect();
         want.sort_unstable();
         want.dedup();
         assert!(want.len() > 20, "{}", want.len());
-        let mut got = distinct_sets(300, lists);
+        let mut got = got_sets;
         let distinct = got.len();
         got.sort_unstable();
         got.dedup();
@@ -953,12 +1079,81 @@ mod tests {
             sets.sort_unstable();
             sets.dedup();
             assert!(sets.len() > 1, "{sets:?}");
-            let mut got = sharing.0.clone();
+            let mut got: Vec<Box<[u32]>> = sharing
+                .sets
+                .iter()
+                .filter(|s| s.len() > 1)
+                .cloned()
+                .collect();
             got.sort_unstable();
             assert_eq!(got, sets);
-            assert_eq!(sharing.shared(Some), claims.shared(Some));
-            assert_eq!(sharing.shared(Some), [(0, 1), (0, 2), (1, 2)]);
+            let all = [true; 3];
+            assert_eq!(sharing.shared(&all), claims.shared(Some));
+            assert_eq!(sharing.shared(&all), [(0, 1), (0, 2), (1, 2)]);
+            // Pairs without a changed candidate are left out.
+            assert_eq!(sharing.shared(&[false, false, true]), [(0, 2), (1, 2)]);
         }
+    }
+
+    #[test]
+    fn the_sharing_after_a_merge_is_the_sharing_of_the_merged_candidates() {
+        // A floor of 30 × 30 points and a wall of 30 × 10 along x = 10:
+        // two overlapping pieces of the floor (one primitive: they merge),
+        // a third piece of it apart from both (kept until the merged one
+        // reaches it) and the wall (across the floor: kept). The update
+        // of the sharing after each round must give every point the set a
+        // fresh sharing of the new candidates gives it, and the rounds
+        // must end where testing every pair each round ends.
+        let mut pts: Vec<[f64; 3]> = (0..900)
+            .map(|k| {
+                let (i, j) = (f64::from(k % 30), f64::from(k / 30));
+                [i, j, 0.02 * ((i * 7.0 + j * 3.0) % 5.0)]
+            })
+            .collect();
+        pts.extend((0..300).map(|k| [10.0, f64::from(k % 30), 1.0 + f64::from(k / 30)]));
+        let copies = Copies::none(pts.len());
+        let cloud = Cloud::new(&pts, &copies);
+        cloud.build_index();
+        let cand = |seeds: Vec<u32>, tau: f64| plane_candidate(&pts, seeds, tau);
+        let mut cands = vec![
+            cand((0..450).collect(), 0.1),
+            cand((300..700).collect(), 0.1),
+            cand((750..900).collect(), 0.1),
+            cand((900..1200).collect(), 0.1),
+        ];
+        let mut sharing = Sharing::of(&cands, &cloud, None);
+        let mut changed = vec![true; cands.len()];
+        let mut rounds = 0;
+        while let Some(groups) = duplicates::<[u32; 3]>(&cands, &sharing, &changed, 10.0, &pts) {
+            let (next, kept, made) = merged::<[u32; 3]>(cands, &groups, &pts);
+            assert!(
+                made.iter().any(|&m| m),
+                "a round that merges makes a candidate"
+            );
+            cands = next;
+            changed = made;
+            sharing = sharing.after(&cands, &kept, &changed, &cloud, None);
+            let fresh = Sharing::of(&cands, &cloud, None);
+            for p in 0..pts.len() {
+                assert_eq!(
+                    sharing.sets[sharing.at[p] as usize], fresh.sets[fresh.at[p] as usize],
+                    "round {rounds}, point {p}"
+                );
+            }
+            rounds += 1;
+        }
+        assert!(rounds >= 1);
+        // The floor is one candidate, the wall another.
+        assert_eq!(cands.len(), 2, "{rounds} rounds");
+        let all = vec![true; cands.len()];
+        assert!(duplicates::<[u32; 3]>(
+            &cands,
+            &Sharing::of(&cands, &cloud, None),
+            &all,
+            10.0,
+            &pts
+        )
+        .is_none());
     }
 
     #[test]
