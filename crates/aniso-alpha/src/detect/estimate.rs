@@ -89,13 +89,17 @@
 //!    an estimate, chooses the scale of each structure. The levels share
 //!    each rotation's triangulation (the Delaunay tetrahedralization of
 //!    Q·P does not depend on α).
-//! 7. **Normals that form no mode: the cover** (planes). A cloud too large
-//!    for the ladder whose points are mostly structure-like (at least
-//!    [`EXPLAINED_MIN`] of them) but whose modes explain less than that
-//!    is not sparse: its local shapes describe it, but its normals spread
-//!    over many directions without peaks (a geodesic dome's facets, each
-//!    facing its own way; a rolling terrain; a rock face), so the mode
-//!    search keeps few modes or none. The points no mode scans are then
+//! 7. **Normals that form no mode: the cover** (planes). A cloud whose
+//!    points are mostly structure-like (at least [`EXPLAINED_MIN`] of
+//!    them) but whose modes explain less than that is not sparse: its
+//!    local shapes describe it, but its normals spread over many
+//!    directions without peaks (a geodesic dome's facets, each facing its
+//!    own way; a rolling terrain; a rock face), so the mode search keeps
+//!    few modes or none. Where the cloud is too large for a ladder, or
+//!    where most of its structure-like points are in no mode (the modes
+//!    explain less than half the structure-like share; the paper's planes,
+//!    whose modes explain most of their few structure-like points, keep
+//!    the ladder), the points no mode scans are then
 //!    scanned along the directions of the ladder's sampler
 //!    ([`COVER_STEP_DEG`]): each direction is a mode whose members are
 //!    taken as a mode's are, with a margin of half the step (a facet whose
@@ -256,7 +260,8 @@ pub struct Estimate {
     /// (with or without a mode).
     pub structured: f64,
     /// The scale ladder scanned instead of the modes when they explain
-    /// less than [`EXPLAINED_MIN`] of the cloud (module doc, step 6).
+    /// less than [`EXPLAINED_MIN`] of the cloud (module doc, step 6), unless
+    /// the cover scans the rest (step 7).
     pub ladder: Option<Ladder>,
     /// The number of points a ladder would have scanned where the cloud
     /// called for one but they were more than [`LADDER_MAX_POINTS`]: the
@@ -918,8 +923,17 @@ fn estimate_with(
         && given.lambda3.is_none()
         && spacing_median.is_finite()
         && spacing_median > 0.0;
+    // Planes whose local shapes describe the cloud (most points are
+    // structure-like) but whose normals form no modes that explain it:
+    // the cover (module doc, step 7), beside the modes of a cloud too
+    // large for a ladder, and in place of the ladder where most of the
+    // structure-like points are in no mode.
+    let covered = kind == StructureKind::Planes
+        && sparse
+        && structured >= EXPLAINED_MIN
+        && (can_be > LADDER_MAX_POINTS || explained < structured / 2.0);
     let ladder_declined = (sparse && can_be > LADDER_MAX_POINTS).then_some(can_be);
-    let ladder = (sparse && ladder_declined.is_none()).then(|| {
+    let ladder = (sparse && !covered && ladder_declined.is_none()).then(|| {
         ladder(
             spacing_median,
             (0..n as u32).filter(|&i| !off(i as usize)).collect(),
@@ -930,9 +944,7 @@ fn estimate_with(
         Some(l) => ladder_params(kind, l, (explained, structured), spacing_median),
     };
     let mut mode_scans = mode_scans;
-    // The cover where the local shapes describe the cloud (most points
-    // are structure-like) but its normals form no modes that explain it.
-    if kind == StructureKind::Planes && ladder_declined.is_some() && structured >= EXPLAINED_MIN {
+    if covered {
         let cover = cover_scans(
             kind,
             points,
