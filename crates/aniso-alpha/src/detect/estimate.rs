@@ -97,9 +97,9 @@
 //!    own way; a rolling terrain; a rock face), so the mode search keeps
 //!    few modes or none. Where the cloud is too large for a ladder, or
 //!    where most of its structure-like points are in no mode (the modes
-//!    explain less than half the structure-like share; the paper's planes,
-//!    whose modes explain most of their few structure-like points, keep
-//!    the ladder), the points no mode scans are then
+//!    explain less than half the structure-like share; the paper's scenes,
+//!    under half structure-like, keep the ladder), the points no mode
+//!    scans are then
 //!    scanned along the directions of the ladder's sampler
 //!    ([`COVER_STEP_DEG`]): each direction is a mode whose members are
 //!    taken as a mode's are, with a margin of half the step (a facet whose
