@@ -354,6 +354,20 @@ pub fn run_warnings(
             style.name("min_size"),
         ));
     }
+    if let Some(e) = detector.estimate().filter(|e| e.ladder_declined.is_none()) {
+        let cover = e.modes.iter().filter(|m| m.cover).count();
+        if cover > 0 {
+            out.push(format!(
+                "the modes of the local normals explain {:.0}% of the points though {:.0}% look \
+                 locally planar: the normals spread without peaks (many facets, or a curved \
+                 surface), so {cover} direction(s) {}° apart cover the normals no mode scans; on a \
+                 curved surface their parts are planar patches",
+                100.0 * e.explained,
+                100.0 * e.structured,
+                crate::detect::estimate::COVER_STEP_DEG,
+            ));
+        }
+    }
     let orientations = detector.orientation_count().unwrap_or(0);
     let work = points as f64 * orientations as f64;
     if work > HUGE_RUN {

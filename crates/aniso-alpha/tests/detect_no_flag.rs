@@ -455,6 +455,19 @@ fn a_dense_cloud_whose_normals_form_no_mode_takes_the_cover_not_the_ladder() {
     assert!(d.ladder().is_none());
     assert_eq!(e.ladder_declined, None);
     assert!(e.modes.iter().filter(|m| m.cover).count() >= 40);
+    use aniso_alpha::options::{run_warnings, DetectOptions, Style};
+    let w = run_warnings(
+        &DetectOptions::new(StructureKind::Planes),
+        &d,
+        pts.len(),
+        1,
+        Style::Cli,
+    );
+    assert!(
+        w.iter()
+            .any(|w| w.contains("cover the normals no mode scans")),
+        "{w:?}"
+    );
     let det = d.run(&pts).unwrap();
     let found = facets_found(&truth, &det);
     assert!(found >= 76, "{found} of 80 facets found as one part");
