@@ -198,23 +198,15 @@ impl Sharing {
         // The sets some point holds, renumbered: kept candidates keep their
         // order, so each stays sorted (two may become equal, which costs
         // their pairs nothing: `shared_pairs` gives each set's pairs once).
-        let mut index = vec![u32::MAX; self.sets.len()];
-        for &k in &self.at {
-            index[k as usize] = 0;
-        }
-        let mut sets: Vec<Box<[u32]>> = Vec::with_capacity(self.sets.len());
-        for (k, s) in self.sets.iter().enumerate() {
-            if index[k] == 0 {
-                index[k] = sets.len() as u32;
-                sets.push(s.iter().filter_map(|&c| kept[c as usize]).collect());
-            }
-        }
+        let mut at = self.at;
+        let mut sets: Vec<Box<[u32]>> = used_in_order(&mut at, self.sets.len())
+            .into_iter()
+            .map(|k| {
+                let old = &self.sets[k as usize];
+                old.iter().filter_map(|&c| kept[c as usize]).collect()
+            })
+            .collect();
         drop(self.sets);
-        let mut at: Vec<u32> = self.at;
-        for k in at.iter_mut() {
-            *k = index[*k as usize];
-        }
-        drop(index);
         // The points the changed candidates claim: their sets, each new set
         // once.
         let mut ids: HashMap<Box<[u32]>, u32> = HashMap::new();
@@ -262,30 +254,41 @@ fn distinct_sets(n: usize, lists: Vec<(u32, Vec<u32>)>) -> (Vec<Box<[u32]>>, Vec
         }
     }
     drop(child);
-    // The used nodes, numbered in node order.
-    let mut index = vec![NONE; nodes.len()];
-    for &k in &at {
+    let sets = used_in_order(&mut at, nodes.len())
+        .into_iter()
+        .map(|k| {
+            let mut set = Vec::new();
+            let mut j = k;
+            while j != 0 {
+                set.push(nodes[j as usize].1);
+                j = nodes[j as usize].0;
+            }
+            set.reverse();
+            set.into_boxed_slice()
+        })
+        .collect();
+    (sets, at)
+}
+
+/// The entries of a table of `n` that `at` refers to, ascending, with
+/// `at` renumbered to their positions in that list.
+fn used_in_order(at: &mut [u32], n: usize) -> Vec<u32> {
+    const UNUSED: u32 = u32::MAX;
+    let mut index = vec![UNUSED; n];
+    for &k in at.iter() {
         index[k as usize] = 0;
     }
-    let mut sets: Vec<Box<[u32]>> = Vec::new();
-    for k in 0..nodes.len() {
-        if index[k] == NONE {
-            continue;
+    let mut used = Vec::new();
+    for (k, i) in index.iter_mut().enumerate() {
+        if *i != UNUSED {
+            *i = used.len() as u32;
+            used.push(k as u32);
         }
-        index[k] = sets.len() as u32;
-        let mut set = Vec::new();
-        let mut j = k as u32;
-        while j != 0 {
-            set.push(nodes[j as usize].1);
-            j = nodes[j as usize].0;
-        }
-        set.reverse();
-        sets.push(set.into_boxed_slice());
     }
     for k in at.iter_mut() {
         *k = index[*k as usize];
     }
-    (sets, at)
+    used
 }
 
 /// The (candidate, first block, end block) of each slice of the
@@ -308,9 +311,9 @@ fn slices_of(blocks: &[usize]) -> Vec<(usize, usize, usize)> {
 
 /// The claims of the candidates `which` (ascending indices into `cands`)
 /// slice by slice ([`slices_of`] of their footprint blocks), each claim
-/// made by `make(point, distance)`, with the candidate of each slice: in parallel over the slices (so
-/// that one large candidate, a scan's ground, is shared between threads),
-/// each point once ([`for_near_in`]).
+/// made by `make(point, distance)`, with the candidate of each slice: in
+/// parallel over the slices (so that one large candidate, a scan's
+/// ground, is shared between threads), each point once ([`for_near_in`]).
 fn claim_slices<T: Send>(
     cands: &[Candidate],
     which: &[u32],
@@ -488,8 +491,8 @@ struct Groups {
 
 /// The groups of candidates that are one primitive and share claimed
 /// points (of which one at least is `changed`: the others were tested
-/// alike before), or `None` when no two are. An absorbed candidate ([`absorbed`])
-/// joins the one that absorbs it and no other. Two candidates of which
+/// alike before), or `None` when no two are. An absorbed candidate
+/// ([`absorbed`]) joins the one that absorbs it and no other. Two candidates of which
 /// one is in a group already join only if their groups are one primitive
 /// too ([`SoFar`]): the pairwise test alone chains two faces of a shallow
 /// roof, 14° apart, through a four-point piece on their ridge whose plane
