@@ -623,6 +623,23 @@ fn detect_uses_the_inputs_normals() {
     assert_eq!(source, "estimated");
 }
 
+/// `detect INPUT --structure planes --report REPORT` and `extra`: the
+/// run's output and its report, read back.
+fn planes_report(input: &Path, report: &Path, extra: &[&str]) -> (Output, serde_json::Value) {
+    let mut args = vec![
+        "detect",
+        input.to_str().unwrap(),
+        "--structure",
+        "planes",
+        "--report",
+        report.to_str().unwrap(),
+    ];
+    args.extend(extra);
+    let o = ok(&args);
+    let r = serde_json::from_str(&std::fs::read_to_string(report).unwrap()).unwrap();
+    (o, r)
+}
+
 /// Three perpendicular walls (a 0.1 m grid, 1 cm of noise), each point
 /// with the normal `normal(wall, rng)` (wall 0: z = 0, 1: x = 0, 2: y = 0),
 /// written as an ASCII PLY in `dir` and run through `detect --structure
@@ -654,17 +671,7 @@ fn corner_with_normals(
         rows.join("\n")
     );
     let input = dir.file("corner.ply", ply.as_bytes());
-    let report = dir.path("r.json");
-    let o = ok(&[
-        "detect",
-        input.to_str().unwrap(),
-        "--structure",
-        "planes",
-        "--report",
-        report.to_str().unwrap(),
-    ]);
-    let r = serde_json::from_str(&std::fs::read_to_string(report).unwrap()).unwrap();
-    (o, r)
+    planes_report(&input, &dir.path("r.json"), &[])
 }
 
 #[test]
@@ -931,24 +938,16 @@ fn detect_dithers_depth_quantized_in_steps_coarser_than_a_neighbourhood() {
     }
     let input = dir.file("ridge.xyz", rows.join("\n").as_bytes());
     let parts = dir.path("parts.txt");
-    let report = dir.path("r.json");
-    let o = ok(&[
-        "detect",
-        input.to_str().unwrap(),
-        "--structure",
-        "planes",
-        "--part-labels",
-        parts.to_str().unwrap(),
-        "--report",
-        report.to_str().unwrap(),
-    ]);
+    let (o, r) = planes_report(
+        &input,
+        &dir.path("r.json"),
+        &["--part-labels", parts.to_str().unwrap()],
+    );
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(
         stderr.contains("the z coordinates lie on levels 0.0300 apart"),
         "{stderr}"
     );
-    let r: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(report).unwrap()).unwrap();
     let q = &r["parameters"]["quantized"];
     assert_eq!(q.as_array().map(Vec::len), Some(1), "{q}");
     assert_eq!(q[0]["axis"], "z");
@@ -968,18 +967,8 @@ fn detect_dithers_depth_quantized_in_steps_coarser_than_a_neighbourhood() {
     }
     // A regular grid's coordinates are levels too, one spacing apart:
     // not quantized, nothing said, nothing in the report.
-    let grid = fixture("grid_6.xyz");
-    let o = ok(&[
-        "detect",
-        grid.to_str().unwrap(),
-        "--structure",
-        "planes",
-        "--report",
-        dir.path("g.json").to_str().unwrap(),
-    ]);
+    let (o, g) = planes_report(&fixture("grid_6.xyz"), &dir.path("g.json"), &[]);
     assert!(!String::from_utf8_lossy(&o.stderr).contains("lie on levels"));
-    let g: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.path("g.json")).unwrap()).unwrap();
     assert_eq!(g["parameters"]["quantized"], serde_json::json!([]));
     // Three parallel lines 50 apart, 7 between points (the Python
     // `detect` example): y lies on levels far coarser than the spacing,
@@ -1030,22 +1019,12 @@ fn detect_dithers_depth_in_fine_steps_where_a_surface_faces_the_camera() {
         }
     }
     let input = dir.file("frame.xyz", rows.join("\n").as_bytes());
-    let report = dir.path("r.json");
-    let o = ok(&[
-        "detect",
-        input.to_str().unwrap(),
-        "--structure",
-        "planes",
-        "--report",
-        report.to_str().unwrap(),
-    ]);
+    let (o, r) = planes_report(&input, &dir.path("r.json"), &[]);
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(
         stderr.contains("the z coordinates lie on levels") && stderr.contains("finer than"),
         "{stderr}"
     );
-    let r: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(report).unwrap()).unwrap();
     let q = &r["parameters"]["quantized"];
     assert_eq!(q.as_array().map(Vec::len), Some(1), "{q}");
     assert_eq!(
