@@ -143,6 +143,7 @@ fn extract<S: Shape>(
     // cost of one pass over the vertices per candidate in all.
     let mut new_count: Vec<usize> = count_each(&cands, &vec![true; cands.len()], &verts, &inside);
     let mut covered = vec![false; verts.len()];
+    let mut taken_since_split = 0usize;
     loop {
         // The first candidate with the most new inliers.
         let mut best: Option<(usize, usize)> = None; // (new inliers, candidate)
@@ -151,10 +152,36 @@ fn extract<S: Shape>(
                 best = Some((new, ci));
             }
         }
-        let Some((new, ci)) = best else { break };
-        if new < min_vertices {
-            break;
+        let exhausted = best.is_none_or(|(new, _)| new < min_vertices);
+        if exhausted {
+            // What no candidate covers: its own pieces are candidates, as
+            // the component's were (a piece grown by angle alone over
+            // undulating ground is wider than one slab of τ).
+            if taken_since_split == 0 {
+                break;
+            }
+            taken_since_split = 0;
+            let rest =
+                pieces_of_the_rest::<S>(points, local, &verts, &covered, min_vertices, angle);
+            if rest.is_empty() {
+                break;
+            }
+            let uncovered: Vec<u32> = verts
+                .iter()
+                .zip(&covered)
+                .filter_map(|(&v, &c)| (!c).then_some(v))
+                .collect();
+            new_count.extend(count_each(
+                &rest,
+                &vec![true; rest.len()],
+                &uncovered,
+                &inside,
+            ));
+            cands.extend(rest);
+            continue;
         }
+        let Some((_, ci)) = best else { break };
+        taken_since_split += 1;
         new_count.swap_remove(ci);
         let mut fit = cands.swap_remove(ci);
         for _ in 0..2 {
@@ -203,6 +230,32 @@ fn extract<S: Shape>(
         }
     }
     out.into_iter().map(|e| e.finish::<S>(points)).collect()
+}
+
+/// The fits of the pieces of the simplices of `local` none of whose
+/// vertices is `covered` (flags over the sorted `verts`), and of all of
+/// them together ([`piece_fits`]); none where those vertices are fewer
+/// than `min_vertices`.
+fn pieces_of_the_rest<S: Shape>(
+    points: &[[f64; 3]],
+    local: &[S],
+    verts: &[u32],
+    covered: &[bool],
+    min_vertices: usize,
+    angle: f64,
+) -> Vec<Primitive> {
+    let open = |v: u32| verts.binary_search(&v).is_ok_and(|k| !covered[k]);
+    let rest: Vec<S> = local
+        .iter()
+        .filter(|s| s.as_ref().iter().all(|&v| open(v)))
+        .copied()
+        .collect();
+    let rest_verts = vertices_of(points.len(), &rest);
+    if rest_verts.len() < min_vertices {
+        return Vec::new();
+    }
+    let part = S::parts(points, &rest, angle).unwrap_or_else(|_| vec![0; rest.len()]);
+    piece_fits(points, &rest, &part, &rest_verts)
 }
 
 /// A candidate extracted from a component ([`extract`]): its inliers and
