@@ -284,9 +284,10 @@ impl Quantization {
                     )
                 };
                 format!(
-                    "the {} coordinates lie on levels {:.4} apart (median), {how}: a depth \
-                     camera's steps; each point is moved within its level (dithered) so that its \
-                     surface, not the step, is seen",
+                    "the {} coordinates lie on levels {:.4} apart (median), {how}: steps of a \
+                     quantization (a depth camera's, or coordinates stored at a coarse scale); \
+                     each point is moved within its level (dithered) so that its surface, not \
+                     the step, is seen",
                     a.name(),
                     a.step,
                 )
