@@ -138,9 +138,45 @@ fn nearest<'a>(claims: impl Iterator<Item = &'a Claim>) -> Option<&'a Claim> {
 /// merge).
 struct Sharing {
     /// The distinct sets (the empty one and sets of one included).
-    sets: Vec<Box<[u32]>>,
+    sets: Sets,
     /// Per point, the index of its set in `sets`.
     at: Vec<u32>,
+}
+
+/// Sets of candidates stored one after another in one buffer: a round
+/// renumbers them all in one pass, with no allocation per set (a point of
+/// a natural terrain's scan has a set of its own: 260,352 sets on PDAL's
+/// `lone-star.laz`).
+#[derive(Default)]
+struct Sets {
+    /// Where each set ends in `items`.
+    ends: Vec<usize>,
+    /// The sets' candidates, set after set.
+    items: Vec<u32>,
+}
+
+impl Sets {
+    /// The number of sets.
+    fn len(&self) -> usize {
+        self.ends.len()
+    }
+
+    /// Set `k`.
+    fn get(&self, k: usize) -> &[u32] {
+        let from = if k == 0 { 0 } else { self.ends[k - 1] };
+        &self.items[from..self.ends[k]]
+    }
+
+    /// Every set, in order.
+    fn iter(&self) -> impl Iterator<Item = &[u32]> + '_ {
+        (0..self.len()).map(|k| self.get(k))
+    }
+
+    /// Appends the set of `candidates`.
+    fn push(&mut self, candidates: impl IntoIterator<Item = u32>) {
+        self.items.extend(candidates);
+        self.ends.push(self.items.len());
+    }
 }
 
 impl Sharing {
@@ -190,7 +226,7 @@ impl Sharing {
             }
         }
         drop(next);
-        let sets: Vec<&[u32]> = shared_sets().map(|s| &s[..]).collect();
+        let sets: Vec<&[u32]> = shared_sets().collect();
         let firsts: Vec<u32> = (0..n as u32).filter(|&a| changed[a as usize]).collect();
         let per = crate::par::map_ranges(
             firsts.len(),
@@ -248,13 +284,12 @@ impl Sharing {
         // order, so each stays sorted (two may become equal, which costs
         // their pairs nothing: `shared_pairs` gives each set's pairs once).
         let mut at = self.at;
-        let mut sets: Vec<Box<[u32]>> = used_in_order(&mut at, self.sets.len())
-            .into_iter()
-            .map(|k| {
-                let old = &self.sets[k as usize];
-                old.iter().filter_map(|&c| kept[c as usize]).collect()
-            })
-            .collect();
+        let mut sets = Sets::default();
+        sets.items.reserve(self.sets.items.len());
+        for k in used_in_order(&mut at, self.sets.len()) {
+            let old = self.sets.get(k as usize);
+            sets.push(old.iter().filter_map(|&c| kept[c as usize]));
+        }
         drop(self.sets);
         // The points the changed candidates claim: their sets, each new set
         // once.
@@ -263,14 +298,14 @@ impl Sharing {
         for here in fresh.chunk_by(|a, b| a.0 == b.0) {
             let p = here[0].0 as usize;
             set.clear();
-            set.extend_from_slice(&sets[at[p] as usize]);
+            set.extend_from_slice(sets.get(at[p] as usize));
             set.extend(here.iter().map(|&(_, c)| c));
             set.sort_unstable();
             at[p] = match ids.get(set.as_slice()) {
                 Some(&k) => k,
                 None => {
                     let k = sets.len() as u32;
-                    sets.push(set.as_slice().into());
+                    sets.push(set.iter().copied());
                     ids.insert(set.as_slice().into(), k);
                     k
                 }
@@ -285,7 +320,7 @@ impl Sharing {
 /// index of its set, from lists of claimed points in candidate order (a
 /// candidate's, or one slice of a candidate's; each point at most once a
 /// candidate): [`Sharing::of`]'s trie. Each list is freed once folded.
-fn distinct_sets(n: usize, lists: Vec<(u32, Vec<u32>)>) -> (Vec<Box<[u32]>>, Vec<u32>) {
+fn distinct_sets(n: usize, lists: Vec<(u32, Vec<u32>)>) -> (Sets, Vec<u32>) {
     const NONE: u32 = u32::MAX;
     // Node 0 is the empty set; a node is (parent, candidate).
     let mut at = vec![0u32; n];
@@ -303,19 +338,17 @@ fn distinct_sets(n: usize, lists: Vec<(u32, Vec<u32>)>) -> (Vec<Box<[u32]>>, Vec
         }
     }
     drop(child);
-    let sets = used_in_order(&mut at, nodes.len())
-        .into_iter()
-        .map(|k| {
-            let mut set = Vec::new();
-            let mut j = k;
-            while j != 0 {
-                set.push(nodes[j as usize].1);
-                j = nodes[j as usize].0;
-            }
-            set.reverse();
-            set.into_boxed_slice()
-        })
-        .collect();
+    let mut sets = Sets::default();
+    let mut set = Vec::new();
+    for k in used_in_order(&mut at, nodes.len()) {
+        set.clear();
+        let mut j = k;
+        while j != 0 {
+            set.push(nodes[j as usize].1);
+            j = nodes[j as usize].0;
+        }
+        sets.push(set.iter().rev().copied());
+    }
     (sets, at)
 }
 
@@ -944,13 +977,13 @@ mod tests {
         }
         let (got_sets, at) = distinct_sets(300, lists);
         for (p, set) in sets.iter().enumerate() {
-            assert_eq!(&*got_sets[at[p] as usize], set.as_slice(), "point {p}");
+            assert_eq!(got_sets.get(at[p] as usize), set.as_slice(), "point {p}");
         }
         let mut want: Vec<Box<[u32]>> = sets.into_iter().map(Vec::into_boxed_slice).collect();
         want.sort_unstable();
         want.dedup();
         assert!(want.len() > 20, "{}", want.len());
-        let mut got = got_sets;
+        let mut got: Vec<Box<[u32]>> = got_sets.iter().map(Box::from).collect();
         let distinct = got.len();
         got.sort_unstable();
         got.dedup();
@@ -1135,7 +1168,7 @@ mod tests {
                 .sets
                 .iter()
                 .filter(|s| s.len() > 1)
-                .cloned()
+                .map(Box::from)
                 .collect();
             got.sort_unstable();
             assert_eq!(got, sets);
@@ -1171,12 +1204,16 @@ mod tests {
             }
             let p_changed = [0.0, 0.1, 0.5, 1.0][trial % 4];
             let changed: Vec<bool> = (0..n).map(|_| rng.uniform() < p_changed).collect();
+            let mut flat = Sets::default();
+            for set in &sets {
+                flat.push(set.iter().copied());
+            }
             let sharing = Sharing {
                 at: vec![0; sets.len()],
-                sets,
+                sets: flat,
             };
             let mut want: Vec<(u32, u32)> = Vec::new();
-            for set in &sharing.sets {
+            for set in sharing.sets.iter() {
                 for (k, &a) in set.iter().enumerate() {
                     for &b in &set[k + 1..] {
                         if changed[a as usize] || changed[b as usize] {
@@ -1232,7 +1269,8 @@ mod tests {
             let fresh = Sharing::of(&cands, &cloud, None);
             for p in 0..pts.len() {
                 assert_eq!(
-                    sharing.sets[sharing.at[p] as usize], fresh.sets[fresh.at[p] as usize],
+                    sharing.sets.get(sharing.at[p] as usize),
+                    fresh.sets.get(fresh.at[p] as usize),
                     "round {rounds}, point {p}"
                 );
             }
