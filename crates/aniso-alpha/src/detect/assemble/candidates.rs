@@ -110,7 +110,9 @@ fn group_components<S: Face>(
 /// Greedy extraction of straight/flat primitives from one connected
 /// component `local` (module doc of `assemble`, step 1): their inlier
 /// vertices (within `tol`) and fits, while the best candidate covers at
-/// least `min_vertices` new vertices.
+/// least `min_vertices` new vertices; then from the pieces of what none
+/// of them covers ([`pieces_of_the_rest`]), the same way, until those
+/// give nothing.
 fn extract<S: Shape>(
     points: &[[f64; 3]],
     local: &[S],
