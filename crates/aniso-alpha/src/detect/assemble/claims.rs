@@ -282,7 +282,7 @@ impl Sharing {
         crate::par::sort_unstable(&mut fresh);
         // The sets some point holds, renumbered: kept candidates keep their
         // order, so each stays sorted (two may become equal, which costs
-        // their pairs nothing: `shared_pairs` gives each set's pairs once).
+        // their pairs nothing: [`Sharing::shared`] gives each pair once).
         let mut at = self.at;
         let mut sets = Sets::default();
         sets.items.reserve(self.sets.items.len());
