@@ -348,11 +348,12 @@ pub fn run_warnings(
             crate::detect::StructureKind::Lines => "the modes were scanned instead".to_string(),
         };
         out.push(format!(
-            "the modes of the cloud explain {:.0}% of its points (under half; {:.0}% look locally \
-             {}), which calls for the scale ladder of sparse structures, but the scale ladder scans \
-             at most {} points (it triangulates them once per rotation of its sampler) and {m} would \
+            "the modes of the cloud explain {:.0}% of {} (under half; {:.0}% look locally {}), \
+             which calls for the scale ladder of sparse structures, but the scale ladder scans at \
+             most {} points (it triangulates them once per rotation of its sampler) and {m} would \
              take it: {instead}; {}, {} and {} give the paper's sampled scan",
             100.0 * e.explained,
+            e.kind.counted_points(),
             100.0 * e.structured,
             e.kind.locally(),
             crate::detect::estimate::LADDER_MAX_POINTS,

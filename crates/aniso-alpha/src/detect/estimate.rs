@@ -1537,7 +1537,7 @@ fn ladder_params(
 ) -> (Param, Param, Param) {
     let alphas: Vec<String> = l.alphas.iter().map(|a| format!("{a:.4}")).collect();
     let why = format!(
-        "scale ladder: the modes of the local {}s explain {:.0}% of the points (under {:.0}%; {:.0}% \
+        "scale ladder: the modes of the local {}s explain {:.0}% of {} (under {:.0}%; {:.0}% \
          are locally {}), so each structure takes the most significant of alpha = {} (reach \
          {C_REACH}·{d:.4}·2^(j/2 - 2), d the median spacing) with lambda {}",
         match kind {
@@ -1545,6 +1545,7 @@ fn ladder_params(
             StructureKind::Lines => "direction",
         },
         100.0 * explained,
+        kind.counted_points(),
         100.0 * EXPLAINED_MIN,
         100.0 * structured,
         kind.locally(),

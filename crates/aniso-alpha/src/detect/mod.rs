@@ -98,4 +98,14 @@ impl StructureKind {
             Self::Planes => "planar",
         }
     }
+
+    /// The points over which the estimate's shares (structure-like,
+    /// explained by the modes) are counted: all of them for planes, those
+    /// not on a surface for lines (the words of the warnings).
+    pub fn counted_points(self) -> &'static str {
+        match self {
+            Self::Lines => "the points not on a surface",
+            Self::Planes => "the points",
+        }
+    }
 }
