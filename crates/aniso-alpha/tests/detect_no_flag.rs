@@ -10,6 +10,24 @@ use aniso_alpha::detect::{Detection, Detector, Given, StructureKind};
 use aniso_alpha::eval::{evaluate, Evaluation};
 use aniso_alpha::synth::{Scene, SceneOptions};
 
+/// Uniform draws in [0, 1) from a 64-bit linear congruential generator
+/// started at `seed`: the same points on every machine.
+fn draws(seed: u64) -> impl FnMut() -> f64 {
+    let mut s = seed;
+    move || {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (s >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// About Gaussian, of deviation 1: a sum of twelve of `next`'s uniform
+/// draws, less 6.
+fn gauss(next: &mut impl FnMut() -> f64) -> f64 {
+    (0..12).map(|_| next()).sum::<f64>() - 6.0
+}
+
 fn run(kind: StructureKind, scene: &Scene) -> (Detector, Detection) {
     let d = Detector::auto(kind, &scene.points, &Given::default()).unwrap();
     let det = d.run(&scene.points).unwrap();
@@ -175,13 +193,7 @@ fn a_large_sparse_cloud_scans_its_modes_and_says_so() {
     use aniso_alpha::detect::estimate::LADDER_MAX_POINTS;
     use aniso_alpha::options::{run_warnings, DetectOptions, Style};
     let n = LADDER_MAX_POINTS + 1000;
-    let mut s = 7u64;
-    let mut next = move || {
-        s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (s >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut next = draws(7u64);
     let pts: Vec<[f64; 3]> = (0..n).map(|_| [next(), next(), next()]).collect();
     let d = Detector::auto(StructureKind::Planes, &pts, &Given::default()).unwrap();
     let e = d.estimate().unwrap();
@@ -335,13 +347,7 @@ fn geodesic(f: usize) -> Vec<[[f64; 3]; 3]> {
 fn dome(n: usize, seed: u64) -> (Vec<[f64; 3]>, Vec<usize>) {
     let tris = geodesic(2);
     assert_eq!(tris.len(), 80);
-    let mut s = seed;
-    let mut next = move || {
-        s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (s >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut next = draws(seed);
     let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
     let cross = |a: [f64; 3], b: [f64; 3]| {
         [
@@ -366,7 +372,7 @@ fn dome(n: usize, seed: u64) -> (Vec<[f64; 3]>, Vec<usize>) {
                 (u, w) = (1.0 - u, 1.0 - w);
             }
             // A sum of uniforms: about Gaussian, of deviation `noise`.
-            let g = (0..12).map(|_| next()).sum::<f64>() - 6.0;
+            let g = gauss(&mut next);
             pts.push([0, 1, 2].map(|i| a[i] + e1[i] * u + e2[i] * w + nv[i] / l * noise * g));
             truth.push(k);
         }
@@ -471,18 +477,12 @@ fn a_dense_cloud_whose_normals_form_no_mode_takes_the_cover_not_the_ladder() {
 /// 2·sin(2πx/100)·sin(2πy/120) (tilts of 7° at most) with noise of
 /// deviation 0.01.
 fn undulating_ground(n: usize, seed: u64) -> Vec<[f64; 3]> {
-    let mut s = seed;
-    let mut next = move || {
-        s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (s >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut next = draws(seed);
     let tau = std::f64::consts::TAU;
     (0..n)
         .map(|_| {
             let (x, y) = (120.0 * next(), 120.0 * next());
-            let g = (0..12).map(|_| next()).sum::<f64>() - 6.0;
+            let g = gauss(&mut next);
             let z = 2.0 * (tau * x / 100.0).sin() * (tau * y / 120.0).sin() + 0.01 * g;
             [x, y, z]
         })
