@@ -327,15 +327,9 @@ pub fn run_warnings(
         };
         out.push(format!("{lead}: {}", g.ignored_reason()));
     }
-    // Most structure-like points in no mode: the normals spread without
-    // peaks, and the cover, not the ladder, is what the cloud calls for
-    // at any size (docs/method.md §8, "the cover").
-    let spread = |e: &crate::detect::estimate::Estimate| {
-        e.modes.iter().any(|m| m.cover) && e.explained < e.structured / 2.0
-    };
     if let Some((e, m)) = detector
         .estimate()
-        .filter(|e| !spread(e))
+        .filter(|e| !e.normals_spread())
         .and_then(|e| e.ladder_declined.map(|m| (e, m)))
     {
         let cover = e.modes.iter().filter(|m| m.cover).count();
@@ -364,7 +358,7 @@ pub fn run_warnings(
     }
     if let Some(e) = detector
         .estimate()
-        .filter(|e| e.ladder_declined.is_none() || spread(e))
+        .filter(|e| e.ladder_declined.is_none() || e.normals_spread())
     {
         let cover = e.modes.iter().filter(|m| m.cover).count();
         if cover > 0 {

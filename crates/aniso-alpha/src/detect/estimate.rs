@@ -269,6 +269,22 @@ pub struct Estimate {
     pub ladder_declined: Option<usize>,
 }
 
+impl Estimate {
+    /// Whether the cover scans this cloud because its normals spread
+    /// without peaks (most structure-like points in no mode), which calls
+    /// for the cover at any size, rather than standing in for a ladder
+    /// the cloud is too large for.
+    pub fn normals_spread(&self) -> bool {
+        self.modes.iter().any(|m| m.cover) && spread_without_peaks(self.explained, self.structured)
+    }
+}
+
+/// Whether the modes explain less than half the structure-like share:
+/// most structure-like points are in no mode.
+fn spread_without_peaks(explained: f64, structured: f64) -> bool {
+    explained < structured / 2.0
+}
+
 /// The scales of a run whose structures are sparse against their
 /// background (module doc, step 6): a sampler's orientations over the
 /// points, at each of several α with one elongation, every level
@@ -931,7 +947,7 @@ fn estimate_with(
     let covered = kind == StructureKind::Planes
         && sparse
         && structured >= EXPLAINED_MIN
-        && (can_be > LADDER_MAX_POINTS || explained < structured / 2.0);
+        && (can_be > LADDER_MAX_POINTS || spread_without_peaks(explained, structured));
     let ladder_declined = (sparse && can_be > LADDER_MAX_POINTS).then_some(can_be);
     let ladder = (sparse && !covered && ladder_declined.is_none()).then(|| {
         ladder(
