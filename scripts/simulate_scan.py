@@ -7,6 +7,7 @@ range, outliers), with per-point ground truth.
     python3 scripts/simulate_scan.py house  --seed 1 --output house.xyz
     python3 scripts/simulate_scan.py halls  --seed 1 --output halls.xyz
     python3 scripts/simulate_scan.py street --seed 1 --output street.xyz
+    python3 scripts/simulate_scan.py avenue --seed 1 --output avenue.xyz
 
 Writes `x y z label` per line (label -1 = clutter/outlier, otherwise the
 id of the planar surface, or of the pole/cable for `street`), and prints a
@@ -41,6 +42,14 @@ Scenes (dimensions in metres):
           each with a crossbar), cables sagging between their tops, a
           facade and the ground, scanned from two stations; labels are the
           line structures (pole, crossbar, cable); planes are -1.
+  avenue  the street's targets among a street's clutter, scanned from
+          three stations at a mapping car's height: lamp posts with an
+          arm, utility poles with a crossbar and sagging cables, sign
+          posts with their plate, trees (a trunk, branches and a crown
+          of 10-20 cm leaves at random orientations), parked cars, and
+          two facades with window recesses; labels are the line targets
+          (pole, arm, crossbar, cable, sign post); trees, plates, cars,
+          facades and the ground are -1.
 
 Scanner: rays on an azimuth x elevation grid (0.1 to 0.2 degree steps,
 jittered), first hit, Gaussian noise along the ray; points beyond 60 m
@@ -385,16 +394,91 @@ def street(rng):
     return pts, labels
 
 
+def _tree(s, rng, base, label):
+    """A tree as a mapping scan sees it: a trunk, a few branches from its
+    top, and a crown of small leaves (triangles 10-20 cm across at random
+    orientations) filling an ellipsoid, all labelled `label`."""
+    base = np.asarray(base, float)
+    h = rng.uniform(2.2, 3.5)
+    top = base + [0, 0, h]
+    s.cylinder(base, top, rng.uniform(0.12, 0.25), label, segments=12)
+    rx, rz = rng.uniform(1.8, 2.8), rng.uniform(2.0, 3.0)
+    centre = top + [0, 0, 0.7 * rz]
+    for _ in range(int(rng.integers(3, 6))):
+        d = rng.normal(0, 1, 3) * [1, 1, 0.6] + [0, 0, 0.8]
+        d /= np.linalg.norm(d)
+        s.cylinder(top, top + d * rng.uniform(1.0, 2.0), rng.uniform(0.03, 0.07), label, segments=8)
+    k = int(3000 * rx * rx * rz / 16)
+    u = rng.normal(0, 1, (k, 3))
+    u /= np.linalg.norm(u, axis=1)[:, None]
+    c = centre + u * rng.uniform(0, 1, (k, 1)) ** (1 / 3) * [rx, rx, rz]
+    for p in c:
+        e = rng.normal(0, 1, (2, 3))
+        size = rng.uniform(0.1, 0.2)
+        a, b = e[0] / np.linalg.norm(e[0]) * size, e[1] / np.linalg.norm(e[1]) * size
+        s.tri(p, p + a, p + 0.5 * (a + b), label)
+
+
+def avenue(rng):
+    s = Scene()
+    lab = 0
+    clutter = 10000                                                     # relabelled -1 below
+    s.quad([-45, -12, 0], [90, 0, 0], [0, 26, 0], clutter)                   # road and walkways
+    for y, n in [(-12, 1), (14, -1)]:                                   # facades with window recesses
+        win = [(x0, x0 + 0.025, 0.25, 0.45) for x0 in np.arange(0.03, 0.97, 0.06)]
+        win += [(x0, x0 + 0.025, 0.6, 0.8) for x0 in np.arange(0.03, 0.97, 0.06)]
+        s.quad([-45, y, 0], [90, 0, 0], [0, 0, 10], clutter, holes=win)
+        for h in win:
+            p0 = np.array([-45 + 90 * h[0], y - 0.25 * n, 10 * h[2]])
+            s.quad(p0, [90 * (h[1] - h[0]), 0, 0], [0, 0, 10 * (h[3] - h[2])], clutter)
+    # Lamp posts on the south walkway, each with an arm over the road.
+    for x in np.linspace(-30, 30, 4) + rng.uniform(-3, 3, 4):
+        h = rng.uniform(6, 9)
+        s.cylinder([x, -7.5, 0], [x, -7.5, h], rng.uniform(0.07, 0.14), lab); lab += 1
+        tilt = rng.uniform(0, 0.4)
+        s.cylinder([x, -7.5, h - 0.3], [x, -7.5 + rng.uniform(1.2, 2.2), h - 0.3 + tilt], 0.05, lab); lab += 1
+    # Utility poles on the north walkway, crossbars, cables between their tops.
+    tops = []
+    for x in np.linspace(-32, 32, 4) + rng.uniform(-2, 2, 4):
+        h = rng.uniform(7, 9)
+        s.cylinder([x, 9, 0], [x, 9, h], rng.uniform(0.1, 0.16), lab); lab += 1
+        s.cylinder([x, 8.2, h - 0.5], [x, 9.8, h - 0.5], 0.05, lab); lab += 1
+        tops.append([x, 9.7, h - 0.45])
+    for a, b in zip(tops[:-1], tops[1:]):
+        a, b = np.array(a), np.array(b)
+        k = 12
+        for i in range(k):
+            t0, t1 = i / k, (i + 1) / k
+            p = a + t0 * (b - a) - [0, 0, 2.4 * t0 * (1 - t0)]
+            q = a + t1 * (b - a) - [0, 0, 2.4 * t1 * (1 - t1)]
+            s.cylinder(p, q, 0.015, lab, segments=8)
+        lab += 1
+    # Sign posts with a plate (the plate is clutter).
+    for x, y in [(rng.uniform(-38, -20), -8.5), (rng.uniform(-5, 5), 10.0), (rng.uniform(20, 38), -8.5)]:
+        s.cylinder([x, y, 0], [x, y, 2.8], 0.035, lab); lab += 1
+        s.quad([x - 0.3, y + 0.06, 2.2], [0.6, 0, 0], [0, 0, 0.6], clutter)
+    # Trees on both walkways, between the posts.
+    for x in np.linspace(-36, 36, 7) + rng.uniform(-2, 2, 7):
+        _tree(s, rng, [x, -9.5 if rng.uniform() < 0.5 else 11.0, 0], clutter)
+    # Parked cars along both kerbs.
+    for x in rng.uniform(-40, 36, 5):
+        y = -6 if rng.uniform() < 0.5 else 6.2
+        s.box([x, y - 0.9, 0.3], [x + 4.3, y + 0.9, 1.0], clutter)
+        s.box([x + 1.1, y - 0.8, 1.0], [x + 3.2, y + 0.8, 1.5], clutter)
+    pts, labels = scan(s, [[-20, -2, 2.2], [0, 2, 2.2], [20, -2, 2.2]], rng, 0.07, 0.01, elev=(-60, 70))
+    return pts, np.where(labels >= clutter, -1, labels)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("scene", choices=["room", "house", "airborne", "halls", "street"])
+    ap.add_argument("scene", choices=["room", "house", "airborne", "halls", "street", "avenue"])
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--output", required=True)
     ap.add_argument("--strips", type=int, default=1, help="airborne: overlapping flight strips (default 1)")
     a = ap.parse_args()
     rng = np.random.default_rng(a.seed)
     scenes = {"room": room, "house": house, "airborne": lambda r: airborne(r, a.strips),
-              "halls": lambda r: halls(r, a.strips), "street": street}
+              "halls": lambda r: halls(r, a.strips), "street": street, "avenue": avenue}
     pts, labels = scenes[a.scene](rng)
     # Shuffle (scanner order would make every neighbour query trivial).
     perm = rng.permutation(len(pts))

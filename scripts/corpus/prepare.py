@@ -291,8 +291,9 @@ def _read_ascii_ply(path):
 
 def prepare_sim(scan):
     """scripts/simulate_scan.py output (x y z label), one point per voxel.
-    room/house: the label is the plane; street: the label is the line
-    structure (pole, crossbar, cable), and its planes are unlabelled."""
+    room/house: the label is the plane; street and avenue: the label is the
+    line structure (pole, arm, crossbar, cable, sign post), and their
+    planes are unlabelled."""
     a = np.loadtxt(raw_path(scan))
     a = a[voxel_first(a[:, :3], scan["prepare"]["voxel"])]
     if "crop" in scan["prepare"]:
@@ -300,7 +301,7 @@ def prepare_sim(scan):
         a = a[np.all((a[:, :3] >= lo) & (a[:, :3] <= hi), axis=1)]
     xyz, lab = a[:, :3], a[:, 3].astype(np.int32)
     none = -np.ones(len(xyz), np.int32)
-    if scan["source"]["scene"] == "street":
+    if scan["source"]["scene"] in ("street", "avenue"):
         return xyz, none, lab, (lab >= 0).astype(np.int32), None
     return xyz, lab, none, (lab >= 0).astype(np.int32), None
 
