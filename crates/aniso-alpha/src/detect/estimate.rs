@@ -13,7 +13,7 @@
 //!    structure (noise), its spacing (distance to the nearest point), and
 //!    a score (planarity or linearity). Points scoring at least
 //!    [`SCORE_MIN`] are *structure-like*. For lines, the points of
-//!    surfaces ([`surface_points`]: as planar at their most planar scale
+//!    surfaces ([`super::local::on_surface`]: as planar at their most planar scale
 //!    as they are linear at their most linear one) are left out of
 //!    everything below: for lines they are background.
 //! 2. **Modes** ([`super::modes`]): the dominant axes of the
@@ -113,7 +113,7 @@
 //! given, no ladder.
 
 use super::detection::{distinct_count, position_key};
-use super::local::{local_shapes, LocalShape, SCORE_MIN};
+use super::local::{line_shapes_on_surfaces, local_shapes, LocalShape, SCORE_MIN};
 use super::modes::{modes, Mode};
 use super::StructureKind;
 use crate::aniso::{completion_first_row, completion_third_row, Mat3};
@@ -651,12 +651,20 @@ pub fn estimate_oriented(
     given: &Given,
     m2: u32,
 ) -> (Estimate, Option<GivenNormals>) {
-    let mut shapes = shapes_for(points, kind);
-    let (StructureKind::Planes, Some(normals)) = (kind, normals) else {
-        let surface = (kind == StructureKind::Lines)
-            .then(|| surface_points(&shapes, &shapes_for(points, StructureKind::Planes)));
+    if kind == StructureKind::Lines {
+        let (shapes, surface): (Vec<LocalShape>, Vec<bool>) =
+            shapes_for(points, line_shapes_on_surfaces)
+                .into_iter()
+                .unzip();
         return (
-            estimate_with(kind, points, &shapes, surface.as_deref(), given, m2, None),
+            estimate_with(kind, points, &shapes, Some(&surface), given, m2, None),
+            None,
+        );
+    }
+    let mut shapes = shapes_for(points, |p| local_shapes(p, kind));
+    let Some(normals) = normals else {
+        return (
+            estimate_with(kind, points, &shapes, None, given, m2, None),
             None,
         );
     };
@@ -707,7 +715,10 @@ pub fn estimate_oriented(
 /// `points`: the check of [`estimate_oriented`], for normals given to a
 /// detector with explicit parameters.
 pub(crate) fn check_normals_agreement(points: &[[f64; 3]], normals: &[[f32; 3]]) -> GivenNormals {
-    normals_agreement(&shapes_for(points, StructureKind::Planes), normals)
+    normals_agreement(
+        &shapes_for(points, |p| local_shapes(p, StructureKind::Planes)),
+        normals,
+    )
 }
 
 /// Of the locally planar points (planarity ≥ [`SCORE_MIN`]) with a usable
@@ -800,27 +811,10 @@ fn mode_search(
     }
 }
 
-/// The points of surfaces, for lines: a point whose neighbourhood, at the
-/// scale where it looks most planar, is planar (planarity ≥ [`SCORE_MIN`])
-/// and at least as planar as it is linear at the scale where it looks most
-/// linear. The local "direction" of a wall's or the ground's point is any
-/// direction in its plane: left among the line directions, such points
-/// fill every cone, so that no mode of the true lines' directions stands
-/// out (a simulated street of 895k points: 0 modes), or their weakly
-/// linear coarse neighbourhoods (linearity ≈ 0.55, planarity ≈ 0.85) make
-/// lines of their own. A pole or a cable is more linear than planar at its
-/// best scales (linearity 0.78–0.93, planarity 0.3–0.7 on that street).
-pub fn surface_points(line_shapes: &[LocalShape], plane_shapes: &[LocalShape]) -> Vec<bool> {
-    line_shapes
-        .iter()
-        .zip(plane_shapes)
-        .map(|(l, p)| p.planarity() >= SCORE_MIN && p.planarity() >= l.linearity())
-        .collect()
-}
-
-/// [`local_shapes`], or for a cloud whose points all sit on copies of
-/// themselves (no neighbour at a non-zero distance), those of its distinct
-/// points ([`shapes_of_distinct`]).
+/// The local analysis `shapes_of` ([`local_shapes`] for one kind,
+/// [`line_shapes_on_surfaces`] for lines), or for a cloud whose points all
+/// sit on copies of themselves (no neighbour at a non-zero distance), that
+/// of its distinct points ([`shapes_of_distinct`]).
 ///
 /// The distinct points are also taken at once when the copies are so many
 /// that the mean number of copies per position reaches the neighbourhood's
@@ -829,25 +823,48 @@ pub fn surface_points(line_shapes: &[LocalShape], plane_shapes: &[LocalShape]) -
 /// of them (issue 19: 10M points made of 1,000 positions took over 100 s).
 /// A cloud with fewer copies keeps each copy's weight in its neighbours'
 /// neighbourhoods, as before.
-fn shapes_for(points: &[[f64; 3]], kind: StructureKind) -> Vec<LocalShape> {
+fn shapes_for<T: HasShape>(
+    points: &[[f64; 3]],
+    shapes_of: impl Fn(&[[f64; 3]]) -> Vec<T>,
+) -> Vec<T> {
     if distinct_count(points) * super::local::NEIGHBOURS <= points.len() {
-        if let Some(shapes) = shapes_of_distinct(points, kind) {
+        if let Some(shapes) = shapes_of_distinct(points, &shapes_of) {
             return shapes;
         }
     }
-    let shapes = local_shapes(points, kind);
-    if !shapes.iter().any(|s| s.spacing.is_finite()) {
-        return shapes_of_distinct(points, kind).unwrap_or(shapes);
+    let shapes = shapes_of(points);
+    if !shapes.iter().any(|s| s.shape().spacing.is_finite()) {
+        return shapes_of_distinct(points, &shapes_of).unwrap_or(shapes);
     }
     shapes
 }
 
-/// The local shapes of the distinct points of `points`, each copy taking
-/// its position's; `None` when every point is distinct. For a cloud made
-/// of copies of few points, every point with as many copies as the
-/// neighbourhood holds: no neighbour at a non-zero distance, so no spacing
-/// (and α, λ would be NaN) without this.
-fn shapes_of_distinct(points: &[[f64; 3]], kind: StructureKind) -> Option<Vec<LocalShape>> {
+/// A per-point result of the local analysis that holds the point's shape.
+trait HasShape: Copy {
+    fn shape(&self) -> &LocalShape;
+}
+
+impl HasShape for LocalShape {
+    fn shape(&self) -> &LocalShape {
+        self
+    }
+}
+
+impl HasShape for (LocalShape, bool) {
+    fn shape(&self) -> &LocalShape {
+        &self.0
+    }
+}
+
+/// The local analysis `shapes_of` of the distinct points of `points`, each
+/// copy taking its position's; `None` when every point is distinct. For a
+/// cloud made of copies of few points, every point with as many copies as
+/// the neighbourhood holds: no neighbour at a non-zero distance, so no
+/// spacing (and α, λ would be NaN) without this.
+fn shapes_of_distinct<T: HasShape>(
+    points: &[[f64; 3]],
+    shapes_of: impl Fn(&[[f64; 3]]) -> Vec<T>,
+) -> Option<Vec<T>> {
     let key = position_key;
     let mut order: Vec<u32> = (0..points.len() as u32).collect();
     order.sort_unstable_by_key(|&i| key(&points[i as usize]));
@@ -863,7 +880,7 @@ fn shapes_of_distinct(points: &[[f64; 3]], kind: StructureKind) -> Option<Vec<Lo
     if distinct.len() == points.len() {
         return None;
     }
-    let shapes = local_shapes(&distinct, kind);
+    let shapes = shapes_of(&distinct);
     Some(of.iter().map(|&d| shapes[d as usize]).collect())
 }
 
@@ -879,7 +896,7 @@ pub fn estimate_from(
 }
 
 /// [`estimate_from`], leaving out the points flagged in `surface` (for
-/// lines: [`surface_points`]) from the structure-like points, the modes and
+/// lines: [`super::local::on_surface`]) from the structure-like points, the modes and
 /// their members.
 fn estimate_with(
     kind: StructureKind,
