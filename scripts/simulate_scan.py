@@ -366,6 +366,18 @@ def halls(rng, strips=1):
     return _fly(rng, s, size, along, across, strips, trees=6, tree_points=(300, 800))
 
 
+def _cable(s, a, b, label):
+    """A cable from `a` to `b` sagging 0.6 m, as 12 straight cylinders 1.5
+    cm in radius, all labelled `label`."""
+    a, b = np.array(a), np.array(b)
+    k = 12
+    for i in range(k):
+        t0, t1 = i / k, (i + 1) / k
+        p = a + t0 * (b - a) - [0, 0, 2.4 * t0 * (1 - t0)]
+        q = a + t1 * (b - a) - [0, 0, 2.4 * t1 * (1 - t1)]
+        s.cylinder(p, q, 0.015, label, segments=8)
+
+
 def street(rng):
     s = Scene()
     lab = 0
@@ -380,15 +392,7 @@ def street(rng):
         s.cylinder([x, -0.8, h - 0.5], [x, 0.8, h - 0.5], 0.05, lab); lab += 1  # crossbar
         tops.append([x, 0.7, h - 0.45])
     for a, b in zip(tops[:-1], tops[1:]):
-        a, b = np.array(a), np.array(b)
-        # A cable sagging 0.6 m, as 12 straight cylinders (one label).
-        k = 12
-        for i in range(k):
-            t0, t1 = i / k, (i + 1) / k
-            p = a + t0 * (b - a) - [0, 0, 2.4 * t0 * (1 - t0)]
-            q = a + t1 * (b - a) - [0, 0, 2.4 * t1 * (1 - t1)]
-            s.cylinder(p, q, 0.015, lab, segments=8)
-        lab += 1
+        _cable(s, a, b, lab); lab += 1
     pts, labels = scan(s, [[-10, -5, 1.8], [12, -5, 1.8]], rng, 0.06, 0.005, elev=(-60, 70))
     labels = np.where(labels >= 1000, -1, labels)
     return pts, labels
@@ -445,14 +449,7 @@ def avenue(rng):
         s.cylinder([x, 8.2, h - 0.5], [x, 9.8, h - 0.5], 0.05, lab); lab += 1
         tops.append([x, 9.7, h - 0.45])
     for a, b in zip(tops[:-1], tops[1:]):
-        a, b = np.array(a), np.array(b)
-        k = 12
-        for i in range(k):
-            t0, t1 = i / k, (i + 1) / k
-            p = a + t0 * (b - a) - [0, 0, 2.4 * t0 * (1 - t0)]
-            q = a + t1 * (b - a) - [0, 0, 2.4 * t1 * (1 - t1)]
-            s.cylinder(p, q, 0.015, lab, segments=8)
-        lab += 1
+        _cable(s, a, b, lab); lab += 1
     # Sign posts with a plate (the plate is clutter).
     for x, y in [(rng.uniform(-38, -20), -8.5), (rng.uniform(-5, 5), 10.0), (rng.uniform(20, 38), -8.5)]:
         s.cylinder([x, y, 0], [x, y, 2.8], 0.035, lab); lab += 1
