@@ -256,15 +256,9 @@ pub(crate) fn any_orthogonal(u: [f64; 3]) -> [f64; 3] {
     c.map(|x| x / n)
 }
 
-/// Principal standard deviations (descending) and axes (rows, matching) of
-/// the points `ids`.
-fn pca(points: &[[f64; 3]], ids: &[(f64, u32)]) -> ([f64; 3], [[f64; 3]; 3]) {
-    let (sigma, axes, _) = pca_centred(points, ids);
-    (sigma, axes)
-}
-
-/// [`pca`] and the neighbourhood's centroid.
-fn pca_centred(points: &[[f64; 3]], ids: &[(f64, u32)]) -> ([f64; 3], [[f64; 3]; 3], [f64; 3]) {
+/// Principal standard deviations (descending), axes (rows, matching) and
+/// centroid of the points `ids`.
+fn pca(points: &[[f64; 3]], ids: &[(f64, u32)]) -> ([f64; 3], [[f64; 3]; 3], [f64; 3]) {
     let (c, m) = super::fit::moments(ids.len(), |k| points[ids[k].1 as usize]);
     let (vals, vecs) = eigen_sym3(m);
     (vals.map(|v| v.max(0.0).sqrt()), vecs, c)
@@ -322,7 +316,7 @@ fn put_back<T: Copy>(found: Vec<T>, order: &[u32], slot: impl Fn(u32) -> Option<
 
 /// The shape of the neighbourhood `nb` (at least 3 points).
 fn shape_of(points: &[[f64; 3]], nb: &[(f64, u32)], scale: usize, spacing: f32) -> LocalShape {
-    let (sigma, axes) = pca(points, nb);
+    let (sigma, axes, _) = pca(points, nb);
     shape_from(sigma, axes, scale, spacing)
 }
 
@@ -501,7 +495,7 @@ fn local_shapes_by<T: Copy + Send>(
         let tree = &trees[j];
         let analysed = in_input_order(tree, tree, ids, |batch, nb, t| {
             batch.nearest(t, NEIGHBOURS, nb);
-            let (sigma, axes, c) = pca_centred(points, nb);
+            let (sigma, axes, c) = pca(points, nb);
             (shape_from(sigma, axes, j, f32::INFINITY), c)
         });
         coarse.push(analysed.iter().map(|a| a.0).collect());
