@@ -8,6 +8,7 @@ range, outliers), with per-point ground truth.
     python3 scripts/simulate_scan.py halls  --seed 1 --output halls.xyz
     python3 scripts/simulate_scan.py street --seed 1 --output street.xyz
     python3 scripts/simulate_scan.py avenue --seed 1 --output avenue.xyz
+    python3 scripts/simulate_scan.py object --mesh anchor.off --seed 1 --output anchor.xyz
 
 Writes `x y z label` per line (label -1 = clutter/outlier, otherwise the
 id of the planar surface, or of the pole/cable for `street`), and prints a
@@ -50,6 +51,15 @@ Scenes (dimensions in metres):
           two facades with window recesses; labels are the line targets
           (pole, arm, crossbar, cable, sign post); trees, plates, cars,
           facades and the ground are -1.
+  object  a mechanical part (an OFF mesh, e.g. CGAL's demo meshes
+          anchor.off, cross.off, fandisk.off) scaled to a 0.3 m diagonal
+          and turned at random, scanned from eight stations 0.8 m away
+          around it (elevations -20 to 70 degrees, 0.07 degree steps,
+          rays only towards the object); range noise 0.3 mm; labels are
+          its planar faces (triangles joined across shared edges while
+          within 1 degree and 0.1% of the diagonal of the seed's plane)
+          of at least 1% of its area; curved surfaces and smaller facets
+          are -1.
 
 Scanner: rays on an azimuth x elevation grid (0.1 to 0.2 degree steps,
 jittered), first hit, Gaussian noise along the ray; points beyond 60 m
@@ -130,7 +140,10 @@ class Scene:
         return np.array(self.v, float), np.array(self.t, np.int64), np.array(self.lab, np.int64)
 
 
-def scan(scene, stations, rng, step_deg, noise, max_range=60.0, elev=(-80, 85)):
+def scan(scene, stations, rng, step_deg, noise, max_range=60.0, elev=(-80, 85), aim=None):
+    """Rays from each station on an azimuth x elevation grid of `step_deg`
+    (all around, within `elev`; or, with `aim` = (centre, radius), over the
+    cone that holds that sphere), first hit, Gaussian range noise."""
     import open3d as o3d
 
     v, t, lab = scene.arrays()
@@ -138,8 +151,17 @@ def scan(scene, stations, rng, step_deg, noise, max_range=60.0, elev=(-80, 85)):
     rs.add_triangles(o3d.core.Tensor(v.astype(np.float32)), o3d.core.Tensor(t.astype(np.uint32)))
     pts, labels = [], []
     for s in stations:
-        az = np.arange(0, 360, step_deg)
-        el = np.arange(elev[0], elev[1], step_deg)
+        if aim is None:
+            az = np.arange(0, 360, step_deg)
+            el = np.arange(elev[0], elev[1], step_deg)
+        else:
+            w = np.asarray(aim[0], float) - np.asarray(s, float)
+            dist = np.linalg.norm(w)
+            az0, el0 = np.degrees(np.arctan2(w[1], w[0])), np.degrees(np.arcsin(w[2] / dist))
+            h = np.degrees(np.arcsin(min(1.0, aim[1] / dist)))
+            ha = min(180.0, h / max(np.cos(np.radians(el0)), 1e-6))
+            az = np.arange(az0 - ha, az0 + ha, step_deg)
+            el = np.arange(el0 - h, el0 + h, step_deg)
         A, E = np.meshgrid(np.radians(az), np.radians(el))
         A = A + rng.normal(0, np.radians(step_deg) * 0.05, A.shape)
         E = E + rng.normal(0, np.radians(step_deg) * 0.05, E.shape)
@@ -466,16 +488,95 @@ def avenue(rng):
     return pts, np.where(labels >= clutter, -1, labels)
 
 
+def read_off(path):
+    """The vertices and triangles of an OFF mesh (polygons fanned)."""
+    with open(path) as f:
+        rows = [ln.split() for ln in f if ln.strip() and not ln.lstrip().startswith("#")]
+    if rows[0][0] != "OFF":
+        raise SystemExit(f"{path}: not an OFF file")
+    head = rows[0][1:] if len(rows[0]) > 1 else rows.pop(1)
+    nv, nf = int(head[0]), int(head[1])
+    v = np.array([[float(x) for x in r[:3]] for r in rows[1:1 + nv]])
+    tris = []
+    for r in rows[1 + nv:1 + nv + nf]:
+        idx = [int(x) for x in r[1:1 + int(r[0])]]
+        tris += [[idx[0], idx[j], idx[j + 1]] for j in range(1, len(idx) - 1)]
+    return v, np.array(tris, np.int64)
+
+
+def planar_groups(v, t, angle_deg=1.0, tol=1e-3):
+    """Each triangle's planar face: triangles joined across shared edges
+    while their normal is within `angle_deg` of the seed's and their
+    vertices within `tol` x the mesh's diagonal of the seed's plane, seeds
+    taken by decreasing area. Returns (group per triangle, triangle areas)."""
+    a, b, c = v[t[:, 0]], v[t[:, 1]], v[t[:, 2]]
+    n = np.cross(b - a, c - a)
+    area = 0.5 * np.linalg.norm(n, axis=1)
+    n = n / np.maximum(2 * area, 1e-300)[:, None]
+    tol *= np.linalg.norm(np.ptp(v, axis=0))
+    by_edge = {}
+    for i, tri in enumerate(t):
+        for e in ((tri[0], tri[1]), (tri[1], tri[2]), (tri[2], tri[0])):
+            by_edge.setdefault((min(e), max(e)), []).append(i)
+    near = [[] for _ in t]
+    for fs in by_edge.values():
+        for i in fs:
+            near[i] += [j for j in fs if j != i]
+    group = -np.ones(len(t), np.int64)
+    cos = np.cos(np.radians(angle_deg))
+    k = 0
+    for seed in np.argsort(-area, kind="stable"):
+        if group[seed] >= 0 or area[seed] == 0:
+            continue
+        ns, d0 = n[seed], n[seed] @ a[seed]
+        group[seed], todo = k, [seed]
+        while todo:
+            for j in near[todo.pop()]:
+                if group[j] < 0 and abs(n[j] @ ns) >= cos and np.abs(v[t[j]] @ ns - d0).max() <= tol:
+                    group[j] = k
+                    todo.append(j)
+        k += 1
+    return group, area
+
+
+def scanned_object(rng, mesh):
+    """A mechanical part (an OFF mesh) scanned as a desktop scanner does:
+    scaled to a 0.3 m diagonal and turned at random, seen from eight
+    stations 0.8 m away around it at elevations from -20 to 70 degrees;
+    its planar faces of at least 1% of its area are the planes, the rest
+    (curved surfaces, small facets) unlabelled."""
+    v, t = read_off(mesh)
+    v = v - 0.5 * (v.min(axis=0) + v.max(axis=0))
+    v *= 0.3 / np.linalg.norm(np.ptp(v, axis=0))
+    q, r = np.linalg.qr(rng.normal(size=(3, 3)))
+    v = v @ (q * np.sign(np.diag(r))).T
+    group, area = planar_groups(v, t)
+    share = np.bincount(group, weights=area) / area.sum()
+    big = np.flatnonzero(share >= 0.01)
+    label = np.full(len(share), -1, np.int64)
+    label[big] = np.arange(len(big))
+    s = Scene()
+    s.v, s.t, s.lab, s.n = list(v), [list(x) for x in t], list(label[group]), len(v)
+    radius = np.linalg.norm(v, axis=1).max()
+    stations = []
+    for k, el in enumerate([-20, 10, 40, 70] * 2):
+        az, el = np.radians(45 * k + rng.uniform(-10, 10)), np.radians(el + rng.uniform(-5, 5))
+        stations.append(0.8 * np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)]))
+    return scan(s, stations, rng, 0.07, 0.0003, max_range=2.0, aim=([0, 0, 0], radius))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("scene", choices=["room", "house", "airborne", "halls", "street", "avenue"])
+    ap.add_argument("scene", choices=["room", "house", "airborne", "halls", "street", "avenue", "object"])
+    ap.add_argument("--mesh", help="object: the OFF mesh to scan")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--output", required=True)
     ap.add_argument("--strips", type=int, default=1, help="airborne: overlapping flight strips (default 1)")
     a = ap.parse_args()
     rng = np.random.default_rng(a.seed)
     scenes = {"room": room, "house": house, "airborne": lambda r: airborne(r, a.strips),
-              "halls": lambda r: halls(r, a.strips), "street": street, "avenue": avenue}
+              "halls": lambda r: halls(r, a.strips), "street": street, "avenue": avenue,
+              "object": lambda r: scanned_object(r, a.mesh)}
     pts, labels = scenes[a.scene](rng)
     # Shuffle (scanner order would make every neighbour query trivial).
     perm = rng.permutation(len(pts))

@@ -61,24 +61,36 @@ def acquire(scan):
         with open(dst, "wb") as f:
             f.write(blob)
     elif src["type"] == "debian":
-        deb_dir = os.path.join(RAW, "debian")
-        os.makedirs(deb_dir, exist_ok=True)
-        deb = os.path.join(deb_dir, f"{src['package']}_{src['version']}_all.deb")
-        if not os.path.exists(deb):
-            subprocess.run(["apt-get", "download", f"{src['package']}={src['version']}"], cwd=deb_dir,
-                           check=True)
-        unpacked = os.path.join(deb_dir, src["package"])
-        if not os.path.isdir(unpacked):
-            subprocess.run(["dpkg-deb", "-x", deb, unpacked], check=True)
-        archive, member = src["path"].split(":")
-        with tarfile.open(os.path.join(unpacked, archive)) as t:
-            with t.extractfile(member) as fin, open(dst, "wb") as fout:
-                shutil.copyfileobj(fin, fout)
+        from_debian(src, dst)
     elif src["type"] == "simulated":
+        extra = []
+        if "mesh" in src:
+            mesh = os.path.join(RAW, src["mesh"]["raw"])
+            if not os.path.exists(mesh):
+                os.makedirs(os.path.dirname(mesh), exist_ok=True)
+                from_debian(src["mesh"], mesh)
+            extra = ["--mesh", mesh]
         subprocess.run([sys.executable, os.path.join(ROOT, src["script"]), src["scene"], "--seed",
-                        str(src["seed"]), "--output", dst], check=True, capture_output=True)
+                        str(src["seed"]), "--output", dst, *extra], check=True, capture_output=True)
     else:
         raise SystemExit(f"{scan['name']}: unknown source type {src['type']}")
+
+
+def from_debian(src, dst):
+    """Extracts `src["path"]` (archive:member) of a Debian package to `dst`."""
+    deb_dir = os.path.join(RAW, "debian")
+    os.makedirs(deb_dir, exist_ok=True)
+    deb = os.path.join(deb_dir, f"{src['package']}_{src['version']}_all.deb")
+    if not os.path.exists(deb):
+        subprocess.run(["apt-get", "download", f"{src['package']}={src['version']}"], cwd=deb_dir,
+                       check=True)
+    unpacked = os.path.join(deb_dir, src["package"])
+    if not os.path.isdir(unpacked):
+        subprocess.run(["dpkg-deb", "-x", deb, unpacked], check=True)
+    archive, member = src["path"].split(":")
+    with tarfile.open(os.path.join(unpacked, archive)) as t:
+        with t.extractfile(member) as fin, open(dst, "wb") as fout:
+            shutil.copyfileobj(fin, fout)
 
 
 # ---------------------------------------------------------------- geometry helpers
@@ -291,7 +303,7 @@ def _read_ascii_ply(path):
 
 def prepare_sim(scan):
     """scripts/simulate_scan.py output (x y z label), one point per voxel.
-    room/house: the label is the plane; street and avenue: the label is the
+    room/house/object: the label is the plane; street and avenue: the label is the
     line structure (pole, arm, crossbar, cable, sign post), and their
     planes are unlabelled."""
     a = np.loadtxt(raw_path(scan))
