@@ -527,3 +527,100 @@ fn undulating_ground_is_covered_by_its_slabs() {
         parts.len()
     );
 }
+
+/// A cross (a plus sign 8 wide, its arms 2 wide, extruded 2 high) sampled
+/// on its surface about every 0.05 with noise 0.005 across it, and each
+/// point's face among its eight arm sides (the four pairs of coplanar
+/// ones, x = ±1 or y = ±1 on either side of the centre), or `None`.
+fn cross(seed: u64) -> (Vec<[f64; 3]>, Vec<Option<usize>>) {
+    let mut next = draws(seed);
+    let (mut pts, mut face) = (Vec::new(), Vec::new());
+    let mut rect = |p0: [f64; 3], u: [f64; 3], w: [f64; 3], f: Option<usize>| {
+        let n = cross3(u, w);
+        let len = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        let (nu, nw) = ((len(u) / 0.05) as usize, (len(w) / 0.05) as usize);
+        for i in 0..nu {
+            for j in 0..nw {
+                let (s, r) = (
+                    (i as f64 + next()) / nu as f64,
+                    (j as f64 + next()) / nw as f64,
+                );
+                let e = 0.005 * gauss(&mut next) / len(n);
+                pts.push(std::array::from_fn(|k| {
+                    p0[k] + s * u[k] + r * w[k] + e * n[k]
+                }));
+                face.push(f);
+            }
+        }
+    };
+    let z = [0.0, 0.0, 2.0];
+    // Top and bottom: the centre square and the four arms.
+    for h in [0.0, 2.0] {
+        rect([-1.0, -1.0, h], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0], None);
+        rect([1.0, -1.0, h], [3.0, 0.0, 0.0], [0.0, 2.0, 0.0], None);
+        rect([-4.0, -1.0, h], [3.0, 0.0, 0.0], [0.0, 2.0, 0.0], None);
+        rect([-1.0, 1.0, h], [2.0, 0.0, 0.0], [0.0, 3.0, 0.0], None);
+        rect([-1.0, -4.0, h], [2.0, 0.0, 0.0], [0.0, 3.0, 0.0], None);
+    }
+    // The arms' ends.
+    rect([4.0, -1.0, 0.0], [0.0, 2.0, 0.0], z, None);
+    rect([-4.0, -1.0, 0.0], [0.0, 2.0, 0.0], z, None);
+    rect([-1.0, 4.0, 0.0], [2.0, 0.0, 0.0], z, None);
+    rect([-1.0, -4.0, 0.0], [2.0, 0.0, 0.0], z, None);
+    // The arms' sides: faces 2k and 2k + 1 are coplanar.
+    for (k, s) in [1.0, -1.0].into_iter().enumerate() {
+        rect([1.0, s, 0.0], [3.0, 0.0, 0.0], z, Some(4 * k));
+        rect([-4.0, s, 0.0], [3.0, 0.0, 0.0], z, Some(4 * k + 1));
+        rect([s, 1.0, 0.0], [0.0, 3.0, 0.0], z, Some(4 * k + 2));
+        rect([s, -4.0, 0.0], [0.0, 3.0, 0.0], z, Some(4 * k + 3));
+    }
+    (pts, face)
+}
+
+fn cross3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+#[test]
+fn a_cross_s_coplanar_arm_sides_are_parts_of_their_own() {
+    // Each pair of coplanar sides has the centre's solid between them,
+    // as deep (the arms, 3 long) as the gap is wide (2): two faces, two
+    // parts (docs/method.md §4 step 5, "A solid between them"), as a
+    // merging by the gap rule alone would not leave them.
+    let (pts, face) = cross(41);
+    let d = Detector::auto(StructureKind::Planes, &pts, &Given::default()).unwrap();
+    let det = d.run(&pts).unwrap();
+    let mut part_of = vec![usize::MAX; pts.len()];
+    for (k, p) in det.structures.iter().flat_map(|s| &s.parts).enumerate() {
+        for &v in &p.vertices {
+            part_of[v as usize] = k;
+        }
+    }
+    // Each side's most common part, holding most of it.
+    let main_part: Vec<usize> = (0..8)
+        .map(|f| {
+            let mut count = std::collections::HashMap::new();
+            let ids: Vec<usize> = (0..pts.len()).filter(|&i| face[i] == Some(f)).collect();
+            for &i in &ids {
+                *count.entry(part_of[i]).or_insert(0usize) += 1;
+            }
+            let (&p, &n) = count.iter().max_by_key(|&(p, n)| (*n, *p)).unwrap();
+            assert!(
+                p != usize::MAX && 2 * n > ids.len(),
+                "face {f}: {n} of {}",
+                ids.len()
+            );
+            p
+        })
+        .collect();
+    for pair in main_part.chunks(2) {
+        assert_ne!(
+            pair[0], pair[1],
+            "coplanar sides in one part: {main_part:?}"
+        );
+    }
+}

@@ -11,7 +11,10 @@
 //! window); a gap larger than both is two surfaces that happen to be
 //! coplanar (the flat roofs of two houses at one height, the floors of two
 //! buildings), which stay two parts. The gap is the distance between the
-//! pieces' bounding boxes.
+//! pieces' bounding boxes. Nor are two pieces one part when a solid stands
+//! between them ([`super::crossing`]: a surface rises from their plane
+//! between them at least as far as the gap is wide): they are two faces
+//! (the arms of a cross, a table top cut in two by a box).
 //!
 //! Two parts are one plane by the test that merges candidates (parallel,
 //! each centroid within τ of the other's plane, or most of the smaller
@@ -32,10 +35,11 @@
 //! most [`JOINT_SAMPLE`] of the larger one's.
 
 use super::super::detection::Primitive;
+use super::crossing::{gap, Box3, Crossings};
 use super::moments::Moments;
 use super::same::SAME_SHARE;
 use super::{Candidate, Draft, Shape};
-use crate::geometry::{bounding_box_of, dot, sub};
+use crate::geometry::{dot, sub};
 use crate::unionfind::UnionFind;
 
 /// The most points of the larger group that the joint plane's test reads
@@ -53,27 +57,24 @@ pub(super) fn planes_apart<S: Shape>(
     if parts.len() < 2 {
         return;
     }
-    let pairs = pairs(parts, cands, points, angle_deg);
+    let crossings = Crossings::new(parts, cands, points, angle_deg);
+    let pairs = pairs(parts, &crossings.boxes, cands, angle_deg);
     let mut groups = Groups::new(parts, cands, points);
     let mut uf = UnionFind::new(parts.len());
     let mut merged = false;
     for (a, b) in pairs {
-        merged |= groups.join(parts, &mut uf, a, b, points, angle_deg);
+        let (ra, rb) = (uf.find(a as u32) as usize, uf.find(b as u32) as usize);
+        if ra != rb
+            && groups.one_plane(parts, ra, rb, points, angle_deg)
+            && !crossings.crossed(parts, points, a, b)
+        {
+            groups.join(&mut uf, a, b, (ra, rb));
+            merged = true;
+        }
     }
     if merged {
         regroup::<S>(parts, uf.sets(), points);
     }
-}
-
-/// A bounding box.
-type Box3 = ([f64; 3], [f64; 3]);
-
-/// The distance between two boxes (0 when they meet).
-fn gap(a: &Box3, b: &Box3) -> f64 {
-    (0..3)
-        .map(|k| (b.0[k] - a.1[k]).max(a.0[k] - b.1[k]).max(0.0).powi(2))
-        .sum::<f64>()
-        .sqrt()
 }
 
 /// Whether the plane of `fit` passes within `tau` of the box `b`: the
@@ -111,14 +112,10 @@ fn size(fit: &Primitive) -> f64 {
 /// part's size), largest pieces first.
 fn pairs(
     parts: &[Draft],
+    boxes: &[Box3],
     cands: &[Candidate],
-    points: &[[f64; 3]],
     angle_deg: f64,
 ) -> Vec<(usize, usize)> {
-    let boxes: Vec<Box3> = parts
-        .iter()
-        .map(|p| bounding_box_of(points, &p.members))
-        .collect();
     let sizes: Vec<f64> = parts.iter().map(|p| size(&p.fit)).collect();
     let tau = |a: usize| cands[parts[a].cand].tau;
     let cos = angle_deg.to_radians().cos();
@@ -264,24 +261,8 @@ impl Groups {
         })
     }
 
-    /// Joins the groups of parts `a` and `b` if they are one plane; whether
-    /// they were joined.
-    fn join(
-        &mut self,
-        parts: &[Draft],
-        uf: &mut UnionFind,
-        a: usize,
-        b: usize,
-        points: &[[f64; 3]],
-        angle_deg: f64,
-    ) -> bool {
-        let (ra, rb) = (uf.find(a as u32) as usize, uf.find(b as u32) as usize);
-        if ra == rb {
-            return false;
-        }
-        if !self.one_plane(parts, ra, rb, points, angle_deg) {
-            return false;
-        }
+    /// Joins the groups of parts `a` and `b`, at roots `ra` and `rb`.
+    fn join(&mut self, uf: &mut UnionFind, a: usize, b: usize, (ra, rb): (usize, usize)) {
         uf.union_min_root(a as u32, b as u32);
         let root = uf.find(a as u32) as usize;
         let other = if root == ra { rb } else { ra };
@@ -295,7 +276,6 @@ impl Groups {
         self.moments[root] = self.moments[root].join(&self.moments[other]);
         self.tau[root] = self.tau[big];
         self.fit[root] = self.moments[root].plane();
-        true
     }
 }
 
@@ -533,7 +513,11 @@ mod tests {
             }
         }
         let (parts, cands): (Vec<Draft>, Vec<Candidate>) = pieces.into_iter().unzip();
-        assert!(pairs(&parts, &cands, &pts, 10.0).is_empty());
+        let boxes: Vec<Box3> = parts
+            .iter()
+            .map(|p| crate::geometry::bounding_box_of(&pts, &p.members))
+            .collect();
+        assert!(pairs(&parts, &boxes, &cands, 10.0).is_empty());
         let mut parts = parts;
         planes_apart::<[u32; 3]>(&mut parts, &cands, &pts, 10.0);
         assert_eq!(parts.len(), 2500);

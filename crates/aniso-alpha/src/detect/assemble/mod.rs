@@ -23,8 +23,9 @@
 //! 4. **Significance** (`significance`). With the test on, each part's
 //!    number of false alarms ([`super::significance`]); parts above ε go.
 //! 5. **One primitive, one part** (`merging`). Planar parts that are one
-//!    plane but lie apart become one part in several pieces; a line keeps
-//!    its segments apart ([`Shape::merge_apart`]).
+//!    plane but lie apart become one part in several pieces, unless a
+//!    solid stands between them (`crossing`); a line keeps its segments
+//!    apart ([`Shape::merge_apart`]).
 //!    **Proportions** (`proportions`; with the data's orientations): a plane holds as many rows of
 //!    points across as its ellipsoid is long in spacings, a line is as
 //!    elongated as its ellipsoid; the others go.
@@ -43,6 +44,7 @@
 
 mod candidates;
 mod claims;
+mod crossing;
 mod embedded;
 mod footprint;
 mod merging;
