@@ -20,10 +20,10 @@
 //!   of a truck standing before a wall, its shadow's cause, does not);
 //! * rises from the plane at least as far as the gap is wide (its
 //!   farthest point from the plane against the width). A solid is as deep
-//!   as it is wide or deeper; a step narrower than it is wide, the recess
-//!   or the porch of a façade (CGAL's building scan: a central section
-//!   set 1–2 m off a 56 m façade, across a 16 m gap), leaves one surface
-//!   with a hole, as the gap rule reads it.
+//!   as it is wide or deeper; a step shallower than it is wide, the recess
+//!   or the porch of a façade (CGAL's building scan: the central section
+//!   between the wings of its 56 m façade, across a 16 m gap), leaves one
+//!   surface with a hole, as the gap rule reads it.
 //!
 //! From the geometry alone (no scanner position) a recess and a
 //! protrusion are mirror images; the comparison of depth and width is
