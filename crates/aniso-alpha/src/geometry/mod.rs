@@ -68,6 +68,17 @@ pub(crate) fn bounding_box_of(points: &[Point3], ids: &[u32]) -> (Point3, Point3
     (lo, hi)
 }
 
+/// An axis-aligned box: its lower and upper corners.
+pub(crate) type Box3 = (Point3, Point3);
+
+/// The distance between two boxes (0 when they meet).
+pub(crate) fn box_gap(a: &Box3, b: &Box3) -> f64 {
+    (0..3)
+        .map(|k| (b.0[k] - a.1[k]).max(a.0[k] - b.1[k]).max(0.0).powi(2))
+        .sum::<f64>()
+        .sqrt()
+}
+
 #[cfg(test)]
 mod tests {
     use super::floor_i64;

@@ -39,18 +39,7 @@
 
 use super::super::detection::Primitive;
 use super::{Candidate, Draft};
-use crate::geometry::{bounding_box_of, dot, sub};
-
-/// A bounding box.
-pub(super) type Box3 = ([f64; 3], [f64; 3]);
-
-/// The distance between two boxes (0 when they meet).
-pub(super) fn gap(a: &Box3, b: &Box3) -> f64 {
-    (0..3)
-        .map(|k| (b.0[k] - a.1[k]).max(a.0[k] - b.1[k]).max(0.0).powi(2))
-        .sum::<f64>()
-        .sqrt()
-}
+use crate::geometry::{bounding_box_of, box_gap, dot, sub, Box3};
 
 /// The parts' boxes, claim radii and an index of the boxes along x.
 pub(super) struct Crossings {
@@ -120,7 +109,7 @@ impl Crossings {
             .take_while(|&k| self.lo_x[k] <= joint.1[0])
             .map(|k| self.order[k])
             .chain(self.wide.iter().copied())
-            .filter(|&c| c != a && c != b && gap(&self.boxes[c], &joint) == 0.0);
+            .filter(|&c| c != a && c != b && box_gap(&self.boxes[c], &joint) == 0.0);
         for c in meeting {
             let Primitive::Plane(pc) = &parts[c].fit else {
                 continue;
@@ -151,7 +140,7 @@ impl Crossings {
                 let q = &points[v as usize];
                 let d = parts[a].fit.distance(q);
                 rise = rise.max(d);
-                meets |= d <= tau && gap(&(*q, *q), &joint) <= tau;
+                meets |= d <= tau && box_gap(&(*q, *q), &joint) <= tau;
             }
             if meets && rise >= width {
                 return true;

@@ -35,11 +35,11 @@
 //! most [`JOINT_SAMPLE`] of the larger one's.
 
 use super::super::detection::Primitive;
-use super::crossing::{gap, Box3, Crossings};
+use super::crossing::Crossings;
 use super::moments::Moments;
 use super::same::SAME_SHARE;
 use super::{Candidate, Draft, Shape};
-use crate::geometry::{dot, sub};
+use crate::geometry::{box_gap, dot, sub, Box3};
 use crate::unionfind::UnionFind;
 
 /// The most points of the larger group that the joint plane's test reads
@@ -131,7 +131,7 @@ fn pairs(
             if start(b) > end(a) {
                 break;
             }
-            if gap(&boxes[a], &boxes[b]) <= sizes[a].max(sizes[b])
+            if box_gap(&boxes[a], &boxes[b]) <= sizes[a].max(sizes[b])
                 && parallel_planes(&parts[a].fit, &parts[b].fit, cos)
                 && (plane_meets_box(&parts[a].fit, tau(a), &boxes[b])
                     || plane_meets_box(&parts[b].fit, tau(b), &boxes[a]))
