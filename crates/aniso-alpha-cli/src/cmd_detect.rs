@@ -883,7 +883,7 @@ fn summary(
         ));
     }
     o.push_str(&format!(
-        "  {} orientations in {:.2} s; union {} simplices; {} part(s) kept, {} rejected by the significance test{}{}\n\n",
+        "  {} orientations in {:.2} s; union {} simplices; {} part(s) kept, {} rejected by the significance test{}{}{}\n\n",
         det.stats.orientations,
         seconds,
         det.stats.union_simplices,
@@ -897,6 +897,10 @@ fn summary(
             (0, _) => String::new(),
             (n, StructureKind::Planes) => format!(", {n} narrower than their ellipsoid (strips: wires, poles, edges)"),
             (n, StructureKind::Lines) => format!(", {n} less elongated than their ellipsoid (blobs)"),
+        },
+        match det.stats.faces_apart {
+            0 => String::new(),
+            n => format!(", {n} pair(s) of coplanar pieces kept apart by a solid between them (two faces)"),
         }
     ));
     o.push_str(&part_table(det));

@@ -246,6 +246,7 @@ pub fn detection_json(det: &Detection, d: &Detector) -> Value {
             "rejected_parts": s.rejected_parts,
             "surface_lines": s.surface_lines,
             "out_of_proportion": s.out_of_proportion,
+            "faces_apart": s.faces_apart,
             "reclaimed_points": s.reclaimed_points,
         },
         "structures": structures_json(det),

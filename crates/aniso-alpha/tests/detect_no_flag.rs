@@ -623,4 +623,6 @@ fn a_cross_s_coplanar_arm_sides_are_parts_of_their_own() {
             "coplanar sides in one part: {main_part:?}"
         );
     }
+    // The run counts the pairs it kept apart (at least the four pairs).
+    assert!(det.stats.faces_apart >= 4, "{:?}", det.stats);
 }

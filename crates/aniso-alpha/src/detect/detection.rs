@@ -167,6 +167,10 @@ pub struct RunStats {
     /// Points whose nearest claimer made no kept part, joined to the
     /// nearest kept part that claims them (docs/method.md §4 step 6).
     pub reclaimed_points: usize,
+    /// Pairs of coplanar planar pieces that would have merged into one
+    /// part, kept apart because a solid stands between them: two faces
+    /// (docs/method.md §4 step 5, "A solid between them").
+    pub faces_apart: usize,
 }
 
 /// Simplices with the same number of vertices each (2: edges, k = 1; 3:

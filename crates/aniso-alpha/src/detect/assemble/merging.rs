@@ -47,27 +47,30 @@ use crate::unionfind::UnionFind;
 /// standard error of a share from 4,096 draws is at most 0.8%).
 const JOINT_SAMPLE: usize = 4096;
 
-/// Merges the planar parts that are one plane (module doc).
+/// Merges the planar parts that are one plane (module doc); how many
+/// pairs of them that are one plane stay apart, a solid between them.
 pub(super) fn planes_apart<S: Shape>(
     parts: &mut Vec<Draft>,
     cands: &[Candidate],
     points: &[[f64; 3]],
     angle_deg: f64,
-) {
+) -> usize {
     if parts.len() < 2 {
-        return;
+        return 0;
     }
     let crossings = Crossings::new(parts, cands, points, angle_deg);
     let pairs = pairs(parts, &crossings.boxes, cands, angle_deg);
     let mut groups = Groups::new(parts, cands, points);
     let mut uf = UnionFind::new(parts.len());
-    let mut merged = false;
+    let (mut merged, mut apart) = (false, 0);
     for (a, b) in pairs {
         let (ra, rb) = (uf.find(a as u32) as usize, uf.find(b as u32) as usize);
-        if ra != rb
-            && groups.one_plane(parts, ra, rb, points, angle_deg)
-            && !crossings.crossed(parts, points, a, b)
-        {
+        if ra == rb || !groups.one_plane(parts, ra, rb, points, angle_deg) {
+            continue;
+        }
+        if crossings.crossed(parts, points, a, b) {
+            apart += 1;
+        } else {
             groups.join(&mut uf, a, b, (ra, rb));
             merged = true;
         }
@@ -75,6 +78,7 @@ pub(super) fn planes_apart<S: Shape>(
     if merged {
         regroup::<S>(parts, uf.sets(), points);
     }
+    apart
 }
 
 /// Whether the plane of `fit` passes within `tau` of the box `b`: the

@@ -275,7 +275,7 @@ pub(crate) fn finish<S: Shape>(
     let cloud = &*cloud;
     let clock = &settings.clock;
     // 5. One primitive, one part.
-    clock.time(Stage::Merge, || {
+    stats.faces_apart += clock.time(Stage::Merge, || {
         S::merge_apart(&mut parts, &cands, cloud.points(), settings.part_angle_deg)
     });
     // 5b. Proportions at the ellipsoid's scale.

@@ -83,13 +83,16 @@ pub(crate) trait Shape: Face {
     /// (parallel lines).
     fn sides(fit: &Primitive, b: &[u32], points: &[[f64; 3]]) -> Option<(usize, usize)>;
     /// Merges the parts that are one primitive seen in places apart
-    /// (docs/method.md §4, step 5); by default they stay apart.
+    /// (docs/method.md §4, step 5); how many pairs that would have merged
+    /// stay apart as two faces of a solid. By default they all stay
+    /// apart, and none is counted.
     fn merge_apart(
         _parts: &mut Vec<Draft>,
         _cands: &[Candidate],
         _points: &[[f64; 3]],
         _angle_deg: f64,
-    ) {
+    ) -> usize {
+        0
     }
     /// Drops the parts that lie inside a surface, its sampling rather than
     /// a structure of this shape; how many went. By default none.
@@ -285,8 +288,8 @@ impl Shape for [u32; 3] {
         cands: &[Candidate],
         points: &[[f64; 3]],
         angle_deg: f64,
-    ) {
-        merging::planes_apart::<Self>(parts, cands, points, angle_deg);
+    ) -> usize {
+        merging::planes_apart::<Self>(parts, cands, points, angle_deg)
     }
 
     /// The plane's 2D α-shape of the members at the candidate's cell.
