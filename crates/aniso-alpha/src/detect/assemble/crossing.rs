@@ -122,8 +122,22 @@ impl Crossings {
             if side_a * side_b >= 0.0 || side_a.abs().min(side_b.abs()) <= self.tau[c] {
                 continue;
             }
+            // C's points: whether one meets the plane of `a` within the
+            // joint box, and how far C rises from that plane.
+            let (mut meets, mut rise) = (false, 0.0f64);
+            for &v in &parts[c].members {
+                let q = &points[v as usize];
+                let d = parts[a].fit.distance(q);
+                rise = rise.max(d);
+                meets |= d <= tau && box_gap(&(*q, *q), &joint) <= tau;
+            }
+            if !meets {
+                continue;
+            }
             // The gap's width across C: how near each piece comes to C's
-            // plane from its own side (negative where it reaches across).
+            // plane from its own side (negative where it reaches across);
+            // read only for a C that meets the plane (the pieces may be
+            // the ground's, of many points).
             let near = |p: usize, side: f64| {
                 parts[p]
                     .members
@@ -132,17 +146,7 @@ impl Crossings {
                     .fold(f64::INFINITY, f64::min)
             };
             let width = near(a, side_a) + near(b, side_b);
-            if width <= tau {
-                continue;
-            }
-            let (mut meets, mut rise) = (false, 0.0f64);
-            for &v in &parts[c].members {
-                let q = &points[v as usize];
-                let d = parts[a].fit.distance(q);
-                rise = rise.max(d);
-                meets |= d <= tau && box_gap(&(*q, *q), &joint) <= tau;
-            }
-            if meets && rise >= width {
+            if width > tau && rise >= width {
                 return true;
             }
         }
