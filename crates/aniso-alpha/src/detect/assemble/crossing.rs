@@ -39,7 +39,7 @@
 
 use super::super::detection::Primitive;
 use super::{Candidate, Draft};
-use crate::geometry::{bounding_box_of, box_gap, dot, sub, Box3};
+use crate::geometry::{bounding_box_of, box_d2, box_gap, dot, sub, Box3};
 
 /// The parts' boxes, claim radii and an index of the boxes along x.
 pub(super) struct Crossings {
@@ -129,7 +129,7 @@ impl Crossings {
                 let q = &points[v as usize];
                 let d = parts[a].fit.distance(q);
                 rise = rise.max(d);
-                meets |= d <= tau && box_gap(&(*q, *q), &joint) <= tau;
+                meets |= d <= tau && box_d2(q, &joint).sqrt() <= tau;
             }
             if !meets {
                 continue;
